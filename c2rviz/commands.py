@@ -1,0 +1,369 @@
+"""The command language: one text line in, one frozen command out.
+
+A pure parser: no sockets, no robot, no state. ``parse_line`` knows the shape
+of every command (how many numbers, which words) but not the robot, so joint
+counts, index ranges and limits are checked later by the session. Numbers are
+returned exactly as written, in the client's units; the session converts.
+
+Grammar (see the README for the full table):
+
+- verbs are case-insensitive; ``#`` starts a comment; blank lines are ``None``;
+- spaces and tabs separate words; spaces around commas are allowed;
+- numbers are ASCII decimals (``-1``, ``2.5``, ``.5``, ``1e-3``); ``nan``,
+  ``inf``, hex, underscores and non-ASCII digits are rejected, and so is a
+  value that overflows to infinity (``1e309``).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from .errors import BadArguments, LineError, UnknownCommand, shown
+
+__all__ = [
+    "MARKER_SHAPES",
+    "USAGE",
+    "Bye",
+    "Clear",
+    "Color",
+    "Command",
+    "ForeignProtocol",
+    "Help",
+    "Home",
+    "Joints",
+    "Mark",
+    "MarkerShape",
+    "Move",
+    "Names",
+    "Pose",
+    "Quit",
+    "Rand",
+    "Sleep",
+    "Units",
+    "Where",
+    "parse_line",
+]
+
+MARKER_SHAPES = ("sphere", "cube", "arrow", "cylinder")
+
+
+class ForeignProtocol(LineError):
+    """A line that is plainly another protocol (an HTTP request) hitting our port."""
+
+    def __init__(self) -> None:
+        super().__init__(
+            "this is the c2rviz command port (one text command per line), not HTTP; "
+            "open the viewer's address in a browser instead"
+        )
+
+
+@dataclass(frozen=True, slots=True)
+class Rand:
+    """Move every chain joint to a random value within its limits."""
+
+
+@dataclass(frozen=True, slots=True)
+class Home:
+    """Move every chain joint to zero."""
+
+
+@dataclass(frozen=True, slots=True)
+class Units:
+    """Switch this connection's angle unit (``degrees=True``) or back to radians."""
+
+    degrees: bool
+
+
+@dataclass(frozen=True, slots=True)
+class Joints:
+    """Set all chain joints, in the client's units."""
+
+    values: tuple[float, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class Move:
+    """Set the joints at ``indices`` to ``values`` (client's units)."""
+
+    indices: tuple[int, ...]
+    values: tuple[float, ...]
+
+
+@dataclass(frozen=True, slots=True)
+class Clear:
+    """Home the robot and remove every marker."""
+
+
+@dataclass(frozen=True, slots=True)
+class Mark:
+    """Drop a marker at ``pose`` (x, y, z [m], roll, pitch, yaw [client's units]).
+
+    ``pose`` is None for a marker at the current end-effector pose.
+    """
+
+    pose: tuple[float, float, float, float, float, float] | None
+
+
+@dataclass(frozen=True, slots=True)
+class Color:
+    """Colour of this connection's next markers, each channel 0..1."""
+
+    rgb: tuple[float, float, float]
+
+
+@dataclass(frozen=True, slots=True)
+class MarkerShape:
+    """Shape of this connection's next markers, one of ``MARKER_SHAPES``."""
+
+    shape: str
+
+
+@dataclass(frozen=True, slots=True)
+class Where:
+    """Ask for the chain's joint values."""
+
+
+@dataclass(frozen=True, slots=True)
+class Pose:
+    """Ask for the end-effector pose in the base frame."""
+
+
+@dataclass(frozen=True, slots=True)
+class Names:
+    """Ask for the robot name and the chain's joint names."""
+
+
+@dataclass(frozen=True, slots=True)
+class Help:
+    """Ask for the list of commands."""
+
+
+@dataclass(frozen=True, slots=True)
+class Sleep:
+    """Pause this connection for ``seconds`` [s]."""
+
+    seconds: float
+
+
+@dataclass(frozen=True, slots=True)
+class Bye:
+    """Close this connection."""
+
+
+@dataclass(frozen=True, slots=True)
+class Quit:
+    """Stop the whole program."""
+
+
+Command = (
+    Rand | Home | Units | Joints | Move | Clear | Mark | Color | MarkerShape
+    | Where | Pose | Names | Help | Sleep | Bye | Quit
+)  # fmt: skip
+
+# Usage of every verb, in the order ``help`` lists them.
+USAGE: dict[str, str] = {
+    "rand": "rand",
+    "home": "home",
+    "degrees": "degrees",
+    "radians": "radians",
+    "joints": "joints v0,...,vn-1",
+    "j": "j v0,...,vn-1",
+    "move": "move i[,j,...] vi[,vj,...]",
+    "clear": "clear",
+    "mark": "mark [x,y,z,roll,pitch,yaw]",
+    "color": "color r,g,b (0..1)",
+    "rgb": "rgb r,g,b (0..255)",
+    "marker": "marker " + "|".join(MARKER_SHAPES),
+    "where": "where",
+    "pose": "pose",
+    "names": "names",
+    "help": "help",
+    "sleep": "sleep seconds",
+    "bye": "bye",
+    "quit": "quit",
+}
+
+_NUMBER = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
+_NUMBER_RE = re.compile(_NUMBER)
+_NUMBER_LIST_RE = re.compile(rf"{_NUMBER}(?:,{_NUMBER})*")
+_INDEX_RE = re.compile(r"[0-9]+")
+_INDEX_LIST_RE = re.compile(r"[0-9]+(?:,[0-9]+)*")
+_AROUND_COMMA_RE = re.compile(r"[ \t]*,[ \t]*")
+_HTTP_RE = re.compile(r"[A-Z]+ \S+ HTTP/[0-9.]+|[A-Za-z][A-Za-z0-9-]*:( .*)?")
+_MAX_INDEX_DIGITS = 9
+
+
+def _numbers(verb: str, text: str) -> tuple[float, ...]:
+    """Parse a comma list of ASCII decimals; reject malformed and non-finite values."""
+    if _NUMBER_LIST_RE.fullmatch(text) is None:
+        for item in text.split(","):
+            if _NUMBER_RE.fullmatch(item) is None:
+                problem = "empty value in list" if not item else f"bad number {shown(item)}"
+                raise BadArguments(verb, problem, USAGE[verb])
+    values = tuple(map(float, text.split(",")))
+    if not all(map(math.isfinite, values)):
+        big = next(item for item in text.split(",") if not math.isfinite(float(item)))
+        raise BadArguments(verb, f"value {shown(big)} is not a finite number", USAGE[verb])
+    return values
+
+
+def _indices(verb: str, text: str) -> tuple[int, ...]:
+    """Parse a comma list of joint indices (ASCII digits, no sign)."""
+    if _INDEX_LIST_RE.fullmatch(text) is None:
+        for item in text.split(","):
+            if _INDEX_RE.fullmatch(item) is None:
+                problem = "empty index in list" if not item else f"bad joint index {shown(item)}"
+                raise BadArguments(verb, problem, USAGE[verb])
+    items = text.split(",")
+    for item in items:
+        if len(item) > _MAX_INDEX_DIGITS:
+            raise BadArguments(verb, f"joint index {shown(item, 12)} is too large", USAGE[verb])
+    return tuple(map(int, items))
+
+
+def _count(verb: str, values: tuple[float, ...], needed: int) -> tuple[float, ...]:
+    if len(values) != needed:
+        raise BadArguments(verb, f"needs {needed} values, got {len(values)}", USAGE[verb])
+    return values
+
+
+def _no_args(command: Command) -> Callable[[str, list[str]], Command]:
+    def parse(verb: str, words: list[str]) -> Command:
+        if words:
+            raise BadArguments(verb, "takes no arguments", USAGE[verb])
+        return command
+
+    return parse
+
+
+def _one_word(verb: str, words: list[str]) -> str:
+    if len(words) != 1:
+        problem = "needs an argument" if not words else f"takes 1 argument, got {len(words)}"
+        raise BadArguments(verb, problem, USAGE[verb])
+    return words[0]
+
+
+def _joints(verb: str, words: list[str]) -> Joints:
+    return Joints(_numbers(verb, _one_word(verb, words)))
+
+
+def _move(verb: str, words: list[str]) -> Move:
+    if len(words) != 2:
+        raise BadArguments(verb, f"takes 2 arguments, got {len(words)}", USAGE[verb])
+    indices = _indices(verb, words[0])
+    values = _numbers(verb, words[1])
+    if len(indices) != len(values):
+        raise BadArguments(
+            verb, f"{len(indices)} indices but {len(values)} values", USAGE[verb]
+        )
+    if len(set(indices)) != len(indices):
+        twice = next(i for i in indices if indices.count(i) > 1)
+        raise BadArguments(verb, f"joint {twice} is given twice", USAGE[verb])
+    return Move(indices, values)
+
+
+def _mark(verb: str, words: list[str]) -> Mark:
+    if not words:
+        return Mark(None)
+    x, y, z, roll, pitch, yaw = _count(verb, _numbers(verb, _one_word(verb, words)), 6)
+    return Mark((x, y, z, roll, pitch, yaw))
+
+
+def _colour(verb: str, words: list[str], top: float) -> Color:
+    r, g, b = _count(verb, _numbers(verb, _one_word(verb, words)), 3)
+    for channel in (r, g, b):
+        if not 0.0 <= channel <= top:
+            raise BadArguments(
+                verb, f"channel {channel:g} is outside 0..{top:g}", USAGE[verb]
+            )
+    return Color((r / top, g / top, b / top))
+
+
+def _marker(verb: str, words: list[str]) -> MarkerShape:
+    shape = _one_word(verb, words).lower()
+    if shape not in MARKER_SHAPES:
+        raise BadArguments(verb, f"unknown shape {shown(shape)}", USAGE[verb])
+    return MarkerShape(shape)
+
+
+def _sleep(verb: str, words: list[str]) -> Sleep:
+    (seconds,) = _count(verb, _numbers(verb, _one_word(verb, words)), 1)
+    if seconds < 0:
+        raise BadArguments(verb, f"seconds must be >= 0, got {seconds:g}", USAGE[verb])
+    return Sleep(seconds)
+
+
+_PARSERS: dict[str, Callable[[str, list[str]], Command]] = {
+    "rand": _no_args(Rand()),
+    "home": _no_args(Home()),
+    "degrees": _no_args(Units(degrees=True)),
+    "degree": _no_args(Units(degrees=True)),
+    "radians": _no_args(Units(degrees=False)),
+    "radian": _no_args(Units(degrees=False)),
+    "joints": _joints,
+    "j": _joints,
+    "move": _move,
+    "clear": _no_args(Clear()),
+    "mark": _mark,
+    "color": lambda verb, words: _colour(verb, words, 1.0),
+    "rgb": lambda verb, words: _colour(verb, words, 255.0),
+    "marker": _marker,
+    "where": _no_args(Where()),
+    "pose": _no_args(Pose()),
+    "names": _no_args(Names()),
+    "help": _no_args(Help()),
+    "sleep": _sleep,
+    "bye": _no_args(Bye()),
+    "quit": _no_args(Quit()),
+}
+_USAGE_KEY = {"degree": "degrees", "radian": "radians"}
+
+
+def _clean(line: str) -> str:
+    """Return ``line`` with tabs as spaces, or raise for any other control or non-ASCII."""
+    line = line.replace("\t", " ")
+    if line.isascii() and line.isprintable():
+        return line
+    for column, char in enumerate(line, start=1):
+        if not (char.isascii() and char.isprintable()):
+            raise LineError(
+                f"character {char!r} at column {column} is not allowed: "
+                "commands are plain ASCII text"
+            )
+    return line  # pragma: no cover - the loop always finds the character
+
+
+def parse_line(line: str) -> Command | None:
+    """Parse one line of the command language.
+
+    Args:
+        line: One line, with or without its trailing ``\\n`` / ``\\r\\n``.
+
+    Returns:
+        The command, or None for a blank or comment-only line.
+
+    Raises:
+        C2rvizError: ``UnknownCommand``, ``BadArguments``, ``LineError`` (or its
+            ``ForeignProtocol``), each with a message for the user.
+    """
+    if "#" in line:
+        line = line[: line.index("#")]
+    line = line.rstrip("\r\n")
+    if not (line.isascii() and line.isprintable()):
+        line = _clean(line)
+    words = line.split()
+    if not words:
+        return None
+    verb = words[0].lower()
+    parser = _PARSERS.get(verb)
+    if parser is None:
+        if _HTTP_RE.fullmatch(line.strip()):
+            raise ForeignProtocol()
+        raise UnknownCommand(words[0])
+    args = words[1:]
+    if len(args) > 1 and "," in line:
+        args = _AROUND_COMMA_RE.sub(",", " ".join(args)).split()
+    return parser(_USAGE_KEY.get(verb, verb), args)

@@ -1,0 +1,185 @@
+"""Settings: cmdinterpreter.ini, overridden by command-line flags.
+
+The ini file has an ``[options]`` section and one section per robot (named as
+in the seed: ``[motoman_sia20d]`` ...) with ``base``, ``eelink`` and ``urdf``
+(relative to the ini file). Every bad value is a ``ConfigError`` naming the key
+and what it accepts.
+"""
+
+from __future__ import annotations
+
+import configparser
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from .errors import ConfigError
+
+__all__ = ["INI_NAME", "Limits", "RobotEntry", "Settings", "find_ini", "load_settings"]
+
+INI_NAME = "cmdinterpreter.ini"
+PROJECT_DIR = Path(__file__).resolve().parent.parent
+
+
+@dataclass(frozen=True)
+class Limits:
+    """What one client may cost the server (README: "Limits")."""
+
+    max_line: int = 8192
+    """Longest line [bytes]; longer closes the connection."""
+    max_clients: int = 64
+    """Clients connected at once; one more is told so and closed."""
+    max_unread: int = 1 << 20
+    """Replies a client has not read [bytes]; more closes the connection."""
+    partial_timeout_s: float = 10.0
+    """How long a started line may stay unfinished [s]."""
+    max_sleep_s: float = 3600.0
+    """Longest ``sleep`` [s]."""
+
+
+@dataclass(frozen=True)
+class RobotEntry:
+    """One robot section of the ini file."""
+
+    name: str
+    urdf: Path
+    base: str | None = None
+    eelink: str | None = None
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Everything the program needs to start."""
+
+    host: str = "127.0.0.1"
+    port: int = 31000
+    hz: float = 100.0
+    viewer_host: str = "127.0.0.1"
+    viewer_port: int = 8080
+    viewer: bool = True
+    robot: str = "motoman_sia20d"
+    urdf: Path | None = None
+    base: str | None = None
+    eelink: str | None = None
+    limits: Limits = field(default_factory=Limits)
+    robots: Mapping[str, RobotEntry] = field(default_factory=dict)
+    ini: Path | None = None
+
+
+# ini key -> (Settings or Limits field, type, lowest allowed, highest allowed)
+_OPTIONS: dict[str, tuple[str, type, float, float]] = {
+    "port": ("port", int, 0, 65535),
+    "hz": ("hz", float, 1, 1000),
+    "viewer_port": ("viewer_port", int, 0, 65535),
+    "max_line": ("max_line", int, 64, 1 << 24),
+    "max_clients": ("max_clients", int, 1, 100000),
+    "max_unread": ("max_unread", int, 1024, 1 << 30),
+    "partial_timeout": ("partial_timeout_s", float, 0.01, 86400),
+    "max_sleep": ("max_sleep_s", float, 0, 1e6),
+}
+_TEXT_OPTIONS = ("host", "viewer_host", "robot")
+_LIMIT_FIELDS = {f for f in Limits.__dataclass_fields__}
+
+
+def number(key: str, text: str, kind: type, low: float, high: float) -> Any:
+    """Parse ``text`` as ``kind`` within [low, high], or raise ConfigError naming ``key``."""
+    try:
+        value = kind(text)
+    except ValueError:
+        raise ConfigError(
+            f"{key} = {text!r} is not {'a whole number' if kind is int else 'a number'}"
+        ) from None
+    if not low <= value <= high:
+        raise ConfigError(f"{key} = {text} is outside {low:g}..{high:g}")
+    return value
+
+
+def find_ini(explicit: str | Path | None) -> Path | None:
+    """The ini to read: ``explicit``, else ./cmdinterpreter.ini, else the project's."""
+    if explicit is not None:
+        path = Path(explicit)
+        if not path.is_file():
+            raise ConfigError(f"config file {str(path)!r} does not exist")
+        return path
+    for candidate in (Path.cwd() / INI_NAME, PROJECT_DIR / INI_NAME):
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
+    parser = configparser.ConfigParser(interpolation=None, inline_comment_prefixes=("#", ";"))
+    try:
+        parser.read(path, encoding="utf-8")
+    except configparser.Error as exc:
+        raise ConfigError(f"cannot read {path}: {exc}".replace("\n", " ")) from None
+    values: dict[str, Any] = {}
+    if parser.has_section("options"):
+        for key, text in parser.items("options"):
+            if key in _OPTIONS:
+                name, kind, low, high = _OPTIONS[key]
+                values[name] = number(f"[options] {key}", text, kind, low, high)
+            elif key in _TEXT_OPTIONS:
+                values[key] = text
+            else:
+                raise ConfigError(
+                    f"unknown key {key!r} in [options] of {path}",
+                    sorted([*_OPTIONS, *_TEXT_OPTIONS]),
+                )
+    robots = {}
+    for section in parser.sections():
+        if section == "options":
+            continue
+        items = dict(parser.items(section))
+        unknown = set(items) - {"base", "eelink", "urdf"}
+        if unknown:
+            raise ConfigError(
+                f"unknown key {sorted(unknown)[0]!r} in [{section}] of {path}",
+                ["base", "eelink", "urdf"],
+            )
+        urdf = items.get("urdf")
+        if not urdf:
+            raise ConfigError(f"[{section}] of {path} has no urdf = PATH")
+        robots[section] = RobotEntry(
+            section, (path.parent / urdf).resolve(), items.get("base"), items.get("eelink")
+        )
+    return values, robots
+
+
+def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
+    """Merge defaults, the ini file and ``overrides`` (flags; None means not given).
+
+    Raises:
+        ConfigError: a bad ini value, or a robot name with no section.
+    """
+    values: dict[str, Any] = {}
+    robots: dict[str, RobotEntry] = {}
+    if ini is not None:
+        values, robots = _read_ini(ini)
+    given = {k: v for k, v in overrides.items() if v is not None}
+    for key, (name, _kind, low, high) in _OPTIONS.items():
+        if name in given and not low <= given[name] <= high:
+            flag = "--" + key.replace("_", "-").replace("viewer", "viser")
+            raise ConfigError(f"{flag} {given[name]:g} is outside {low:g}..{high:g}")
+    values.update(given)
+    limit_values = {k: values.pop(k) for k in list(values) if k in _LIMIT_FIELDS}
+    settings = replace(Settings(), **values, limits=Limits(**limit_values), robots=robots, ini=ini)
+    if settings.urdf is None:
+        entry = robots.get(settings.robot)
+        if entry is None:
+            where = f"in {ini}" if ini else "(no cmdinterpreter.ini found)"
+            raise ConfigError(f"unknown robot {settings.robot!r} {where}", sorted(robots))
+        settings = replace(
+            settings,
+            urdf=entry.urdf,
+            base=settings.base or entry.base,
+            eelink=settings.eelink or entry.eelink,
+        )
+    elif "robot" in overrides and overrides["robot"] is not None:
+        entry = robots.get(settings.robot)
+        if entry is not None:
+            settings = replace(
+                settings, base=settings.base or entry.base, eelink=settings.eelink or entry.eelink
+            )
+    return settings

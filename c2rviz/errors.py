@@ -1,0 +1,120 @@
+"""One error family for everything a user can get wrong.
+
+Every error builds its own message, names what was wrong and, where there is a
+finite set, the valid choices. The server turns any of these into one
+``error: <message>`` reply; the command-line tools print the message and exit 2.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+__all__ = [
+    "BadArguments",
+    "C2rvizError",
+    "ConfigError",
+    "JointCountError",
+    "JointIndexError",
+    "JointLimitError",
+    "LineError",
+    "LineTooLong",
+    "RobotError",
+    "UnknownCommand",
+    "shown",
+]
+
+
+def shown(text: str, limit: int = 40) -> str:
+    """Return ``text`` quoted for an error message: printable, and cut if long."""
+    cut = text if len(text) <= limit else text[:limit] + "..."
+    return repr(cut)
+
+
+class C2rvizError(Exception):
+    """Root of every c2rviz error; ``str(error)`` is the message for the user."""
+
+
+class LineError(C2rvizError):
+    """A line that cannot be a command at all (bad bytes, control characters)."""
+
+
+class LineTooLong(LineError):
+    """A line over the server's length limit; the connection is closed."""
+
+    def __init__(self, limit: int) -> None:
+        self.limit = limit
+        super().__init__(f"line too long (limit {limit} bytes); closing")
+
+
+class UnknownCommand(C2rvizError):
+    """A verb that is not in the command language."""
+
+    def __init__(self, verb: str) -> None:
+        self.verb = verb
+        super().__init__(f"unknown command {shown(verb)} (try 'help')")
+
+
+class BadArguments(C2rvizError):
+    """A known verb with arguments of the wrong shape."""
+
+    def __init__(self, verb: str, problem: str, usage: str) -> None:
+        self.verb = verb
+        self.problem = problem
+        self.usage = usage
+        super().__init__(f"{verb}: {problem} (usage: {usage})")
+
+
+class JointIndexError(C2rvizError):
+    """A joint index outside 0..n-1 of the chain."""
+
+    def __init__(self, index: int | str, robot: str, count: int) -> None:
+        self.index = index
+        self.robot = robot
+        self.count = count
+        shown_index = index if isinstance(index, int) else shown(index, 12)
+        super().__init__(
+            f"joint index {shown_index} out of range: {robot} has joints 0..{count - 1}"
+        )
+
+
+class JointCountError(C2rvizError):
+    """A ``joints`` command whose value count differs from the chain's length."""
+
+    def __init__(self, needed: int, got: int) -> None:
+        self.needed = needed
+        self.got = got
+        super().__init__(f"joints needs {needed} values, got {got}")
+
+
+class JointLimitError(C2rvizError):
+    """A value outside a joint's limits, reported in the client's units."""
+
+    def __init__(
+        self, joint: str, index: int, value: float, lower: float, upper: float, unit: str
+    ) -> None:
+        self.joint = joint
+        self.index = index
+        self.value = value
+        self.lower = lower
+        self.upper = upper
+        self.unit = unit
+        super().__init__(
+            f"{joint} (index {index}) = {value:.10g} {unit} is outside its limits "
+            f"{lower:.4g}..{upper:.4g} {unit}"
+        )
+
+
+class RobotError(C2rvizError):
+    """A robot description that cannot be loaded or has no usable chain."""
+
+
+class ConfigError(C2rvizError):
+    """A bad setting in cmdinterpreter.ini or on the command line."""
+
+    def __init__(self, problem: str, choices: Sequence[str] = ()) -> None:
+        self.problem = problem
+        self.choices = tuple(choices)
+        message = problem
+        if self.choices:
+            message += " (choose from: " + ", ".join(self.choices) + ")"
+        super().__init__(message)

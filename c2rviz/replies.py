@@ -1,0 +1,60 @@
+"""Every reply text the server sends, in one place (the tests import these too).
+
+A reply is one line that starts with ``ok`` or ``error:``. Functions here return
+the line without its newline; the server adds ``\\n``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from .commands import USAGE
+
+__all__ = [
+    "BYE",
+    "HELP",
+    "OK",
+    "SHUTTING_DOWN",
+    "error",
+    "incomplete_line",
+    "numbers",
+    "ok",
+    "too_many_clients",
+    "unread_replies",
+]
+
+OK = "ok"
+BYE = "ok bye"
+SHUTTING_DOWN = "error: server is shutting down"
+NOT_UTF8 = "line is not valid UTF-8"
+HELP = "ok commands: " + "; ".join(USAGE.values())
+
+
+def ok(payload: str) -> str:
+    """An ``ok`` reply carrying ``payload``."""
+    return f"ok {payload}"
+
+
+def error(problem: object) -> str:
+    """An ``error:`` reply; ``problem`` is usually a ``C2rvizError``."""
+    return f"error: {problem}"
+
+
+def numbers(values: Iterable[float]) -> str:
+    """Comma-separated values, 10 significant digits, no trailing zeros.
+
+    Values within 1e-12 of zero print as 0 (no ``6.7e-17`` from rounding noise).
+    """
+    return ",".join([f"{value:.10g}" if abs(value) > 1e-12 else "0" for value in values])
+
+
+def too_many_clients(limit: int) -> str:
+    return f"error: too many clients (limit {limit}); closing"
+
+
+def incomplete_line(timeout_s: float) -> str:
+    return f"error: line left incomplete for {timeout_s:g} s; closing"
+
+
+def unread_replies(limit: int) -> str:
+    return f"error: over {limit} bytes of unread replies; closing"

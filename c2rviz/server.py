@@ -1,0 +1,312 @@
+"""The TCP side: an asyncio line server in front of the shared world.
+
+Each connection is an ``asyncio.Protocol``: it splits what arrives into lines,
+runs every complete line through the parser and its ``Session``, and answers
+all lines of one read with one write. Nothing here knows kinematics or
+drawing. The limits in ``config.Limits`` bound what one client can cost; a
+client that breaks one is told why and closed, and no other client notices.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from collections.abc import Callable
+
+from . import replies
+from .commands import USAGE, Bye, ForeignProtocol, Quit, Sleep, parse_line
+from .config import Limits
+from .errors import BadArguments, C2rvizError, LineError, LineTooLong
+from .session import Session
+from .world import World
+
+__all__ = ["CommandServer", "Connection"]
+
+log = logging.getLogger("c2rviz.server")
+
+Line = str | C2rvizError  # a decoded line, or why it could not be one
+
+
+class Connection(asyncio.Protocol):
+    """One TCP client: its buffer, its session and its timers."""
+
+    def __init__(self, server: CommandServer) -> None:
+        self.server = server
+        self.limits = server.limits
+        self.session = Session(server.world)
+        self.transport: asyncio.Transport | None = None
+        self.peer = "?"
+        self.buffer = b""
+        self.backlog: list[Line] = []  # lines read but waiting behind a sleep
+        self.sleep_timer: asyncio.TimerHandle | None = None
+        self.partial_timer: asyncio.TimerHandle | None = None
+        self.closing = False
+        self.eof = False
+        self.closed = asyncio.get_running_loop().create_future()
+
+    # asyncio callbacks
+
+    def connection_made(self, transport: asyncio.BaseTransport) -> None:
+        assert isinstance(transport, asyncio.Transport)
+        self.transport = transport
+        peer = transport.get_extra_info("peername")
+        self.peer = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
+        server = self.server
+        if server.stopping:
+            self._close_with(replies.SHUTTING_DOWN)
+        elif len(server.connections) >= self.limits.max_clients:
+            log.warning("refused %s: %d clients already", self.peer, len(server.connections))
+            self._close_with(replies.too_many_clients(self.limits.max_clients))
+        else:
+            server.connections.add(self)
+            server.world.set_client_count(len(server.connections))
+            log.info("client %s connected", self.peer)
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        self._cancel_timers()
+        self.closing = True
+        server = self.server
+        if self in server.connections:
+            server.connections.discard(self)
+            server.world.set_client_count(len(server.connections))
+            log.info("client %s left", self.peer)
+        if not self.closed.done():
+            self.closed.set_result(None)
+
+    def data_received(self, data: bytes) -> None:
+        if self.closing:
+            return
+        buffer = self.buffer + data if self.buffer else data
+        if self.sleep_timer is not None:
+            self.buffer = buffer  # reading is paused; the wake-up goes on from here
+            return
+        self._consume(buffer)
+
+    def eof_received(self) -> bool:
+        self.eof = True
+        if self.sleep_timer is None:
+            self._close()
+        return True  # keep the write side open until the replies are out
+
+    # line handling
+
+    def _consume(self, buffer: bytes) -> None:
+        """Run every complete line in ``buffer``; keep the unfinished rest."""
+        cut = buffer.rfind(b"\n")
+        if cut >= 0:
+            self.buffer = buffer[cut + 1 :]
+            self._run(self._decode(buffer[:cut]))
+        else:
+            self.buffer = buffer
+        if self.closing or self.sleep_timer is not None:
+            return
+        if len(self.buffer) > self.limits.max_line:
+            self._close_with(replies.error(LineTooLong(self.limits.max_line)))
+        elif self.buffer and self.partial_timer is None:
+            self.partial_timer = asyncio.get_running_loop().call_later(
+                self.limits.partial_timeout_s, self._partial_timeout
+            )
+        elif not self.buffer and self.partial_timer is not None:
+            self.partial_timer.cancel()
+            self.partial_timer = None
+
+    def _decode(self, complete: bytes) -> list[Line]:
+        """Split complete lines; mark the undecodable and the over-long ones."""
+        max_line = self.limits.max_line
+        if len(complete) <= max_line:
+            try:
+                return complete.decode().split("\n")  # type: ignore[return-value]
+            except UnicodeDecodeError:
+                pass
+        lines: list[Line] = []
+        for raw in complete.split(b"\n"):
+            if len(raw) > max_line:
+                lines.append(LineTooLong(max_line))
+                break  # the connection closes here; nothing after it runs
+            try:
+                lines.append(raw.decode())
+            except UnicodeDecodeError:
+                lines.append(LineError(replies.NOT_UTF8))
+        return lines
+
+    def _run(self, lines: list[Line]) -> None:
+        """Answer ``lines`` in order, stopping at a sleep, bye, quit or fatal line."""
+        out: list[str] = []
+        reply = out.append
+        execute = self.session.execute
+        note = self.server.world.note_command
+        for i, line in enumerate(lines):
+            try:
+                if line.__class__ is not str:
+                    raise line  # type: ignore[misc]
+                command = parse_line(line)  # type: ignore[arg-type]
+                if command is None:
+                    continue
+                note(line)  # type: ignore[arg-type]
+                if command.__class__ in _CONNECTION_COMMANDS:
+                    if isinstance(command, Sleep) and command.seconds > self.limits.max_sleep_s:
+                        raise BadArguments(
+                            "sleep",
+                            f"{command.seconds:g} s is over the limit of "
+                            f"{self.limits.max_sleep_s:g} s",
+                            USAGE["sleep"],
+                        )
+                    self._write(out)
+                    self._connection_command(command, lines[i + 1 :])
+                    return
+                reply(execute(command))
+            except (ForeignProtocol, LineTooLong) as exc:
+                out.append(replies.error(exc))
+                self._write(out)
+                self._close()
+                return
+            except C2rvizError as exc:
+                reply(replies.error(exc))
+            except Exception:  # a bug must cost one reply, never the server
+                log.exception("internal error on %r from %s", line, self.peer)
+                reply(replies.error("internal error (see the server log)"))
+        self._write(out)
+
+    def _connection_command(self, command: object, rest: list[Line]) -> None:
+        if isinstance(command, Sleep):
+            self.backlog = rest
+            assert self.transport is not None
+            self.transport.pause_reading()
+            self.sleep_timer = asyncio.get_running_loop().call_later(
+                command.seconds, self._wake
+            )
+        elif isinstance(command, Bye):
+            self._write([replies.BYE])
+            self._close()
+        elif isinstance(command, Quit):
+            self._write([replies.OK])
+            self._write([replies.SHUTTING_DOWN for line in rest if _is_command(line)])
+            self._close()
+            self.server.request_quit()
+
+    def _wake(self) -> None:
+        self.sleep_timer = None
+        if self.closing:
+            return
+        self._write([replies.OK])
+        backlog, self.backlog = self.backlog, []
+        self._run(backlog)
+        if self.closing or self.sleep_timer is not None:
+            return
+        buffer, self.buffer = self.buffer, b""
+        self._consume(buffer)
+        if self.closing or self.sleep_timer is not None:
+            return
+        if self.eof:
+            self._close()
+        elif self.transport is not None:
+            self.transport.resume_reading()
+
+    def _partial_timeout(self) -> None:
+        self.partial_timer = None
+        if self.buffer and not self.closing:
+            self._close_with(replies.incomplete_line(self.limits.partial_timeout_s))
+
+    # output and closing
+
+    def _write(self, out: list[str]) -> None:
+        if not out or self.transport is None or self.transport.is_closing():
+            return
+        self.transport.write(("\n".join(out) + "\n").encode())
+        unread = self.transport.get_write_buffer_size()
+        if unread > self.limits.max_unread:
+            log.warning("closing %s: %d bytes of replies unread", self.peer, unread)
+            self.closing = True
+            self.transport.abort()
+
+    def _close_with(self, text: str) -> None:
+        self._write([text])
+        self._close()
+
+    def _close(self) -> None:
+        self.closing = True
+        self.buffer = b""
+        self._cancel_timers()
+        if self.transport is not None:
+            self.transport.close()
+
+    def _cancel_timers(self) -> None:
+        for timer in (self.sleep_timer, self.partial_timer):
+            if timer is not None:
+                timer.cancel()
+        self.sleep_timer = self.partial_timer = None
+
+    def shutdown(self) -> None:
+        """The program is stopping: answer what was read, then close."""
+        if self.closing:
+            return
+        unanswered = (self.sleep_timer is not None) + sum(map(_is_command, self.backlog))
+        self._write([replies.SHUTTING_DOWN] * unanswered)
+        self.backlog = []
+        self._close()
+
+
+def _is_command(line: Line) -> bool:
+    """True for a line that would get a reply (not blank, not only a comment)."""
+    if line.__class__ is not str:
+        return True
+    try:
+        return parse_line(line) is not None  # type: ignore[arg-type]
+    except C2rvizError:
+        return True
+
+
+_CONNECTION_COMMANDS = frozenset({Sleep, Bye, Quit})
+
+
+class CommandServer:
+    """Listens for TCP clients and runs each one's lines against one ``World``."""
+
+    def __init__(
+        self,
+        world: World,
+        limits: Limits | None = None,
+        on_quit: Callable[[], None] | None = None,
+    ) -> None:
+        """Args:
+            world: The shared state every client acts on.
+            limits: What one client may cost.
+            on_quit: Called once when a client sends ``quit``.
+        """
+        self.world = world
+        self.limits = limits if limits is not None else Limits()
+        self.on_quit = on_quit
+        self.connections: set[Connection] = set()
+        self.stopping = False
+        self.quit_requested = False
+        self._server: asyncio.Server | None = None
+
+    async def start(self, host: str = "127.0.0.1", port: int = 0) -> tuple[str, int]:
+        """Start listening; return the address actually bound (port 0 picks one)."""
+        loop = asyncio.get_running_loop()
+        self._server = await loop.create_server(lambda: Connection(self), host, port)
+        bound = self._server.sockets[0].getsockname()
+        return bound[0], bound[1]
+
+    def request_quit(self) -> None:
+        if not self.quit_requested:
+            self.quit_requested = True
+            log.info("quit requested by a client")
+            if self.on_quit is not None:
+                self.on_quit()
+
+    async def stop(self, grace_s: float = 1.0) -> None:
+        """Stop accepting, answer and close every client, free the port."""
+        self.stopping = True
+        if self._server is not None:
+            self._server.close()
+        for connection in list(self.connections):
+            connection.shutdown()
+        pending = [c.closed for c in self.connections if not c.closed.done()]
+        if pending:
+            await asyncio.wait(pending, timeout=grace_s)
+        for connection in list(self.connections):
+            if connection.transport is not None:
+                connection.transport.abort()
+        if self._server is not None:
+            await self._server.wait_closed()
