@@ -5,20 +5,19 @@ visualization": clients send one-line commands over TCP (port 31000) and the
 arm moves in a viser page. The parts, each usable alone:
 
 - ``commands``: the pure parser (line -> frozen command);
-- ``robot``: the Pinocchio model and its serial chain;
+- ``robot`` / ``sources``: the Pinocchio model and its serial chain, and where
+  its URDF and meshes come from;
 - ``session`` / ``world``: one client's units and the shared state;
 - ``server``: the asyncio TCP server;
 - ``scene`` / ``viewer``: what is drawn, and the viser implementation;
 - ``config`` / ``cli``: cmdinterpreter.ini, flags, ``main``.
+
+Importing the package is cheap (the clients use the parser alone); the heavy
+parts (Pinocchio, viser) load when first named.
 """
 
-from .commands import parse_line
-from .errors import C2rvizError
-from .robot import Robot
-from .scene import Marker, RecordingScene, Scene
-from .server import CommandServer
-from .session import Session
-from .world import World
+from importlib import import_module
+from typing import Any
 
 __all__ = [
     "C2rvizError",
@@ -32,3 +31,21 @@ __all__ = [
     "parse_line",
 ]
 __version__ = "0.1.0"
+
+_HOME = {
+    "C2rvizError": "errors",
+    "CommandServer": "server",
+    "Marker": "scene",
+    "RecordingScene": "scene",
+    "Robot": "robot",
+    "Scene": "scene",
+    "Session": "session",
+    "World": "world",
+    "parse_line": "commands",
+}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _HOME:
+        return getattr(import_module(f".{_HOME[name]}", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -19,6 +19,7 @@ import numpy as np
 import pinocchio as pin
 
 from .errors import RobotError
+from .sources import RobotSource, load_source
 
 __all__ = ["ChainJoint", "Robot"]
 
@@ -58,7 +59,7 @@ class Robot:
         model: pin.Model,
         base: str | None = None,
         eelink: str | None = None,
-        source: str = "",
+        source: RobotSource | None = None,
     ) -> None:
         """Choose the chain of ``model``.
 
@@ -67,7 +68,8 @@ class Robot:
             base: Link the chain starts at; with ``eelink`` None, both default
                 to the root and the only leaf of an unbranched tree.
             eelink: Link the chain ends at (the end effector).
-            source: Where the model came from, for messages.
+            source: The description the model was built from (its meshes are
+                looked up through it).
 
         Raises:
             RobotError: unknown links, a branching tree with no ends given, or
@@ -76,7 +78,7 @@ class Robot:
         self.model = model
         self.data = model.createData()
         self.name = model.name
-        self.source = source
+        self.source = source if source is not None else RobotSource("")
         links = self.link_names()
         if base is None or eelink is None:
             root, leaves = self._root_and_leaves()
@@ -112,21 +114,18 @@ class Robot:
     def from_urdf(
         cls, path: str | Path, base: str | None = None, eelink: str | None = None
     ) -> Robot:
-        """Build the model from a URDF file (mimic joints follow their leader)."""
-        path = Path(path)
-        if not path.is_file():
-            raise RobotError(f"URDF file {str(path)!r} does not exist")
-        return cls.from_xml(path.read_text(encoding="utf-8"), base, eelink, source=str(path))
+        """Build the model from a URDF file."""
+        return cls.from_source(load_source(path), base, eelink)
 
     @classmethod
-    def from_xml(
-        cls, xml: str, base: str | None = None, eelink: str | None = None, source: str = ""
+    def from_source(
+        cls, source: RobotSource, base: str | None = None, eelink: str | None = None
     ) -> Robot:
-        """Build the model from URDF text."""
+        """Build the model from a loaded description (mimic joints follow their leader)."""
         try:
-            model = pin.buildModelFromXML(xml, mimic=True)
+            model = pin.buildModelFromXML(source.xml, mimic=True)
         except (RuntimeError, ValueError) as exc:
-            where = f" {source}" if source else ""
+            where = f" {source.path}" if source.path else ""
             raise RobotError(f"cannot read the URDF{where}: {exc}") from exc
         return cls(model, base, eelink, source)
 

@@ -1,0 +1,222 @@
+"""Shared fixtures: a real server on 127.0.0.1:0 and plain-socket clients.
+
+``start_server`` runs a real ``CommandServer`` (real Pinocchio robot, recording
+scene) on its own asyncio loop in a thread, so tests talk to it exactly as a
+controller would: through a TCP socket. ``c2rviz_process`` runs the whole
+program as a subprocess for the tests that need ``main`` (quit, signals).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import re
+import socket
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator
+from concurrent.futures import Future
+from dataclasses import dataclass, field
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from c2rviz.config import Limits
+from c2rviz.robot import Robot
+from c2rviz.scene import RecordingScene
+from c2rviz.server import CommandServer
+from c2rviz.world import World
+
+ROOT = Path(__file__).resolve().parent.parent
+ROBOTS = {
+    "motoman_sia20d": ("robots/motoman_sia20d/robot.urdf", "base_link", "link_t"),
+    "fanuc_lrmate200id": ("robots/fanuc_lrmate200id/robot.urdf", "base_link", "link_6"),
+    "kuka_lwr": ("robots/kuka_lwr/robot.urdf", "lwr_base_link", "lwr_7_link"),
+}
+
+
+@cache
+def load_robot(name: str = "motoman_sia20d") -> Robot:
+    """One of the bundled robots, with the ini's base and eelink (cached)."""
+    path, base, eelink = ROBOTS[name]
+    return Robot.from_urdf(ROOT / path, base, eelink)
+
+
+@dataclass
+class ServerThread:
+    """A live server on its own loop and thread."""
+
+    robot: Robot
+    limits: Limits
+    scene: RecordingScene = field(default_factory=RecordingScene)
+    quit: threading.Event = field(default_factory=threading.Event)
+    host: str = "127.0.0.1"
+    port: int = 0
+
+    def start(self) -> ServerThread:
+        self.loop = asyncio.new_event_loop()
+        self.world = World(self.robot, self.scene)
+        self.server = CommandServer(self.world, self.limits, on_quit=self.quit.set)
+        self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
+        self.thread.start()
+        self.host, self.port = self.call_async(self.server.start("127.0.0.1", 0))
+        return self
+
+    def call(self, fn: Callable[..., Any], *args: Any) -> Any:
+        """Run ``fn(*args)`` on the server's loop and return its result."""
+        done: Future[Any] = Future()
+
+        def run() -> None:
+            try:
+                done.set_result(fn(*args))
+            except BaseException as exc:  # handed to the caller
+                done.set_exception(exc)
+
+        self.loop.call_soon_threadsafe(run)
+        return done.result(timeout=10)
+
+    def call_async(self, coro: Any) -> Any:
+        return asyncio.run_coroutine_threadsafe(coro, self.loop).result(timeout=10)
+
+    @property
+    def q(self) -> tuple[float, ...]:
+        """The shared joint values [rad], read on the server's loop."""
+        return self.call(lambda: self.world.q)
+
+    def stop(self) -> None:
+        if self.loop.is_running():
+            self.call_async(self.server.stop())
+            self.loop.call_soon_threadsafe(self.loop.stop)
+        self.thread.join(timeout=10)
+        self.loop.close()
+
+
+@pytest.fixture
+def start_server() -> Iterator[Callable[..., ServerThread]]:
+    """Factory: ``start_server(robot="motoman_sia20d", **limits)``; always stopped."""
+    started: list[ServerThread] = []
+
+    def start(robot: str = "motoman_sia20d", **limits: Any) -> ServerThread:
+        server = ServerThread(load_robot(robot), Limits(**limits)).start()
+        started.append(server)
+        return server
+
+    yield start
+    for server in started:
+        server.stop()
+
+
+@pytest.fixture
+def server(start_server: Callable[..., ServerThread]) -> ServerThread:
+    """A live motoman server with default limits."""
+    return start_server()
+
+
+class Client:
+    """A controller's view of the server: a blocking TCP socket, one line at a time."""
+
+    def __init__(self, host: str, port: int, timeout: float = 10.0) -> None:
+        self.sock = socket.create_connection((host, port), timeout=timeout)
+        self.file = self.sock.makefile("rb")
+
+    def send(self, data: str | bytes) -> None:
+        self.sock.sendall(data.encode() if isinstance(data, str) else data)
+
+    def read_line(self) -> str:
+        """The next reply line, without its newline ('' when the server closed)."""
+        return self.file.readline().decode().rstrip("\n")
+
+    def ask(self, line: str) -> str:
+        """Send one command and return its reply."""
+        self.send(line + "\n")
+        return self.read_line()
+
+    def closed_by_server(self) -> bool:
+        """True when the server has closed the connection (reads EOF)."""
+        try:
+            return self.file.read() == b""  # reads to EOF: only returns once closed
+        except (ConnectionResetError, TimeoutError):
+            return False
+
+    def close(self) -> None:
+        self.file.close()
+        self.sock.close()
+
+
+@pytest.fixture
+def connect() -> Iterator[Callable[[ServerThread], Client]]:
+    """Factory: ``connect(server)`` opens a client; all are closed afterwards."""
+    clients: list[Client] = []
+
+    def open_client(server: ServerThread) -> Client:
+        client = Client(server.host, server.port)
+        clients.append(client)
+        return client
+
+    yield open_client
+    for client in clients:
+        client.close()
+
+
+@dataclass
+class Process:
+    """``python -m c2rviz`` running as a subprocess."""
+
+    popen: subprocess.Popen[str]
+    port: int
+    output: list[str]
+    viewer_url: str | None = None
+
+    def wait(self, timeout: float = 10.0) -> int:
+        return self.popen.wait(timeout=timeout)
+
+
+@pytest.fixture
+def c2rviz_process() -> Iterator[Callable[..., Process]]:
+    """Factory: start ``python -m c2rviz --port 0 ARGS``; waits until it listens."""
+    procs: list[Process] = []
+
+    def start(*args: str, timeout: float = 30.0) -> Process:
+        popen = subprocess.Popen(
+            [sys.executable, "-m", "c2rviz", "--port", "0", *args],
+            cwd=ROOT,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            env={**os.environ, "PYTHONUNBUFFERED": "1"},
+        )
+        output: list[str] = []
+        deadline = time.monotonic() + timeout
+        port = None
+        url = None
+        no_viewer = "--no-viewer" in args
+        assert popen.stdout is not None
+        while time.monotonic() < deadline:
+            line = popen.stdout.readline()
+            if not line:
+                break
+            output.append(line)
+            if m := re.search(r"commands on [\d.]+:(\d+)", line):
+                port = int(m.group(1))
+            if m := re.search(r"viewer at (\S+)", line):
+                url = m.group(1)
+            if port is not None and (no_viewer or url is not None):
+                break
+        if port is None:
+            popen.kill()
+            raise RuntimeError("c2rviz did not start:\n" + "".join(output))
+        proc = Process(popen, port, output, url)
+        procs.append(proc)
+        return proc
+
+    yield start
+    for proc in procs:
+        if proc.popen.poll() is None:
+            proc.popen.kill()
+            proc.popen.wait(timeout=10)
+        if proc.popen.stdout is not None:
+            proc.popen.stdout.close()
