@@ -1,0 +1,107 @@
+"""cmdinterpreter.ini and the flags that override it; every bad value exits 2."""
+
+from __future__ import annotations
+
+import pytest
+from conftest import ROOT
+
+from c2rviz.cli import main
+from c2rviz.config import Limits, find_ini, load_settings
+from c2rviz.errors import ConfigError
+
+INI = ROOT / "cmdinterpreter.ini"
+
+
+def test_the_shipped_ini_names_the_seed_robots():
+    settings = load_settings(INI, {})
+    assert (settings.host, settings.port, settings.hz) == ("127.0.0.1", 31000, 100.0)
+    assert (settings.viewer_host, settings.viewer_port) == ("127.0.0.1", 8080)
+    assert set(settings.robots) == {"motoman_sia20d", "fanuc_lrmate200id", "kuka_lwr"}
+    assert settings.urdf == ROOT / "robots/motoman_sia20d/robot.urdf"
+    assert (settings.base, settings.eelink) == ("base_link", "link_t")
+    assert settings.limits == Limits()
+
+
+def test_flags_override_the_file():
+    settings = load_settings(
+        INI, {"robot": "kuka_lwr", "port": 0, "eelink": "lwr_6_link", "max_clients": 3}
+    )
+    assert settings.urdf == ROOT / "robots/kuka_lwr/robot.urdf"
+    assert (settings.base, settings.eelink) == ("lwr_base_link", "lwr_6_link")
+    assert settings.port == 0
+    assert settings.limits.max_clients == 3
+
+
+def test_urdf_flag_with_a_robot_section_keeps_its_links(tmp_path):
+    settings = load_settings(INI, {"robot": "fanuc_lrmate200id", "urdf": tmp_path / "x.urdf"})
+    assert (settings.base, settings.eelink) == ("base_link", "link_6")
+    alone = load_settings(INI, {"urdf": tmp_path / "x.urdf"})
+    assert (alone.base, alone.eelink) == (None, None)
+
+
+def test_relative_urdf_paths_are_relative_to_the_ini(tmp_path):
+    ini = tmp_path / "my.ini"
+    ini.write_text("[options]\nrobot = arm\n[arm]\nurdf = urdf/arm.urdf\neelink = tip\n")
+    settings = load_settings(ini, {})
+    assert settings.urdf == tmp_path / "urdf" / "arm.urdf"
+    assert settings.eelink == "tip"
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("[options]\nport = lots\n", "[options] port = 'lots' is not a whole number"),
+        ("[options]\nport = 70000\n", "[options] port = 70000 is outside 0..65535"),
+        ("[options]\nhz = 0\n", "[options] hz = 0 is outside 1..1000"),
+        ("[options]\ncolour = red\n", "unknown key 'colour' in [options]"),
+        ("[arm]\nbase = a\n", "[arm] of"),
+        ("[arm]\nurdf = a.urdf\ntip = x\n", "unknown key 'tip' in [arm]"),
+        ("no section\n", "cannot read"),
+    ],
+    ids=["port-text", "port-range", "hz-zero", "unknown-option", "no-urdf", "robot-key", "junk"],
+)
+def test_bad_ini_values_are_named(tmp_path, text, message):
+    ini = tmp_path / "bad.ini"
+    ini.write_text(text)
+    with pytest.raises(ConfigError) as info:
+        load_settings(ini, {"urdf": tmp_path / "x.urdf"})
+    assert message in str(info.value)
+
+
+def test_find_ini_prefers_the_flag_then_the_working_directory(tmp_path, monkeypatch):
+    with pytest.raises(ConfigError, match="does not exist"):
+        find_ini(tmp_path / "missing.ini")
+    monkeypatch.chdir(tmp_path)
+    assert find_ini(None) == INI  # falls back to the project's
+    (tmp_path / "cmdinterpreter.ini").write_text("[options]\n")
+    assert find_ini(None) == tmp_path / "cmdinterpreter.ini"
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--robot", "r2d2"], "unknown robot 'r2d2'"),
+        (
+            ["--urdf", "/nonexistent/robot.urdf"],
+            "URDF file '/nonexistent/robot.urdf' does not exist",
+        ),
+        (["--config", "/nonexistent.ini"], "config file '/nonexistent.ini' does not exist"),
+        (["--port", "99999"], "--port 99999 is outside 0..65535"),
+        (["--eelink", "hand"], "eelink link 'hand' is not in motoman_sia20d"),
+        (["--robot", "fanuc_lrmate200id", "--base", "link_2", "--eelink", "link_1"], "below base"),
+    ],
+    ids=["robot", "urdf", "config", "port", "eelink", "chain"],
+)
+def test_main_exits_2_with_one_clear_sentence(argv, message, capsys):
+    assert main([*argv, "--no-viewer"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err
+    assert err.count("\n") == 0, err
+    if argv == ["--robot", "r2d2"]:
+        assert "choose from: fanuc_lrmate200id, kuka_lwr, motoman_sia20d" in err
+
+
+def test_port_zero_prints_the_port_it_picked(c2rviz_process):
+    proc = c2rviz_process("--no-viewer")
+    assert proc.port > 0
+    assert any(f"commands on 127.0.0.1:{proc.port}" in line for line in proc.output)
