@@ -30,29 +30,60 @@ def build_parser() -> argparse.ArgumentParser:
         "move in a browser. Flags override cmdinterpreter.ini.",
     )
     add = parser.add_argument
-    add("--config", metavar="PATH", help="ini file (default: ./cmdinterpreter.ini, "
-        "else the project's)")
+    add(
+        "--config",
+        metavar="PATH",
+        help="ini file (default: ./cmdinterpreter.ini, else the project's)",
+    )
     add("--robot", metavar="NAME", help="robot section of the ini file (default: motoman_sia20d)")
     add("--urdf", metavar="PATH", type=Path, help="load this URDF instead of the robot's")
     add("--base", metavar="LINK", help="first link of the chain")
     add("--eelink", metavar="LINK", help="end-effector link: last link of the chain")
     add("--host", help="address for the command server (default 127.0.0.1)")
     add("--port", type=int, help="command port (default 31000; 0 picks a free one)")
-    add("--viser-host", dest="viewer_host", metavar="HOST",
-        help="address for the browser view (default 127.0.0.1)")
-    add("--viser-port", dest="viewer_port", type=int, metavar="PORT",
-        help="port for the browser view (default 8080)")
+    add(
+        "--viser-host",
+        dest="viewer_host",
+        metavar="HOST",
+        help="address for the browser view (default 127.0.0.1)",
+    )
+    add(
+        "--viser-port",
+        dest="viewer_port",
+        type=int,
+        metavar="PORT",
+        help="port for the browser view (default 8080)",
+    )
     add("--hz", type=float, help="most scene updates per second (default 100)")
-    add("--no-viewer", dest="viewer", action="store_const", const=False,
-        help="run the command server alone")
+    add(
+        "--no-viewer",
+        dest="viewer",
+        action="store_const",
+        const=False,
+        help="run the command server alone",
+    )
     add("--max-clients", type=int, metavar="N", help="clients at once (default 64)")
     add("--max-line", type=int, metavar="BYTES", help="longest line (default 8192)")
-    add("--max-unread", type=int, metavar="BYTES",
-        help="unread replies before a client is dropped (default 1 MiB)")
-    add("--partial-timeout", dest="partial_timeout_s", type=float, metavar="S",
-        help="seconds a started line may stay unfinished (default 10)")
-    add("--max-sleep", dest="max_sleep_s", type=float, metavar="S",
-        help="longest sleep command (default 3600)")
+    add(
+        "--max-unread",
+        type=int,
+        metavar="BYTES",
+        help="unread replies before a client is dropped (default 1 MiB)",
+    )
+    add(
+        "--partial-timeout",
+        dest="partial_timeout_s",
+        type=float,
+        metavar="S",
+        help="seconds a started line may stay unfinished (default 10)",
+    )
+    add(
+        "--max-sleep",
+        dest="max_sleep_s",
+        type=float,
+        metavar="S",
+        help="longest sleep command (default 3600)",
+    )
     add("-v", "--verbose", action="store_true", help="log every connection")
     return parser
 
@@ -87,23 +118,32 @@ async def serve(settings: Settings, robot: Robot) -> int:
     try:
         host, port = await server.start(settings.host, settings.port)
     except OSError as exc:
-        print(f"c2rviz: cannot listen on {settings.host}:{settings.port}: {exc.strerror}",
-              file=sys.stderr)
+        print(
+            f"c2rviz: cannot listen on {settings.host}:{settings.port}: {exc.strerror}",
+            file=sys.stderr,
+        )
         getattr(scene, "stop", lambda: None)()
         return 2
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, stop.set)
     names = " ".join(robot.joint_names)
-    print(f"c2rviz: {robot.name}, chain {robot.base} -> {robot.eelink}, joints 0..{robot.n - 1}: "
-          f"{names}", flush=True)
+    print(
+        f"c2rviz: {robot.name}, chain {robot.base} -> {robot.eelink}, joints 0..{robot.n - 1}: "
+        f"{names}",
+        flush=True,
+    )
     print(f"c2rviz: commands on {host}:{port} (try: nc {host} {port}, then 'help')", flush=True)
     url = getattr(scene, "url", None)
     if url:
         print(f"c2rviz: viewer at {url}", flush=True)
     for what, address in (("command server", settings.host), ("viewer", settings.viewer_host)):
         if not _is_loopback(address) and (what == "command server" or settings.viewer):
-            print(f"c2rviz: warning: the {what} listens on {address}: anyone who can reach it "
-                  "can move the robot and stop the program", file=sys.stderr, flush=True)
+            print(
+                f"c2rviz: warning: the {what} listens on {address}: anyone who can reach it "
+                "can move the robot and stop the program",
+                file=sys.stderr,
+                flush=True,
+            )
     try:
         await stop.wait()
     finally:

@@ -256,9 +256,7 @@ def _move(verb: str, words: list[str]) -> Move:
     indices = _indices(verb, words[0])
     values = _numbers(verb, words[1])
     if len(indices) != len(values):
-        raise BadArguments(
-            verb, f"{len(indices)} indices but {len(values)} values", USAGE[verb]
-        )
+        raise BadArguments(verb, f"{len(indices)} indices but {len(values)} values", USAGE[verb])
     if len(set(indices)) != len(indices):
         twice = next(i for i in indices if indices.count(i) > 1)
         raise BadArguments(verb, f"joint {twice} is given twice", USAGE[verb])
@@ -276,9 +274,7 @@ def _colour(verb: str, words: list[str], top: float) -> Color:
     r, g, b = _count(verb, _numbers(verb, _one_word(verb, words)), 3)
     for channel in (r, g, b):
         if not 0.0 <= channel <= top:
-            raise BadArguments(
-                verb, f"channel {channel:g} is outside 0..{top:g}", USAGE[verb]
-            )
+            raise BadArguments(verb, f"channel {channel:g} is outside 0..{top:g}", USAGE[verb])
     return Color((r / top, g / top, b / top))
 
 

@@ -172,9 +172,7 @@ class Connection(asyncio.Protocol):
             self.backlog = rest
             assert self.transport is not None
             self.transport.pause_reading()
-            self.sleep_timer = asyncio.get_running_loop().call_later(
-                command.seconds, self._wake
-            )
+            self.sleep_timer = asyncio.get_running_loop().call_later(command.seconds, self._wake)
         elif isinstance(command, Bye):
             self._write([replies.BYE])
             self._close()
@@ -269,9 +267,9 @@ class CommandServer:
         on_quit: Callable[[], None] | None = None,
     ) -> None:
         """Args:
-            world: The shared state every client acts on.
-            limits: What one client may cost.
-            on_quit: Called once when a client sends ``quit``.
+        world: The shared state every client acts on.
+        limits: What one client may cost.
+        on_quit: Called once when a client sends ``quit``.
         """
         self.world = world
         self.limits = limits if limits is not None else Limits()

@@ -123,8 +123,11 @@ class Session:
             upper = table.upper[i]
             if lower <= value <= upper:
                 out.append(value * table.scale[i])
-            elif (lower - _TOLERANCE * max(1.0, abs(lower)) <= value
-                  <= upper + _TOLERANCE * max(1.0, abs(upper))):
+            elif (
+                lower - _TOLERANCE * max(1.0, abs(lower))
+                <= value
+                <= upper + _TOLERANCE * max(1.0, abs(upper))
+            ):
                 out.append(self.robot.lower[i] if value < lower else self.robot.upper[i])
             else:
                 raise JointLimitError(
@@ -212,4 +215,3 @@ class Session:
 
     def _help(self, command: Command) -> str:
         return replies.HELP
-

@@ -49,15 +49,17 @@ class World:
         """End-effector placement in the base frame."""
         return self.robot.ee_pose(self.q)
 
-    def add_marker(self, pose_in_base: pin.SE3 | None, rgb: tuple[float, float, float],
-                   shape: str) -> Marker:
+    def add_marker(
+        self, pose_in_base: pin.SE3 | None, rgb: tuple[float, float, float], shape: str
+    ) -> Marker:
         """Drop a marker at ``pose_in_base``, or at the end effector when None."""
         in_base = self.ee_pose() if pose_in_base is None else pose_in_base
         placement = self.robot.base_placement * in_base
         x, y, z, w = pin.Quaternion(placement.rotation).coeffs()
         px, py, pz = placement.translation
-        marker = Marker((float(px), float(py), float(pz)),
-                        (float(w), float(x), float(y), float(z)), rgb, shape)
+        marker = Marker(
+            (float(px), float(py), float(pz)), (float(w), float(x), float(y), float(z)), rgb, shape
+        )
         self.markers.append(marker)
         self.scene.add_marker(marker)
         return marker
