@@ -186,7 +186,9 @@ USAGE: dict[str, str] = {
     "quit": "quit",
 }
 
-_NUMBER = r"[+-]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
+# Unambiguous (digits, then an optional fraction): a regex that could split a run of digits
+# two ways backtracks quadratically, and one 8 KiB line held the event loop for 3 s.
+_NUMBER = r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?"
 _NUMBER_RE = re.compile(_NUMBER)
 _NUMBER_LIST_RE = re.compile(rf"{_NUMBER}(?:,{_NUMBER})*")
 _INDEX_RE = re.compile(r"[0-9]+")

@@ -1,0 +1,172 @@
+"""The parser alone: one table of good lines, one of bad lines, and its speed on hostile lines."""
+
+from __future__ import annotations
+
+import time
+
+import pytest
+
+from c2rviz.commands import (
+    Bye,
+    Clear,
+    Color,
+    ForeignProtocol,
+    Help,
+    Home,
+    Joints,
+    Mark,
+    MarkerShape,
+    Move,
+    Names,
+    Pose,
+    Quit,
+    Rand,
+    Sleep,
+    Units,
+    Where,
+    parse_line,
+)
+from c2rviz.errors import BadArguments, C2rvizError, LineError, UnknownCommand
+
+GOOD = [
+    ("home", Home(), "home"),
+    ("home\n", Home(), "newline"),
+    ("home\r\n", Home(), "crlf"),
+    ("  HOME\t", Home(), "case-and-whitespace"),
+    ("HoMe # to zero", Home(), "trailing-comment"),
+    ("", None, "empty"),
+    ("   \t ", None, "whitespace-only"),
+    ("# only a comment", None, "comment-only"),
+    ("\r\n", None, "bare-crlf"),
+    ("rand", Rand(), "rand"),
+    ("degrees", Units(degrees=True), "degrees"),
+    ("degree", Units(degrees=True), "degree"),
+    ("RADIANS", Units(degrees=False), "radians"),
+    ("radian", Units(degrees=False), "radian"),
+    ("joints 1,2,3", Joints((1.0, 2.0, 3.0)), "joints"),
+    ("j -1,+2.5,.5,1.,1e-3,2E+2", Joints((-1.0, 2.5, 0.5, 1.0, 1e-3, 200.0)), "number-forms"),
+    ("joints 1 , 2 ,3", Joints((1.0, 2.0, 3.0)), "spaces-around-commas"),
+    ("joints\t1,\t2", Joints((1.0, 2.0)), "tabs-around-commas"),
+    ("joints 1e308", Joints((1e308,)), "largest-finite"),
+    ("move 0 1", Move((0,), (1.0,)), "move-one"),
+    ("move 0,1 90,-90", Move((0, 1), (90.0, -90.0)), "move-two"),
+    ("move 0 , 1   0.1 , 0.2", Move((0, 1), (0.1, 0.2)), "move-spaced"),
+    ("move 99 1", Move((99,), (1.0,)), "move-index-checked-later"),
+    ("move 007 1", Move((7,), (1.0,)), "move-leading-zeros"),
+    ("clear", Clear(), "clear"),
+    ("mark", Mark(None), "mark-here"),
+    ("mark 1,2,3,0,0,90", Mark((1.0, 2.0, 3.0, 0.0, 0.0, 90.0)), "mark-pose"),
+    ("color 0,0.5,1", Color((0.0, 0.5, 1.0)), "color"),
+    ("rgb 0,255,51", Color((0.0, 1.0, 0.2)), "rgb"),
+    ("marker CUBE", MarkerShape("cube"), "marker"),
+    ("where", Where(), "where"),
+    ("pose", Pose(), "pose"),
+    ("names", Names(), "names"),
+    ("help", Help(), "help"),
+    ("sleep 0", Sleep(0.0), "sleep-zero"),
+    ("sleep 1e9", Sleep(1e9), "sleep-long-checked-by-server"),
+    ("bye", Bye(), "bye"),
+    ("quit", Quit(), "quit"),
+]
+
+
+@pytest.mark.parametrize(("line", "expected"), [g[:2] for g in GOOD], ids=[g[2] for g in GOOD])
+def test_good_lines(line, expected):
+    got = parse_line(line)
+    assert got == expected
+    if isinstance(got, Color):  # compare channels as numbers, not float bit patterns
+        assert got.rgb == pytest.approx(expected.rgb)
+
+
+BAD = [
+    ("joints", BadArguments, "joints: needs an argument", "joints-nothing"),
+    ("joints 1 2", BadArguments, "joints: takes 1 argument, got 2", "joints-two-words"),
+    ("joints nan", BadArguments, "bad number 'nan'", "nan"),
+    ("joints 1,NaN", BadArguments, "bad number 'NaN'", "NaN"),
+    ("joints inf", BadArguments, "bad number 'inf'", "inf"),
+    ("joints -Infinity", BadArguments, "bad number '-Infinity'", "-Infinity"),
+    ("joints 1e309", BadArguments, "value '1e309' is not a finite number", "overflow"),
+    ("joints -1e309", BadArguments, "not a finite number", "negative-overflow"),
+    ("joints 0x10", BadArguments, "bad number '0x10'", "hex"),
+    ("joints 1.5abc", BadArguments, "bad number '1.5abc'", "trailing-letters"),
+    ("joints 1,,2", BadArguments, "empty value in list", "double-comma"),
+    ("joints 1,", BadArguments, "empty value in list", "trailing-comma"),
+    ("joints ,1", BadArguments, "empty value in list", "leading-comma"),
+    ("joints 1_0", BadArguments, "bad number '1_0'", "underscore"),
+    ("joints .", BadArguments, "bad number '.'", "lone-dot"),
+    ("joints 1e", BadArguments, "bad number '1e'", "bare-exponent"),
+    ("joints --1", BadArguments, "bad number '--1'", "double-sign"),
+    ("joints \u0661", LineError, "column 8 is not allowed", "arabic-indic-digit"),
+    ("joints \uff11", LineError, "column 8 is not allowed", "fullwidth-digit"),
+    ("home\x00x", LineError, "'\\x00' at column 5", "nul-inside"),
+    ("home\x00", LineError, "'\\x00' at column 5", "nul-at-end"),
+    ("ho\rme", LineError, "'\\r' at column 3", "cr-inside"),
+    ("home\x1b[2J", LineError, "'\\x1b'", "escape-sequence"),
+    ("home\u2028", LineError, "not allowed", "unicode-line-separator"),
+    ("home\x0b", LineError, "'\\x0b'", "vertical-tab"),
+    ("move 0,1 90", BadArguments, "2 indices but 1 values", "move-fewer-values"),
+    ("move 0 1,2", BadArguments, "1 indices but 2 values", "move-more-values"),
+    ("move 0,0 1,2", BadArguments, "joint 0 is given twice", "move-twice"),
+    ("move -1 1", BadArguments, "bad joint index '-1'", "move-negative"),
+    ("move x 1", BadArguments, "bad joint index 'x'", "move-letter"),
+    ("move 1.5 1", BadArguments, "bad joint index '1.5'", "move-fraction"),
+    ("move +1 1", BadArguments, "bad joint index '+1'", "move-plus"),
+    ("move 0 nan", BadArguments, "bad number 'nan'", "move-nan"),
+    ("move 1", BadArguments, "takes 2 arguments, got 1", "move-one-arg"),
+    ("move 0, 1", BadArguments, "takes 2 arguments, got 1", "move-comma-glues"),
+    ("move " + "9" * 5000 + " 1", BadArguments, "is too large", "move-5000-digits"),
+    ("move 1234567890 1", BadArguments, "'1234567890' is too large", "move-10-digits"),
+    ("mark 1,2,3", BadArguments, "mark: needs 6 values, got 3", "mark-three"),
+    ("mark 1,2,3,4,5,6,7", BadArguments, "needs 6 values, got 7", "mark-seven"),
+    ("mark 1,2,3,0,0,inf", BadArguments, "bad number 'inf'", "mark-inf"),
+    ("color 1,1", BadArguments, "color: needs 3 values, got 2", "color-two"),
+    ("color 1,1,1,1", BadArguments, "needs 3 values, got 4", "color-four"),
+    ("color 0,0,1.5", BadArguments, "channel 1.5 is outside 0..1", "color-over"),
+    ("color -0.1,0,0", BadArguments, "channel -0.1 is outside 0..1", "color-negative"),
+    ("rgb 0,0,256", BadArguments, "channel 256 is outside 0..255", "rgb-over"),
+    ("rgb 1,2", BadArguments, "rgb: needs 3 values, got 2", "rgb-two"),
+    ("marker cone", BadArguments, "unknown shape 'cone'", "marker-unknown"),
+    ("marker", BadArguments, "marker: needs an argument", "marker-none"),
+    ("sleep", BadArguments, "sleep: needs an argument", "sleep-none"),
+    ("sleep -1", BadArguments, "seconds must be >= 0, got -1", "sleep-negative"),
+    ("sleep nan", BadArguments, "bad number 'nan'", "sleep-nan"),
+    ("sleep 1,2", BadArguments, "sleep: needs 1 values, got 2", "sleep-two"),
+    ("home 1", BadArguments, "home: takes no arguments", "home-arg"),
+    ("degree 1", BadArguments, "(usage: degrees)", "alias-usage"),
+    ("jump 1", UnknownCommand, "unknown command 'jump' (try 'help')", "unknown-verb"),
+    ("x" * 100, UnknownCommand, "'" + "x" * 40 + "...'", "unknown-long-verb-cut"),
+    ("GET / HTTP/1.1", ForeignProtocol, "not HTTP", "http-get"),
+    ("POST /api HTTP/1.0\r\n", ForeignProtocol, "not HTTP", "http-post"),
+    ("Host: 127.0.0.1:31000", ForeignProtocol, "not HTTP", "http-host-header"),
+    ("User-Agent: curl/8.0", ForeignProtocol, "not HTTP", "http-user-agent"),
+]
+
+
+@pytest.mark.parametrize(
+    ("line", "error", "message"), [b[:3] for b in BAD], ids=[b[3] for b in BAD]
+)
+def test_bad_lines(line, error, message):
+    with pytest.raises(error) as caught:
+        parse_line(line)
+    assert message in str(caught.value)
+    assert "\n" not in str(caught.value)  # a reply is always one line
+
+
+HOSTILE = [
+    "joints " + "1" * 8000 + "x",
+    "sleep " + "1" * 8000 + "e",
+    "move 0 " + "1" * 8000 + ".x",
+    "joints " + "1." * 4000,
+    "move " + ",".join(map(str, range(1, 1500))) + ",1 " + ",".join(["0"] * 1500),
+]
+
+
+@pytest.mark.parametrize(
+    "line", HOSTILE, ids=["digits-x", "digits-e", "digits-dot-x", "dots", "late-duplicate"]
+)
+def test_hostile_lines_are_rejected_in_linear_time(line):
+    """One 8 KiB line must not hold the event loop (it once took 3 s: regex backtracking)."""
+    start = time.perf_counter()
+    with pytest.raises(C2rvizError):
+        parse_line(line)
+    assert time.perf_counter() - start < 0.25
