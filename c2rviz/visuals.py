@@ -1,0 +1,218 @@
+"""What each link looks like: URDF visual and collision geometry, ready to draw.
+
+yourdfpy parses the URDF (links, their ``<visual>``/``<collision>`` elements
+and materials); this module turns every element into a ``Shape`` placed at its
+URDF origin in the link frame. Boxes, cylinders and spheres stay primitives
+(the viewer draws them natively); mesh files are loaded with trimesh, resolved
+through ``RobotSource.resolve``. Link poses are not computed here: the viewer
+takes them from Pinocchio.
+
+A mesh that cannot be found or read is logged with the places searched, and
+the link falls back to its collision geometry or, failing that, a small grey
+placeholder, so a robot with missing meshes is still drawn and never crashes
+the program.
+"""
+
+from __future__ import annotations
+
+import io
+import logging
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import trimesh
+import yourdfpy
+
+from .sources import RobotSource
+
+__all__ = ["LinkGeometry", "Shape", "load_link_geometry"]
+
+log = logging.getLogger("c2rviz.visuals")
+
+DEFAULT_RGBA = (0.7, 0.7, 0.72, 1.0)  # URDF geometry without a material colour
+COLLISION_RGBA = (1.0, 0.45, 0.1, 0.45)  # translucent orange, as RViz draws collisions
+PLACEHOLDER_SIZE_M = 0.05
+
+
+@dataclass(frozen=True)
+class Shape:
+    """One drawable piece of a link, in the link frame.
+
+    Attributes:
+        kind: ``box``, ``cylinder``, ``sphere`` or ``mesh``.
+        origin: 4x4 pose of the piece in its link's frame (the URDF ``<origin>``).
+        rgba: Colour, each channel 0..1; for a mesh, None keeps the file's own
+            colours and textures.
+        size: Box edge lengths (x, y, z) [m]; cylinder (radius, length) [m];
+            sphere (radius,) [m]; empty for a mesh.
+        mesh: The loaded mesh (kind ``mesh`` only), scale already applied.
+    """
+
+    kind: str
+    origin: np.ndarray
+    rgba: tuple[float, float, float, float] | None
+    size: tuple[float, ...] = ()
+    mesh: trimesh.Trimesh | None = None
+
+
+@dataclass
+class LinkGeometry:
+    """Everything drawn for one link.
+
+    Attributes:
+        visual: What the page shows normally.
+        collision: What the 'collision geometry' checkbox shows.
+        missing: Mesh references of this link that could not be loaded.
+    """
+
+    visual: list[Shape] = field(default_factory=list)
+    collision: list[Shape] = field(default_factory=list)
+    missing: list[str] = field(default_factory=list)
+
+
+def load_link_geometry(source: RobotSource) -> dict[str, LinkGeometry]:
+    """Every link's visual and collision shapes, keyed by link name.
+
+    Never raises for a missing or broken mesh: see the module docstring.
+    """
+    urdf = yourdfpy.URDF.load(
+        io.BytesIO(source.xml.encode("utf-8")), build_scene_graph=False, load_meshes=False
+    )
+    materials = {m.name: m for m in urdf.robot.materials if m.name is not None}
+    loader = _MeshLoader(source)
+    links: dict[str, LinkGeometry] = {}
+    for link in urdf.robot.links:
+        geometry = LinkGeometry()
+        for element in link.visuals:
+            rgba = _material_rgba(element.material, materials)
+            shapes = _shapes(element, rgba, loader, geometry.missing)
+            geometry.visual.extend(shapes)
+        for element in link.collisions:
+            geometry.collision.extend(_shapes(element, COLLISION_RGBA, loader, []))
+        if geometry.missing:
+            _fall_back(link.name, geometry)
+        links[link.name] = geometry
+    return links
+
+
+def _fall_back(link: str, geometry: LinkGeometry) -> None:
+    """Stand in for the link's missing visual meshes."""
+    if geometry.collision:
+        stand_in = [
+            Shape(s.kind, s.origin, DEFAULT_RGBA if s.kind != "mesh" else None, s.size, s.mesh)
+            for s in geometry.collision
+        ]
+        how = "its collision geometry"
+    else:
+        size = (PLACEHOLDER_SIZE_M,) * 3
+        stand_in = [Shape("box", np.eye(4), DEFAULT_RGBA, size)]
+        how = "a placeholder box"
+    geometry.visual.extend(stand_in)
+    log.warning("link %s is drawn with %s instead of its missing mesh", link, how)
+
+
+def _material_rgba(
+    material: yourdfpy.Material | None, materials: dict[str, yourdfpy.Material]
+) -> tuple[float, float, float, float] | None:
+    """The colour a visual's material names, directly or through a top-level material."""
+    if material is None:
+        return None
+    color = material.color
+    if color is None and material.name in materials:
+        color = materials[material.name].color
+    if color is None:
+        return None
+    r, g, b, a = (float(c) for c in color.rgba)
+    return (r, g, b, a)
+
+
+def _shapes(
+    element: yourdfpy.Visual | yourdfpy.Collision,
+    rgba: tuple[float, float, float, float] | None,
+    loader: _MeshLoader,
+    missing: list[str],
+) -> list[Shape]:
+    """The shapes of one ``<visual>`` or ``<collision>`` element (none when a mesh is missing)."""
+    origin = element.origin if element.origin is not None else np.eye(4)
+    geom = element.geometry
+    if geom is None:
+        return []
+    if geom.box is not None:
+        size = tuple(float(s) for s in geom.box.size)
+        return [Shape("box", origin, rgba or DEFAULT_RGBA, size)]
+    if geom.cylinder is not None:
+        size = (float(geom.cylinder.radius), float(geom.cylinder.length))
+        return [Shape("cylinder", origin, rgba or DEFAULT_RGBA, size)]
+    if geom.sphere is not None:
+        return [Shape("sphere", origin, rgba or DEFAULT_RGBA, (float(geom.sphere.radius),))]
+    if geom.mesh is None:
+        return []
+    meshes = loader.load(geom.mesh.filename, geom.mesh.scale)
+    if meshes is None:
+        missing.append(geom.mesh.filename)
+        return []
+    shapes = []
+    for mesh in meshes:
+        # A URDF colour paints meshes that bring no colour of their own (STL);
+        # RViz does the same, so coloured COLLADA/glTF files keep theirs.
+        own = mesh.visual is not None and mesh.visual.defined
+        shapes.append(Shape("mesh", origin, None if own else rgba or DEFAULT_RGBA, (), mesh))
+    return shapes
+
+
+class _MeshLoader:
+    """Loads mesh files once each, and says where it looked when it cannot."""
+
+    def __init__(self, source: RobotSource) -> None:
+        self.source = source
+        self.cache: dict[str, list[trimesh.Trimesh] | None] = {}
+
+    def load(self, uri: str, scale: float | np.ndarray | None) -> list[trimesh.Trimesh] | None:
+        """The pieces of the mesh file ``uri``, scaled; None when it cannot be loaded."""
+        if uri not in self.cache:
+            self.cache[uri] = self._read(uri)
+        pieces = self.cache[uri]
+        if pieces is None:
+            return None
+        if scale is None:
+            return pieces
+        factors = np.broadcast_to(np.asarray(scale, dtype=float), (3,))
+        scaled = []
+        for piece in pieces:
+            piece = piece.copy()
+            piece.apply_transform(np.diag([*factors, 1.0]))
+            scaled.append(piece)
+        return scaled
+
+    def _read(self, uri: str) -> list[trimesh.Trimesh] | None:
+        path = self.source.resolve(uri)
+        if path is None:
+            log.warning("mesh %s not found; looked in: %s", uri, self._searched(uri))
+            return None
+        try:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                scene = trimesh.load_scene(str(path))
+                # dump() bakes each instance's transform; unlike
+                # dump(concatenate=True) it keeps the pieces (and their
+                # materials) apart and raises no DeprecationWarning.
+                pieces = [g for g in scene.dump() if isinstance(g, trimesh.Trimesh)]
+        except Exception as exc:  # trimesh raises many kinds for a bad file
+            log.warning("mesh %s (%s) cannot be read: %s", uri, path, exc)
+            return None
+        for warning in caught:
+            log.debug("loading %s: %s", path, warning.message)
+        if not pieces:
+            log.warning("mesh %s (%s) holds no triangles", uri, path)
+            return None
+        return pieces
+
+    def _searched(self, uri: str) -> str:
+        """The places ``uri`` was looked up in, for the warning."""
+        if uri.startswith("package://"):
+            name, _, rest = uri[len("package://") :].partition("/")
+            return ", ".join(str(folder / rest) for folder in self.source.package_dirs(name))
+        path = Path(uri[len("file://") :] if uri.startswith("file://") else uri)
+        return str(path if path.is_absolute() else self.source.folder / path)
