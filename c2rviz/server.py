@@ -95,20 +95,20 @@ class Connection(asyncio.Protocol):
         cut = buffer.rfind(b"\n")
         if cut >= 0:
             self.buffer = buffer[cut + 1 :]
+            if self.partial_timer is not None:  # the line it timed is finished
+                self.partial_timer.cancel()
+                self.partial_timer = None
             self._run(self._decode(buffer[:cut]))
         else:
             self.buffer = buffer
         if self.closing or self.sleep_timer is not None:
-            return
+            return  # while asleep we do not read, so an unfinished line is not the client's fault
         if len(self.buffer) > self.limits.max_line:
             self._close_with(replies.error(LineTooLong(self.limits.max_line)))
         elif self.buffer and self.partial_timer is None:
             self.partial_timer = asyncio.get_running_loop().call_later(
                 self.limits.partial_timeout_s, self._partial_timeout
             )
-        elif not self.buffer and self.partial_timer is not None:
-            self.partial_timer.cancel()
-            self.partial_timer = None
 
     def _decode(self, complete: bytes) -> list[Line]:
         """Split complete lines; mark the undecodable and the over-long ones."""
@@ -266,10 +266,12 @@ class CommandServer:
         limits: Limits | None = None,
         on_quit: Callable[[], None] | None = None,
     ) -> None:
-        """Args:
-        world: The shared state every client acts on.
-        limits: What one client may cost.
-        on_quit: Called once when a client sends ``quit``.
+        """Set up the server; ``start`` makes it listen.
+
+        Args:
+            world: The shared state every client acts on.
+            limits: What one client may cost.
+            on_quit: Called once when a client sends ``quit``.
         """
         self.world = world
         self.limits = limits if limits is not None else Limits()
