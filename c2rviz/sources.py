@@ -1,20 +1,106 @@
 """Where a robot description comes from: its URDF text and its mesh files.
 
-``load_source`` reads a URDF file into a ``RobotSource``; the source resolves
-every mesh reference in it (``package://NAME/...``, ``file://...`` or a path
-relative to the URDF's folder) to a file on disk. Kinematics never need the
-meshes, so a mesh that cannot be found is the viewer's concern, not an error.
+``load_source`` reads a URDF (expanding a ``.xacro`` first) into a
+``RobotSource``; the source resolves every mesh reference in it to a file on
+disk, the way ROS would but without ROS:
+
+- ``package://NAME/rest`` looks for package NAME, in this order: in each
+  ``--package-path`` entry (``NAME=DIR`` names the folder outright; a plain
+  ``DIR`` is the package itself, holds ``DIR/NAME``, or holds it further down
+  with a ``package.xml`` that says ``<name>NAME</name>``), then the same in each
+  ``ROS_PACKAGE_PATH`` entry, then ``PREFIX/share/NAME`` for each
+  ``AMENT_PREFIX_PATH`` prefix, then upward from the URDF's folder: a folder
+  named NAME (with or without a ``package.xml``) or one whose ``package.xml``
+  names it.
+- ``file://PATH`` and plain paths; relative ones against the URDF's folder.
+
+Kinematics never need the meshes, so a mesh that cannot be found is not an
+error here: ``searched`` and ``missing_meshes`` say where it was looked for, and
+the viewer warns with that and draws a stand-in.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+import os
+import re
+import threading
+import xml.etree.ElementTree as ET
+from collections import deque
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
 from pathlib import Path
+from urllib.parse import unquote
 
-from .errors import RobotError
+from .errors import ConfigError, RobotError
 
-__all__ = ["RobotSource", "load_source"]
+__all__ = ["MissingMesh", "RobotSource", "load_source", "parse_xacro_args"]
+
+_NAME = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
+_MESH = re.compile(r"""<mesh\b[^>]*\bfilename\s*=\s*["']([^"']+)["']""")
+_PACKAGE_NAME = re.compile(r"[A-Za-z0-9_.-]+")
+_SCAN_DEPTH = 4  # how far below a package-path entry package.xml files are looked for
+_SCAN_MAX_DIRS = 5000  # and how many folders at most, so a too-wide entry stays quick
+_IGNORE_MARKERS = ("CATKIN_IGNORE", "COLCON_IGNORE", "AMENT_IGNORE")
+_xacro_lock = threading.Lock()  # xacro keeps module-level state
+
+
+def package_name(folder: Path) -> str | None:
+    """The ``<name>`` in ``folder/package.xml``, or None if there is none."""
+    try:
+        text = (folder / "package.xml").read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return None
+    match = _NAME.search(text)
+    return match.group(1) if match else None
+
+
+def _scan_packages(root: Path) -> dict[str, list[Path]]:
+    """Packages at or below ``root`` (by ``package.xml``), as rospack crawls them."""
+    found: dict[str, list[Path]] = {}
+    queue = deque([(root, 0)])
+    visited = 0
+    while queue and visited < _SCAN_MAX_DIRS:
+        folder, depth = queue.popleft()
+        visited += 1
+        name = package_name(folder)
+        if name is not None:
+            found.setdefault(name, []).append(folder)
+            continue  # packages do not nest
+        if depth >= _SCAN_DEPTH or any((folder / m).exists() for m in _IGNORE_MARKERS):
+            continue
+        try:
+            children = sorted(p for p in folder.iterdir() if p.is_dir())
+        except OSError:
+            continue
+        queue.extend((c, depth + 1) for c in children if not c.name.startswith("."))
+    return found
+
+
+@dataclass(frozen=True)
+class MissingMesh:
+    """A mesh reference that resolves to no file.
+
+    Attributes:
+        uri: The ``filename`` as written in the URDF.
+        links: The links whose visual or collision geometry uses it.
+        searched: Every file path that was tried, in order.
+    """
+
+    uri: str
+    links: tuple[str, ...]
+    searched: tuple[Path, ...]
+
+    def message(self) -> str:
+        """The warning text: the file, its links and the places searched."""
+        links = ", ".join(self.links)
+        where = (
+            ", ".join(str(p) for p in self.searched) or "nowhere (remote meshes are not fetched)"
+        )
+        hint = ""
+        if self.uri.startswith("package://"):
+            name = self.uri[len("package://") :].partition("/")[0]
+            hint = f" (give the folder that holds {name} with --package-path DIR)"
+        return f"mesh {self.uri} of link {links} not found; searched: {where}{hint}"
 
 
 @dataclass(frozen=True)
@@ -22,53 +108,202 @@ class RobotSource:
     """A URDF's text and the places its meshes are looked up in.
 
     Attributes:
-        xml: The URDF text.
+        xml: The URDF text (already expanded if it came from a ``.xacro``).
         path: The file it was read from (None for text given directly).
-        package_paths: Folders searched for ``package://NAME`` (NAME is a
-            sub-folder of one of them).
+        package_paths: ``--package-path`` folders, in search order.
+        package_map: ``--package-path NAME=DIR`` entries: package NAME is DIR.
+        ros_package_path: ``ROS_PACKAGE_PATH`` entries when the source was loaded.
+        ament_prefix_path: ``AMENT_PREFIX_PATH`` prefixes when the source was loaded.
     """
 
     xml: str
     path: Path | None = None
     package_paths: tuple[Path, ...] = ()
+    package_map: tuple[tuple[str, Path], ...] = ()
+    ros_package_path: tuple[Path, ...] = ()
+    ament_prefix_path: tuple[Path, ...] = ()
+    _scans: dict[Path, dict[str, list[Path]]] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
 
     @property
     def folder(self) -> Path:
         return self.path.parent if self.path is not None else Path.cwd()
 
+    def _packages_under(self, root: Path) -> dict[str, list[Path]]:
+        if root not in self._scans:
+            self._scans[root] = _scan_packages(root) if root.is_dir() else {}
+        return self._scans[root]
+
     def package_dirs(self, name: str) -> list[Path]:
-        """Candidate folders for package ``name``, in search order."""
-        candidates = [root / name for root in self.package_paths]
+        """Candidate folders for package ``name``, in search order (existing or not)."""
+        candidates = [folder for key, folder in self.package_map if key == name]
+        for root in (*self.package_paths, *self.ros_package_path):
+            if root.name == name:
+                candidates.append(root)
+            candidates.append(root / name)
+            candidates.extend(self._packages_under(root).get(name, []))
+        candidates.extend(prefix / "share" / name for prefix in self.ament_prefix_path)
         for parent in [self.folder, *self.folder.parents]:
-            if parent.name == name:
+            if parent.name == name or package_name(parent) == name:
                 candidates.append(parent)
             candidates.append(parent / name)
-        return candidates
+        return list(dict.fromkeys(candidates))  # drop repeats, keep the order
+
+    def find_package(self, name: str) -> Path | None:
+        """The first existing folder for package ``name`` (what ``$(find NAME)`` gives)."""
+        return next((d for d in self.package_dirs(name) if d.is_dir()), None)
+
+    def searched(self, uri: str) -> list[Path]:
+        """Every file ``resolve(uri)`` tries, in order; empty for remote URIs."""
+        if uri.startswith("package://"):
+            name, _, rest = uri[len("package://") :].partition("/")
+            return [folder / rest for folder in self.package_dirs(name)]
+        if uri.startswith(("http://", "https://")):
+            return []
+        path = Path(unquote(uri[len("file://") :]) if uri.startswith("file://") else uri)
+        return [path if path.is_absolute() else self.folder / path]
 
     def resolve(self, uri: str) -> Path | None:
         """The file a mesh reference names, or None when it is nowhere to be found."""
-        if uri.startswith("package://"):
-            name, _, rest = uri[len("package://") :].partition("/")
-            for folder in self.package_dirs(name):
-                if (folder / rest).is_file():
-                    return folder / rest
-            return None
-        path = Path(uri[len("file://") :] if uri.startswith("file://") else uri)
-        path = path if path.is_absolute() else self.folder / path
-        return path if path.is_file() else None
+        return next((p for p in self.searched(uri) if p.is_file()), None)
+
+    def mesh_uris(self) -> dict[str, tuple[str, ...]]:
+        """Each mesh ``filename`` in the URDF, with the links that use it."""
+        try:
+            root = ET.fromstring(self.xml)
+        except ET.ParseError:  # Pinocchio's parser forgives more than ElementTree does
+            return {uri: ("?",) for uri in dict.fromkeys(_MESH.findall(self.xml))}
+        uses: dict[str, list[str]] = {}
+        for link in root.iter("link"):
+            for mesh in link.iter("mesh"):
+                uri = mesh.get("filename")
+                if uri:
+                    users = uses.setdefault(uri, [])
+                    if link.get("name", "?") not in users:
+                        users.append(link.get("name", "?"))
+        return {uri: tuple(links) for uri, links in uses.items()}
+
+    def missing_meshes(self) -> list[MissingMesh]:
+        """The meshes that resolve to no file, each with the places searched."""
+        return [
+            MissingMesh(uri, links, tuple(self.searched(uri)))
+            for uri, links in self.mesh_uris().items()
+            if self.resolve(uri) is None
+        ]
 
 
-def load_source(path: str | Path, package_paths: Sequence[str | Path] = ()) -> RobotSource:
-    """Read the URDF at ``path``.
+def parse_xacro_args(args: Mapping[str, str] | Iterable[str]) -> dict[str, str]:
+    """``name:=value`` strings (or a mapping) as a dict for xacro.
 
     Raises:
-        RobotError: the file does not exist or cannot be read.
+        ConfigError: an entry that is not ``name:=value``.
+    """
+    if isinstance(args, Mapping):
+        return dict(args)
+    parsed = {}
+    for arg in args:
+        name, sep, value = arg.partition(":=")
+        if not sep or not name.strip():
+            raise ConfigError(f"--xacro-arg {arg!r} is not name:=value")
+        parsed[name.strip()] = value
+    return parsed
+
+
+def _expand_xacro(path: Path, args: dict[str, str], source: RobotSource) -> str:
+    """Run xacro on ``path``; ``$(find NAME)`` uses ``source``'s package search."""
+    try:
+        import xacro
+        from xacro import substitution_args
+    except ImportError as exc:  # pragma: no cover - xacro is a dependency
+        raise RobotError(f"{path} is a xacro file and xacro is not installed: {exc}") from exc
+
+    def find(name: str) -> str:
+        folder = source.find_package(name)
+        if folder is None:
+            raise substitution_args.SubstitutionException(
+                f"package {name!r} not found (give the folder that holds it with --package-path)"
+            )
+        return str(folder)
+
+    # xacro answers $(find NAME) through ROS's package index; swap in our search
+    # (these are xacro 2.x internals: without them, xacro's own lookup stays).
+    patch = hasattr(substitution_args, "_eval_find") and hasattr(substitution_args, "_eval_dict")
+    with _xacro_lock:
+        if patch:
+            saved = substitution_args._eval_find, substitution_args._eval_dict.get("find")
+            substitution_args._eval_find = find
+            substitution_args._eval_dict["find"] = find
+        try:
+            return xacro.process_file(str(path), mappings=args).toprettyxml(indent="  ")
+        except Exception as exc:  # xacro raises all sorts; each is a bad description
+            problem = " ".join(str(exc).split()) or type(exc).__name__
+            if "argument" in problem.lower():
+                problem += " (give it with --xacro-arg name:=value)"
+            raise RobotError(f"cannot expand {path}: {problem}") from exc
+        finally:
+            if patch:
+                substitution_args._eval_find, substitution_args._eval_dict["find"] = saved
+
+
+def _split_env(value: str | None) -> tuple[Path, ...]:
+    return tuple(Path(p) for p in (value or "").split(os.pathsep) if p)
+
+
+def load_source(
+    path: str | Path,
+    package_paths: Sequence[str | Path] = (),
+    xacro_args: Mapping[str, str] | Iterable[str] = (),
+    *,
+    environ: Mapping[str, str] | None = None,
+) -> RobotSource:
+    """Read the URDF at ``path``, expanding it with xacro if it ends in ``.xacro``.
+
+    Args:
+        path: A ``.urdf`` or ``.xacro`` file.
+        package_paths: ``--package-path`` entries: ``DIR`` or ``NAME=DIR``.
+        xacro_args: ``name:=value`` strings (or a mapping) for xacro's ``$(arg name)``.
+        environ: Where ``ROS_PACKAGE_PATH`` and ``AMENT_PREFIX_PATH`` are read
+            (default ``os.environ``).
+
+    Raises:
+        RobotError: the file does not exist, cannot be read or does not expand.
+        ConfigError: a package path that is not a folder, or a bad xacro argument.
     """
     path = Path(path)
     if not path.is_file():
         raise RobotError(f"URDF file {str(path)!r} does not exist")
-    try:
-        xml = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise RobotError(f"cannot read {path}: {exc}") from exc
-    return RobotSource(xml, path.resolve(), tuple(Path(p) for p in package_paths))
+    env = os.environ if environ is None else environ
+    folders: list[Path] = []
+    mapped: list[tuple[str, Path]] = []
+    for entry in package_paths:
+        name, sep, named = str(entry).partition("=")
+        if sep and _PACKAGE_NAME.fullmatch(name) and not Path(entry).exists():
+            mapped.append((name, Path(named).expanduser().resolve()))
+        else:
+            folders.append(Path(entry).expanduser().resolve())
+    for folder in [*folders, *(f for _, f in mapped)]:
+        if not folder.is_dir():
+            raise ConfigError(f"--package-path {str(folder)!r} is not a folder")
+    source = RobotSource(
+        "",
+        path.resolve(),
+        tuple(folders),
+        tuple(mapped),
+        _split_env(env.get("ROS_PACKAGE_PATH")),
+        _split_env(env.get("AMENT_PREFIX_PATH")),
+    )
+    args = parse_xacro_args(xacro_args)
+    if path.suffix == ".xacro":
+        xml = _expand_xacro(source.path, args, source)  # type: ignore[arg-type]
+    else:
+        if args:
+            raise ConfigError(f"--xacro-arg given, but {path} is not a .xacro file")
+        try:
+            xml = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError) as exc:
+            raise RobotError(f"cannot read {path}: {exc}") from exc
+    scans = source._scans
+    source = replace(source, xml=xml)
+    source._scans.update(scans)  # keep the package.xml scans made while expanding
+    return source
