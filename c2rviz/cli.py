@@ -11,7 +11,8 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from .config import Settings, find_ini, load_settings
+from .catalogue import catalogue, listing
+from .config import Settings, find_ini, load_settings, read_robots
 from .errors import C2rvizError
 from .robot import Robot
 from .scene import NullScene, Scene
@@ -35,8 +36,29 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="PATH",
         help="ini file (default: ./cmdinterpreter.ini, else the project's)",
     )
-    add("--robot", metavar="NAME", help="robot section of the ini file (default: motoman_sia20d)")
-    add("--urdf", metavar="PATH", type=Path, help="load this URDF instead of the robot's")
+    add(
+        "--robot",
+        metavar="NAME",
+        help="robot section of the ini file, or an example-robot-data "
+        "arm such as ur5 or panda (default: motoman_sia20d; see --list-robots)",
+    )
+    add("--list-robots", action="store_true", help="list the robots --robot can name, and exit")
+    add("--urdf", metavar="PATH", type=Path, help="load this URDF or .xacro instead of the robot's")
+    add(
+        "--package-path",
+        dest="package_paths",
+        metavar="DIR",
+        action="append",
+        help="where package://NAME/... is looked for: a folder holding packages, a package, "
+        "or NAME=DIR (repeatable; then ROS_PACKAGE_PATH, then upward from the URDF)",
+    )
+    add(
+        "--xacro-arg",
+        dest="xacro_args",
+        metavar="NAME:=VALUE",
+        action="append",
+        help="an argument for a .xacro file (repeatable)",
+    )
     add("--base", metavar="LINK", help="first link of the chain")
     add("--eelink", metavar="LINK", help="end-effector link: last link of the chain")
     add("--host", help="address for the command server (default 127.0.0.1)")
@@ -162,11 +184,23 @@ def main(argv: Sequence[str] | None = None) -> int:
         level=logging.INFO if args.verbose else logging.WARNING,
         format="c2rviz: %(levelname)s: %(message)s",
     )
-    overrides = {k: v for k, v in vars(args).items() if k not in ("config", "verbose")}
+    overrides = {
+        k: v for k, v in vars(args).items() if k not in ("config", "verbose", "list_robots")
+    }
     try:
+        if args.list_robots:
+            ini = find_ini(args.config)
+            print(listing(catalogue(read_robots(ini), ini).values()))
+            return 0
         settings = load_settings(find_ini(args.config), overrides)
         assert settings.urdf is not None
-        robot = Robot.from_urdf(settings.urdf, settings.base, settings.eelink)
+        robot = Robot.from_urdf(
+            settings.urdf,
+            settings.base,
+            settings.eelink,
+            package_paths=settings.package_paths,
+            xacro_args=settings.xacro_args,
+        )
     except C2rvizError as exc:
         print(f"c2rviz: {exc}", file=sys.stderr)
         return 2

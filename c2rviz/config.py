@@ -2,8 +2,11 @@
 
 The ini file has an ``[options]`` section and one section per robot (named as
 in the seed: ``[motoman_sia20d]`` ...) with ``base``, ``eelink`` and ``urdf``
-(relative to the ini file). Every bad value is a ``ConfigError`` naming the key
-and what it accepts.
+(relative to the ini file), and optionally ``package_path`` (folders for
+``package://``, relative to the ini file) and ``xacro_args`` (``name:=value``
+...), each a space-separated list. A robot name with no section is looked up in
+the catalogue (example-robot-data). Every bad value is a ``ConfigError`` naming
+the key and what it accepts.
 """
 
 from __future__ import annotations
@@ -14,9 +17,18 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+from .catalogue import catalogue, find_robot
 from .errors import ConfigError
 
-__all__ = ["INI_NAME", "Limits", "RobotEntry", "Settings", "find_ini", "load_settings"]
+__all__ = [
+    "INI_NAME",
+    "Limits",
+    "RobotEntry",
+    "Settings",
+    "find_ini",
+    "load_settings",
+    "read_robots",
+]
 
 INI_NAME = "cmdinterpreter.ini"
 PROJECT_DIR = Path(__file__).resolve().parent.parent
@@ -46,6 +58,8 @@ class RobotEntry:
     urdf: Path
     base: str | None = None
     eelink: str | None = None
+    package_paths: tuple[Path, ...] = ()
+    xacro_args: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -62,6 +76,10 @@ class Settings:
     urdf: Path | None = None
     base: str | None = None
     eelink: str | None = None
+    package_paths: tuple[str | Path, ...] = ()
+    """``package://`` search folders (``DIR`` or ``NAME=DIR``), flags first."""
+    xacro_args: tuple[str, ...] = ()
+    """``name:=value`` for a ``.xacro`` robot, the robot section's then the flags'."""
     limits: Limits = field(default_factory=Limits)
     robots: Mapping[str, RobotEntry] = field(default_factory=dict)
     ini: Path | None = None
@@ -79,6 +97,7 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "max_sleep": ("max_sleep_s", float, 0, 1e6),
 }
 _TEXT_OPTIONS = ("host", "viewer_host", "robot")
+_ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args"]
 _LIMIT_FIELDS = {f for f in Limits.__dataclass_fields__}
 
 
@@ -132,19 +151,28 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
         if section == "options":
             continue
         items = dict(parser.items(section))
-        unknown = set(items) - {"base", "eelink", "urdf"}
+        unknown = set(items) - set(_ROBOT_KEYS)
         if unknown:
             raise ConfigError(
-                f"unknown key {sorted(unknown)[0]!r} in [{section}] of {path}",
-                ["base", "eelink", "urdf"],
+                f"unknown key {sorted(unknown)[0]!r} in [{section}] of {path}", _ROBOT_KEYS
             )
         urdf = items.get("urdf")
         if not urdf:
             raise ConfigError(f"[{section}] of {path} has no urdf = PATH")
         robots[section] = RobotEntry(
-            section, (path.parent / urdf).resolve(), items.get("base"), items.get("eelink")
+            section,
+            (path.parent / urdf).resolve(),
+            items.get("base"),
+            items.get("eelink"),
+            tuple((path.parent / p).resolve() for p in items.get("package_path", "").split()),
+            tuple(items.get("xacro_args", "").split()),
         )
     return values, robots
+
+
+def read_robots(ini: Path | None) -> dict[str, RobotEntry]:
+    """The robot sections of ``ini`` (none without an ini)."""
+    return _read_ini(ini)[1] if ini is not None else {}
 
 
 def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
@@ -163,23 +191,24 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
             flag = "--" + key.replace("_", "-").replace("viewer", "viser")
             raise ConfigError(f"{flag} {given[name]:g} is outside {low:g}..{high:g}")
     values.update(given)
+    for key in ("package_paths", "xacro_args"):
+        values[key] = tuple(values.get(key, ()))
     limit_values = {k: values.pop(k) for k in list(values) if k in _LIMIT_FIELDS}
     settings = replace(Settings(), **values, limits=Limits(**limit_values), robots=robots, ini=ini)
     if settings.urdf is None:
-        entry = robots.get(settings.robot)
-        if entry is None:
-            where = f"in {ini}" if ini else "(no cmdinterpreter.ini found)"
-            raise ConfigError(f"unknown robot {settings.robot!r} {where}", sorted(robots))
+        entry = find_robot(settings.robot, robots, ini)
         settings = replace(
             settings,
             urdf=entry.urdf,
             base=settings.base or entry.base,
             eelink=settings.eelink or entry.eelink,
+            package_paths=(*settings.package_paths, *entry.package_paths),
+            xacro_args=(*entry.xacro_args, *settings.xacro_args),
         )
     elif "robot" in overrides and overrides["robot"] is not None:
-        entry = robots.get(settings.robot)
-        if entry is not None:
+        found = catalogue(robots, ini).get(settings.robot)
+        if found is not None:
             settings = replace(
-                settings, base=settings.base or entry.base, eelink=settings.eelink or entry.eelink
+                settings, base=settings.base or found.base, eelink=settings.eelink or found.eelink
             )
     return settings

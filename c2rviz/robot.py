@@ -11,7 +11,7 @@ metres for prismatic ones.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -104,7 +104,7 @@ class Robot:
         self.lower = tuple(joint.lower for joint in self.joints)
         self.upper = tuple(joint.upper for joint in self.joints)
         self.prismatic = tuple(joint.prismatic for joint in self.joints)
-        self.neutral = pin.neutral(model)
+        self.neutral = self._neutral()
         self._simple_q = all(joint.nq == 1 for joint in self.joints)
         self._idx_q = np.array([joint.idx_q for joint in self.joints], dtype=int)
         pin.framesForwardKinematics(model, self.data, self.neutral)
@@ -112,10 +112,16 @@ class Robot:
 
     @classmethod
     def from_urdf(
-        cls, path: str | Path, base: str | None = None, eelink: str | None = None
+        cls,
+        path: str | Path,
+        base: str | None = None,
+        eelink: str | None = None,
+        *,
+        package_paths: Sequence[str | Path] = (),
+        xacro_args: Mapping[str, str] | Iterable[str] = (),
     ) -> Robot:
-        """Build the model from a URDF file."""
-        return cls.from_source(load_source(path), base, eelink)
+        """Build the model from a URDF or xacro file (see ``sources.load_source``)."""
+        return cls.from_source(load_source(path, package_paths, xacro_args), base, eelink)
 
     @classmethod
     def from_source(
@@ -188,10 +194,27 @@ class Robot:
             )
         return tuple(chain)
 
+    def _neutral(self) -> np.ndarray:
+        """Pinocchio's neutral configuration, kept within each joint's limits.
+
+        A 1-DoF joint whose limits exclude 0 sits at its nearest limit, as
+        ``home`` puts chain joints; off-chain joints stay there.
+        """
+        model = self.model
+        q = pin.neutral(model)
+        for jm in model.joints[1:]:
+            if jm.nq == 1 and jm.nv == 1:
+                lower = model.lowerPositionLimit[jm.idx_q]
+                upper = model.upperPositionLimit[jm.idx_q]
+                if lower <= upper:
+                    q[jm.idx_q] = min(max(q[jm.idx_q], lower), upper)
+        return q
+
     def configuration(self, q: Sequence[float]) -> np.ndarray:
         """Pinocchio's full configuration for chain values ``q`` [rad or m].
 
-        Joints off the chain stay at their neutral value; mimic joints follow.
+        Joints off the chain stay at their neutral value (0, or the nearest limit
+        when 0 is outside them); mimic joints follow their leader.
         """
         full = self.neutral.copy()
         if self._simple_q:
