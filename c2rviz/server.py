@@ -11,7 +11,9 @@ from __future__ import annotations
 
 import asyncio
 import logging
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from itertools import islice
+from operator import length_hint
 
 from . import replies
 from .commands import USAGE, Bye, ForeignProtocol, Quit, Sleep, parse_line
@@ -37,8 +39,9 @@ class Connection(asyncio.Protocol):
         self.transport: asyncio.Transport | None = None
         self.peer = "?"
         self.buffer = b""
-        self.backlog: list[Line] = []  # lines read but waiting behind a sleep
-        self.sleep_timer: asyncio.TimerHandle | None = None
+        self.backlog: Iterator[Line] = iter(())  # lines read, waiting behind a sleep or a yield
+        self.wake_timer: asyncio.Handle | None = None  # set while reading is paused
+        self.sleeping = False  # the pause is a `sleep`, which is answered when it ends
         self.partial_timer: asyncio.TimerHandle | None = None
         self.closing = False
         self.eof = False
@@ -77,14 +80,14 @@ class Connection(asyncio.Protocol):
         if self.closing:
             return
         buffer = self.buffer + data if self.buffer else data
-        if self.sleep_timer is not None:
+        if self.wake_timer is not None:
             self.buffer = buffer  # reading is paused; the wake-up goes on from here
             return
         self._consume(buffer)
 
     def eof_received(self) -> bool:
         self.eof = True
-        if self.sleep_timer is None:
+        if self.wake_timer is None:
             self._close()
         return True  # keep the write side open until the replies are out
 
@@ -98,11 +101,11 @@ class Connection(asyncio.Protocol):
             if self.partial_timer is not None:  # the line it timed is finished
                 self.partial_timer.cancel()
                 self.partial_timer = None
-            self._run(self._decode(buffer[:cut]))
+            self._run(iter(self._decode(buffer[:cut])))
         else:
             self.buffer = buffer
-        if self.closing or self.sleep_timer is not None:
-            return  # while asleep we do not read, so an unfinished line is not the client's fault
+        if self.closing or self.wake_timer is not None:
+            return  # while paused we do not read, so an unfinished line is not the client's fault
         if len(self.buffer) > self.limits.max_line:
             self._close_with(replies.error(LineTooLong(self.limits.max_line)))
         elif self.buffer and self.partial_timer is None:
@@ -129,13 +132,17 @@ class Connection(asyncio.Protocol):
                 lines.append(LineError(replies.NOT_UTF8))
         return lines
 
-    def _run(self, lines: list[Line]) -> None:
-        """Answer ``lines`` in order, stopping at a sleep, bye, quit or fatal line."""
+    def _run(self, lines: Iterator[Line]) -> None:
+        """Answer ``lines`` in order, stopping at a sleep, bye, quit or fatal line.
+
+        At most ``_BATCH`` lines run in one go; the rest wait one loop turn, so a
+        client that sends thousands of lines in one read cannot stall the others.
+        """
         out: list[str] = []
         reply = out.append
         execute = self.session.execute
         note = self.server.world.note_command
-        for i, line in enumerate(lines):
+        for line in islice(lines, _BATCH):
             try:
                 if line.__class__ is not str:
                     raise line  # type: ignore[misc]
@@ -152,7 +159,7 @@ class Connection(asyncio.Protocol):
                             USAGE["sleep"],
                         )
                     self._write(out)
-                    self._connection_command(command, lines[i + 1 :])
+                    self._connection_command(command, lines)
                     return
                 reply(execute(command))
             except (ForeignProtocol, LineTooLong) as exc:
@@ -166,13 +173,12 @@ class Connection(asyncio.Protocol):
                 log.exception("internal error on %r from %s", line, self.peer)
                 reply(replies.error("internal error (see the server log)"))
         self._write(out)
+        if length_hint(lines) and not self.closing:  # exact for a list's iterator
+            self._pause(lines, 0.0, sleeping=False)
 
-    def _connection_command(self, command: object, rest: list[Line]) -> None:
+    def _connection_command(self, command: object, rest: Iterator[Line]) -> None:
         if isinstance(command, Sleep):
-            self.backlog = rest
-            assert self.transport is not None
-            self.transport.pause_reading()
-            self.sleep_timer = asyncio.get_running_loop().call_later(command.seconds, self._wake)
+            self._pause(rest, command.seconds, sleeping=True)
         elif isinstance(command, Bye):
             self._write([replies.BYE])
             self._close()
@@ -182,18 +188,32 @@ class Connection(asyncio.Protocol):
             self._close()
             self.server.request_quit()
 
+    def _pause(self, rest: Iterator[Line], seconds: float, sleeping: bool) -> None:
+        """Stop reading; after ``seconds`` (0: the next loop turn) run ``rest`` and go on."""
+        self.backlog = rest
+        self.sleeping = sleeping
+        assert self.transport is not None
+        self.transport.pause_reading()
+        loop = asyncio.get_running_loop()
+        if seconds > 0:
+            self.wake_timer = loop.call_later(seconds, self._wake)
+        else:
+            self.wake_timer = loop.call_soon(self._wake)
+
     def _wake(self) -> None:
-        self.sleep_timer = None
+        self.wake_timer = None
         if self.closing:
             return
-        self._write([replies.OK])
-        backlog, self.backlog = self.backlog, []
+        if self.sleeping:
+            self.sleeping = False
+            self._write([replies.OK])
+        backlog, self.backlog = self.backlog, iter(())
         self._run(backlog)
-        if self.closing or self.sleep_timer is not None:
+        if self.closing or self.wake_timer is not None:
             return
         buffer, self.buffer = self.buffer, b""
         self._consume(buffer)
-        if self.closing or self.sleep_timer is not None:
+        if self.closing or self.wake_timer is not None:
             return
         if self.eof:
             self._close()
@@ -229,18 +249,18 @@ class Connection(asyncio.Protocol):
             self.transport.close()
 
     def _cancel_timers(self) -> None:
-        for timer in (self.sleep_timer, self.partial_timer):
+        for timer in (self.wake_timer, self.partial_timer):
             if timer is not None:
                 timer.cancel()
-        self.sleep_timer = self.partial_timer = None
+        self.wake_timer = self.partial_timer = None
 
     def shutdown(self) -> None:
         """The program is stopping: answer what was read, then close."""
         if self.closing:
             return
-        unanswered = (self.sleep_timer is not None) + sum(map(_is_command, self.backlog))
+        unanswered = self.sleeping + sum(map(_is_command, self.backlog))
         self._write([replies.SHUTTING_DOWN] * unanswered)
-        self.backlog = []
+        self.backlog = iter(())
         self._close()
 
 
@@ -255,6 +275,7 @@ def _is_command(line: Line) -> bool:
 
 
 _CONNECTION_COMMANDS = frozenset({Sleep, Bye, Quit})
+_BATCH = 1024  # lines run per loop turn per client (a few ms of work)
 
 
 class CommandServer:
