@@ -1,0 +1,140 @@
+"""Stopping: quit, SIGINT and SIGTERM with clients mid-command, the port freed, and exposure."""
+
+from __future__ import annotations
+
+import signal
+import socket
+import time
+
+import pytest
+
+from c2rviz import replies
+
+HOME = "ok 0,0,0,0,0,0,0"
+
+
+def port_is_free(port: int) -> bool:
+    """True when a new server could listen on ``port`` (as the server does: SO_REUSEADDR)."""
+    with socket.socket() as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        try:
+            probe.bind(("127.0.0.1", port))
+            probe.listen()
+        except OSError:
+            return False
+    return True
+
+
+def read_all(sock: socket.socket) -> list[str]:
+    """Every reply line until the server closes the connection."""
+    data = b""
+    while chunk := sock.recv(65536):
+        data += chunk
+    return data.decode().splitlines()
+
+
+def open_clients(port: int) -> dict[str, list[socket.socket]]:
+    """20 clients in every state a stop can find them in; each is answered once first."""
+    kinds = {"idle": 8, "sleeping": 5, "partial": 4, "sent-bye": 1, "flooding": 2}
+    clients: dict[str, list[socket.socket]] = {kind: [] for kind in kinds}
+    for kind, count in kinds.items():
+        for _ in range(count):
+            sock = socket.socket()
+            if kind == "flooding":
+                sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+            sock.settimeout(10)
+            sock.connect(("127.0.0.1", port))
+            sock.sendall(b"where\n")
+            assert sock.recv(100) == (HOME + "\n").encode()  # connected and served
+            clients[kind].append(sock)
+    for sock in clients["sleeping"]:  # a sleep with lines queued behind it
+        sock.sendall(b"sleep 30\nwhere\n# a comment\nmove 0 1\n")
+    for sock in clients["partial"]:
+        sock.sendall(b"move 0 0.")
+    for sock in clients["sent-bye"]:
+        sock.sendall(b"bye\n")
+    for sock in clients["flooding"]:  # ~8 MB of replies never read: more than the kernel holds
+        sock.sendall(b"help\n" * 30_000)
+    return clients
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_a_signal_stops_promptly_with_20_clients(c2rviz_process, sig):
+    proc = c2rviz_process("--no-viewer", "--max-unread", str(64 << 20))  # floods stay connected
+    clients = open_clients(proc.port)
+    time.sleep(0.3)  # let the server read what was sent
+    start = time.monotonic()
+    proc.popen.send_signal(sig)
+    assert proc.wait(timeout=10) == 0
+    took = time.monotonic() - start
+    print(f"{sig.name}: stopped {took:.2f} s after the signal, 20 clients connected")
+    for sock in clients["idle"]:
+        assert read_all(sock) == []  # nothing unanswered: just closed
+    for sock in clients["sleeping"]:  # the sleep and both queued commands are answered
+        assert read_all(sock) == [replies.SHUTTING_DOWN] * 3
+    for sock in clients["partial"]:
+        assert read_all(sock) == []  # half a line is not a command
+    for sock in clients["sent-bye"]:
+        assert read_all(sock) == [replies.BYE]
+    for sock in clients["flooding"]:
+        sock.close()  # whatever it got, the program did not wait for it
+    for group in clients.values():
+        for sock in group:
+            sock.close()
+    assert port_is_free(proc.port)
+    rest = proc.popen.stdout.read()
+    assert "c2rviz: stopped" in rest
+    assert "Traceback" not in rest and "warning" not in "".join(proc.output) + rest
+
+
+def test_quit_answers_every_line_already_read_then_exits_cleanly(c2rviz_process):
+    proc = c2rviz_process("--no-viewer")
+    clients = open_clients(proc.port)
+    quitter = socket.create_connection(("127.0.0.1", proc.port), timeout=10)
+    time.sleep(0.2)
+    quitter.sendall(b"where\nquit\nwhere\nhome\n")
+    assert read_all(quitter) == [HOME, "ok", replies.SHUTTING_DOWN, replies.SHUTTING_DOWN]
+    assert proc.wait(timeout=10) == 0  # well before the 30 s sleeps end
+    for sock in clients["sleeping"]:
+        assert read_all(sock) == [replies.SHUTTING_DOWN] * 3
+    for sock in clients["idle"] + clients["partial"]:
+        assert read_all(sock) == []
+    for group in clients.values():
+        for sock in group:
+            sock.close()
+    quitter.close()
+    assert port_is_free(proc.port)
+
+
+def test_the_port_is_free_after_stop(start_server, connect):
+    server = start_server()
+    idle, sleeper = connect(server), connect(server)
+    assert idle.ask("where") == HOME
+    sleeper.send("sleep 30\nwhere\n")
+    time.sleep(0.1)
+    server.stop()
+    assert idle.closed_by_server()
+    assert sleeper.read_line() == replies.SHUTTING_DOWN
+    assert sleeper.read_line() == replies.SHUTTING_DOWN
+    assert sleeper.closed_by_server()
+    assert port_is_free(server.port)
+
+
+def test_a_client_arriving_during_stop_is_told_and_closed(start_server, connect):
+    server = start_server()
+    server.call(lambda: setattr(server.server, "stopping", True))
+    late = connect(server)
+    assert late.read_line() == replies.SHUTTING_DOWN
+    assert late.closed_by_server()
+
+
+def test_binding_beyond_loopback_warns_and_needs_an_explicit_host(c2rviz_process):
+    proc = c2rviz_process("--host", "0.0.0.0", "--no-viewer")
+    assert any("commands on 0.0.0.0:" in line for line in proc.output)
+    warning = proc.popen.stdout.readline()
+    assert warning.startswith("c2rviz: warning: the command server listens on 0.0.0.0")
+    assert "anyone who can reach it can move the robot and stop the program" in warning
+    with socket.create_connection(("127.0.0.1", proc.port), timeout=10) as sock:
+        sock.sendall(b"where\nquit\n")
+        assert read_all(sock) == [HOME, "ok"]
+    assert proc.wait(timeout=10) == 0
