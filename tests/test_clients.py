@@ -1,0 +1,503 @@
+"""The REPL and the player against a real server.
+
+``main(argv)`` runs in-process where that keeps the test fast; a subprocess
+(pipes, or a pseudo-terminal from the ``pty``-free ``os.openpty``) where the
+real process matters: prompts, Ctrl-C/Ctrl-D, exit statuses, retrying.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+import select
+import signal
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from c2rviz import client as client_module
+from c2rviz import player, repl
+from c2rviz.client import Client, ServerUnavailable, default_address
+
+ROOT = Path(__file__).resolve().parent.parent
+MOTOMAN = str(ROOT / "commands" / "motoman.txt")
+REPL_SCRIPT = str(ROOT / "clients" / "socketcmdline.py")
+PLAYER_SCRIPT = str(ROOT / "clients" / "fileplayer.py")
+SEED_END = "ok -90,-90,0,0,0,0,0"
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def where_degrees(server, connect) -> str:
+    """``where`` in degrees, from a separate client."""
+    other = connect(server)
+    assert other.ask("degrees") == "ok"
+    return other.ask("where")
+
+
+def write(tmp_path: Path, name: str, text: str) -> str:
+    path = tmp_path / name
+    path.write_text(text)
+    return str(path)
+
+
+def run_repl(monkeypatch, text: str, *args: str) -> int:
+    """``repl.main`` with ``text`` as piped stdin."""
+    monkeypatch.setattr(sys, "stdin", io.StringIO(text))
+    return repl.main(list(args))
+
+
+def env() -> dict[str, str]:
+    return {**os.environ, "PYTHONUNBUFFERED": "1", "TERM": "dumb"}
+
+
+# --- the shared client -------------------------------------------------------------------
+
+
+def test_clients_do_not_import_pinocchio():
+    code = (
+        "import sys, c2rviz.client, c2rviz.repl, c2rviz.player\n"
+        "print(c2rviz.client.default_address())\n"
+        "print(sorted(m for m in ('pinocchio', 'viser', 'numpy') if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.splitlines() == ["('127.0.0.1', 31000)", "[]"]
+
+
+def test_default_address_reads_the_ini(tmp_path):
+    ini = write(tmp_path, "my.ini", "[options]\nhost = 0.0.0.0\nport = 31234\n")
+    assert default_address(ini) == ("127.0.0.1", 31234)
+
+
+def test_client_tracks_units_and_restores_them_after_a_reconnect(server, connect):
+    client = Client(server.host, server.port)
+    assert client.ask("degrees") == "ok"
+    assert client.degrees
+    client.close()
+    assert client.ask("move 0 90") == "ok"  # reconnected, still in degrees
+    assert math.isclose(server.q[0], math.pi / 2)
+    assert client.ask("RADIANS # back") == "ok"
+    assert not client.degrees
+    client.close()
+
+
+def test_client_gives_up_after_its_retry_time():
+    port = free_port()
+    notes: list[str] = []
+    client = Client("127.0.0.1", port, retry_s=0.3, notify=notes.append)
+    start = time.monotonic()
+    with pytest.raises(ServerUnavailable, match=f"no c2rviz server at 127.0.0.1:{port}"):
+        client.open()
+    assert 0.3 <= time.monotonic() - start < 2.0
+    assert len(notes) == 1 and "retrying" in notes[0]
+
+
+# --- the player ----------------------------------------------------------------------------
+
+
+def test_player_plays_motoman_txt_to_the_seed_end_pose(server, connect, capsys):
+    start = time.monotonic()
+    assert player.main([MOTOMAN, "--port", str(server.port), "--speed", "1000"]) == 0
+    assert time.monotonic() - start < 5  # 26 s of sleeps at speed 1000
+    assert where_degrees(server, connect) == SEED_END
+    out = capsys.readouterr().out
+    assert "[ 1/16] sleep 5 -> ok" in out
+    assert "[16/16] move 0,1 -90,-90 -> ok" in out
+    assert "16 commands, all ok" in out
+    assert "\r" not in out  # plain lines when not on a terminal
+
+
+BAD_LINE_3 = "degrees\nmove 0 30\nmvoe 1 30   # typo\nhome\n"
+
+
+def test_check_reports_a_bad_line_without_connecting(tmp_path, capsys):
+    bad = write(tmp_path, "bad.txt", BAD_LINE_3)
+    port = free_port()  # nothing listens there: --check must not connect
+    assert player.main([bad, "--check", "--port", str(port)]) == 2
+    err = capsys.readouterr().err
+    assert f"{bad}:3: error: unknown command 'mvoe'" in err
+    assert "nothing was sent" in err
+    good = player.main([MOTOMAN, "--check", "--port", str(port)])
+    assert good == 0
+    assert "16 commands, all parse" in capsys.readouterr().out
+
+
+def test_a_bad_line_3_is_rejected_before_anything_moves(server, connect, tmp_path, capsys):
+    other = connect(server)
+    assert other.ask("move 2 0.5") == "ok"
+    before = server.q
+    bad = write(tmp_path, "bad.txt", BAD_LINE_3)
+    assert player.main([bad, "--port", str(server.port)]) == 2
+    assert f"{bad}:3: error: unknown command" in capsys.readouterr().err
+    assert server.q == before
+    assert other.ask("where") == "ok 0,0,0.5,0,0,0,0"
+
+
+def test_joint_counts_and_indices_are_checked_against_the_robot(server, tmp_path, capsys):
+    before = server.q
+    text = "degrees\nmove 0 10\njoints 1,2,3\nmove 1,9 1,2\n"
+    path = write(tmp_path, "count.txt", text)
+    assert player.main([path, "--port", str(server.port)]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}:3: error: joints needs 7 values, got 3" in err
+    assert f"{path}:4: error: joint index 9 out of range: motoman_sia20d has joints 0..6" in err
+    assert server.q == before
+
+
+LIMIT_LINE_3 = "degrees\nmove 0 10\nmove 1 500\nmove 2 20\n"
+
+
+def test_an_error_reply_stops_the_play_with_status_1(server, tmp_path, capsys):
+    path = write(tmp_path, "limit.txt", LIMIT_LINE_3)
+    assert player.main([path, "--port", str(server.port)]) == 1
+    captured = capsys.readouterr()
+    assert f"{path}:3: error: joint_l (index 1) = 500 deg is outside its limits" in captured.err
+    assert "[4/4]" not in captured.out
+    q = server.q
+    assert math.isclose(q[0], math.radians(10)) and q[1] == 0 and q[2] == 0
+
+
+def test_keep_going_plays_every_line_but_still_fails(server, tmp_path, capsys):
+    path = write(tmp_path, "limit.txt", LIMIT_LINE_3)
+    assert player.main([path, "--port", str(server.port), "--keep-going"]) == 1
+    captured = capsys.readouterr()
+    assert "[4/4] move 2 20 -> ok" in captured.out
+    assert "1 error" in captured.err
+    assert math.isclose(server.q[2], math.radians(20))
+
+
+def test_pipelined_play_matches_replies_to_lines(server, connect, tmp_path, capsys):
+    assert (
+        player.main([MOTOMAN, "--port", str(server.port), "--speed", "1e4", "--window", "8"]) == 0
+    )
+    out = capsys.readouterr().out
+    assert [line.split("]")[0] for line in out.splitlines()[:16]] == [
+        f"[{k:>2}/16" for k in range(1, 17)
+    ]
+    assert where_degrees(server, connect) == SEED_END
+    path = write(tmp_path, "limit.txt", LIMIT_LINE_3)
+    assert player.main([path, "--port", str(server.port), "--window", "8"]) == 1
+    # Line 4 was already sent when line 3 failed: it has run, and its reply is shown.
+    assert "[4/4] move 2 20 -> ok" in capsys.readouterr().out
+
+
+def test_loop_plays_the_file_n_times(server, tmp_path, capsys):
+    path = write(tmp_path, "two.txt", "# two lines\nmove 0 0.1\n\nmove 0 0.2\n")
+    assert player.main([path, "--port", str(server.port), "--loop", "3"]) == 0
+    out = capsys.readouterr().out
+    assert "[3: 2/2] move 0 0.2 -> ok" in out
+    assert "3 x 2 commands, all ok" in out
+
+
+def test_lines_after_quit_would_never_run(tmp_path, capsys):
+    path = write(tmp_path, "quit.txt", "home\nquit\nhome\n")
+    assert player.main([path, "--check"]) == 2
+    assert f"{path}:3: error: line 2 ('quit') closes the connection" in capsys.readouterr().err
+
+
+def test_the_player_finds_bundled_files_and_reports_missing_ones(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert player.main(["motoman.txt", "--check"]) == 0
+    assert player.main(["nonesuch.txt", "--check"]) == 2
+    assert "no command file 'nonesuch.txt'" in capsys.readouterr().err
+
+
+def test_the_player_gives_up_when_no_server_answers(tmp_path, capsys):
+    start = time.monotonic()
+    assert player.main([MOTOMAN, "--port", str(free_port()), "--timeout", "0.3"]) == 1
+    assert time.monotonic() - start < 3
+    assert "no c2rviz server at 127.0.0.1:" in capsys.readouterr().err
+
+
+def test_in_place_progress_on_a_terminal():
+    out = io.StringIO()
+    show = player.Progress(out, out, in_place=True)
+    show.step("[1/3]", "home", "ok")
+    show.step("[2/3]", "where", "ok 0,0")
+    show.step("[3/3]", "home", "ok")
+    show.error("x.txt:3: error: boom")
+    assert out.getvalue() == (
+        "\r\x1b[K[1/3] home -> ok"
+        "\r\x1b[K[2/3] where -> ok 0,0\n"  # a reply with data stays on screen
+        "\r\x1b[K[3/3] home -> ok\n"
+        "x.txt:3: error: boom\n"
+    )
+
+
+def test_fileplayer_script_runs_as_a_process(server, connect):
+    args = [PLAYER_SCRIPT, "commands/motoman.txt", "--port", str(server.port), "--speed", "1000"]
+    done = subprocess.run(
+        [sys.executable, *args], cwd=ROOT, capture_output=True, text=True, timeout=30
+    )
+    assert done.returncode == 0, done.stderr
+    assert "[16/16] move 0,1 -90,-90 -> ok" in done.stdout
+    assert where_degrees(server, connect) == SEED_END
+    bad = subprocess.run(
+        [sys.executable, *args[:1], "nonesuch.txt"], capture_output=True, text=True, timeout=30
+    )
+    assert bad.returncode == 2 and "Traceback" not in bad.stderr
+
+
+# --- the REPL, piped -----------------------------------------------------------------------
+
+
+def test_repl_piped(server, connect, monkeypatch, capsys):
+    text = (
+        "file motoman.txt speed=1000\n"
+        "where\n"
+        "goto 10,20,0,0,0,0,0 step=5 rate=500\n"
+        "frobnicate 3\n"
+        "\n# a comment\n"
+        "where\n"
+        "sleep 0.01\n"
+        "q\n"
+    )
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 0
+    captured = capsys.readouterr()
+    assert "Socket Created" in captured.err and "Socket Connected" in captured.err
+    assert not any(line.startswith(">") for line in captured.out.splitlines())  # no prompt
+    out = captured.out
+    assert "[16/16] move 0,1 -90,-90 -> ok" in out
+    first, second = out.split("motoman_sia20d (degrees):")[1:]
+    assert "0  joint_s  -90" in first and "1  joint_l  -90" in first
+    assert "ok (goto: 22 steps" in out  # 110 degrees in 5-degree steps
+    assert "error: unknown command 'frobnicate' (try 'help')" in out
+    assert "0  joint_s  10" in second and "1  joint_l  20" in second
+    # q leaves the server running
+    assert where_degrees(server, connect) == "ok 10,20,0,0,0,0,0"
+
+
+def test_repl_goto_in_radians_and_its_errors(server, monkeypatch, capsys):
+    text = (
+        "goto 0.5,0,0,0,0,0,0 rate=1000\n"  # default step: 2 degrees = 0.0349 rad
+        "goto 1,2\n"
+        "goto 0,0,0,0,0,0,0 speed=3\n"
+        "goto 0,0,0,9,0,0,0 step=1 rate=1000\n"  # joint_u's limit is 2.26 rad
+        "help\n"
+    )
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 0
+    out = capsys.readouterr().out
+    assert "ok (goto: 15 steps" in out
+    assert "error: goto: joints needs 7 values, got 2" in out
+    assert "error: goto: unknown option 'speed'" in out
+    assert "goto: stopped at step 3/9: error: joint_u (index 3)" in out
+    assert "file NAME [speed=X]" in out and "marker sphere|cube|arrow|cylinder" in out
+    assert math.isclose(server.q[0], 0.5 - 0.5 * 2 / 9)  # stopped before the limit
+
+
+def test_repl_file_stops_at_the_first_error(server, tmp_path, monkeypatch, capsys):
+    bad = write(tmp_path, "bad.txt", BAD_LINE_3)
+    limit = write(tmp_path, "limit.txt", LIMIT_LINE_3)
+    text = f"file {bad}\nfile {limit}\nfile nonesuch.txt\nwhere\n"
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 0
+    out = capsys.readouterr().out
+    assert f"{bad}:3: error: unknown command 'mvoe'" in out
+    assert f"{limit}:3: error: joint_l (index 1) = 500 deg" in out
+    assert "[4/4]" not in out
+    assert "error: file: no command file 'nonesuch.txt'" in out
+    assert "(degrees)" in out.split("nonesuch")[-1]  # the file's `degrees` was tracked
+
+
+def test_repl_quit_stops_the_server(c2rviz_process, monkeypatch, capsys):
+    proc = c2rviz_process("--no-viewer")
+    assert run_repl(monkeypatch, "where\nquit\n", "--port", str(proc.port)) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == "ok"
+    assert proc.wait(timeout=10) == 0
+
+
+def test_repl_waits_for_a_server_that_starts_late(c2rviz_process):
+    port = free_port()
+    repl_proc = subprocess.Popen(
+        [sys.executable, REPL_SCRIPT, "--port", str(port), "--timeout", "30"],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env(),
+    )
+    try:
+        time.sleep(1.0)
+        assert repl_proc.poll() is None
+        c2rviz_process("--no-viewer", "--port", str(port))
+        out, err = repl_proc.communicate("where\nq\n", timeout=30)
+    finally:
+        repl_proc.kill()
+        repl_proc.wait()
+    assert repl_proc.returncode == 0, err
+    assert f"no server at 127.0.0.1:{port} yet" in err and "retrying" in err
+    assert "Socket Connected" in err
+    assert "6  joint_t  0" in out
+
+
+def test_repl_gives_up_with_a_clear_message():
+    port = free_port()
+    start = time.monotonic()
+    done = subprocess.run(
+        [sys.executable, REPL_SCRIPT, "--port", str(port), "--timeout", "1"],
+        input="where\n",
+        capture_output=True,
+        text=True,
+        timeout=30,
+        env=env(),
+    )
+    assert done.returncode == 1
+    assert time.monotonic() - start < 6
+    assert f"no c2rviz server at 127.0.0.1:{port} after 1." in done.stderr
+    assert "giving up" in done.stderr
+    assert "Traceback" not in done.stderr + done.stdout
+
+
+# --- the REPL on a terminal ----------------------------------------------------------------
+
+# Make the pseudo-terminal the child's controlling terminal, so ^C and ^D act as typed,
+# and undo an inherited "ignore SIGINT" (background jobs get one), as a login shell would.
+LAUNCH = (
+    "import fcntl, os, signal, sys, termios; fcntl.ioctl(0, termios.TIOCSCTTY, 0); "
+    "signal.signal(signal.SIGINT, signal.SIG_DFL); "
+    "os.execv(sys.executable, [sys.executable, *sys.argv[1:]])"
+)
+
+
+class Terminal:
+    """A process on a pseudo-terminal: ``send`` keystrokes, ``expect`` output."""
+
+    def __init__(self, *args: str, history: Path) -> None:
+        master, slave = os.openpty()
+        self.proc = subprocess.Popen(
+            [sys.executable, "-c", LAUNCH, *args],
+            stdin=slave,
+            stdout=slave,
+            stderr=slave,
+            start_new_session=True,
+            env={**env(), "C2RVIZ_HISTORY": str(history)},
+        )
+        os.close(slave)
+        self.master = master
+        self.seen = ""
+
+    def send(self, keys: str) -> None:
+        os.write(self.master, keys.encode())
+
+    def expect(self, text: str, timeout: float = 15.0) -> str:
+        """Wait until ``text`` appears; return the output up to it and consume it."""
+        deadline = time.monotonic() + timeout
+        while text not in self.seen:
+            left = deadline - time.monotonic()
+            ready, _, _ = select.select([self.master], [], [], max(0.0, left))
+            if not ready:
+                raise AssertionError(f"no {text!r} after {timeout} s; got {self.seen!r}")
+            try:
+                data = os.read(self.master, 65536)
+            except OSError:  # EIO: the child closed the terminal
+                data = b""
+            if not data:
+                raise AssertionError(f"terminal closed before {text!r}; got {self.seen!r}")
+            self.seen += data.decode(errors="replace").replace("\r\n", "\n")
+        cut = self.seen.index(text) + len(text)
+        before, self.seen = self.seen[:cut], self.seen[cut:]
+        return before
+
+    def finish(self, timeout: float = 10.0) -> tuple[int, str]:
+        """Wait for the exit; return the status and the rest of the output."""
+        status = self.proc.wait(timeout=timeout)
+        while select.select([self.master], [], [], 0.2)[0]:
+            try:
+                data = os.read(self.master, 65536)
+            except OSError:
+                break
+            if not data:
+                break
+            self.seen += data.decode(errors="replace")
+        return status, self.seen
+
+    def close(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait()
+        os.close(self.master)
+
+
+@pytest.fixture
+def terminal(tmp_path) -> Callable[..., Terminal]:
+    opened: list[Terminal] = []
+
+    def start(*args: str) -> Terminal:
+        term = Terminal(REPL_SCRIPT, *args, history=tmp_path / "history")
+        opened.append(term)
+        return term
+
+    yield start
+    for term in opened:
+        term.close()
+
+
+def test_repl_on_a_terminal(server, connect, terminal, tmp_path):
+    term = terminal("--port", str(server.port))
+    term.expect("Socket Created")
+    term.expect("Socket Connected")
+    term.expect("> ")
+    term.send("file motoman.txt speed=1000\n")
+    term.expect("16 commands, all ok")
+    term.send("where\n")
+    assert "1  joint_l  -90" in term.expect("joint_t")
+    term.send("goto 0,0,0,0,0,0,0 rate=1000\n")
+    term.expect("ok (goto: 45 steps")
+    term.send("bogus\n")
+    term.expect("error: unknown command 'bogus'")
+    term.send("sleep 30\n")
+    time.sleep(0.5)
+    term.send("\x03")  # Ctrl-C stops the command, not the REPL
+    term.expect("interrupted")
+    term.send("where\n")
+    term.expect("joint_t")
+    term.send("q\n")
+    status, rest = term.finish()
+    assert status == 0
+    assert "Traceback" not in rest
+    assert where_degrees(server, connect) == "ok 0,0,0,0,0,0,0"  # the server is still up
+    history = (tmp_path / "history").read_text()
+    assert "file motoman.txt speed=1000" in history and "bogus" in history
+
+
+@pytest.mark.parametrize("key", ["\x04", "\x03"], ids=["ctrl-d", "ctrl-c"])
+def test_repl_leaves_cleanly_on_ctrl_d_and_ctrl_c(server, terminal, key):
+    term = terminal("--port", str(server.port))
+    term.expect("> ")
+    # CPython's readline misses a SIGINT that lands between drawing the prompt and
+    # waiting for input (a race no typist can hit): give it time to start waiting.
+    time.sleep(0.3)
+    term.send(key)
+    status, rest = term.finish()
+    assert status == 0
+    assert "Traceback" not in rest
+
+
+def test_repl_reconnects_when_the_server_restarts(c2rviz_process, terminal):
+    port = free_port()
+    first = c2rviz_process("--no-viewer", "--port", str(port))
+    term = terminal("--port", str(port), "--timeout", "30")
+    term.expect("> ")
+    term.send("degrees\n")
+    term.expect("ok")
+    first.popen.send_signal(signal.SIGTERM)
+    assert first.wait() == 0
+    c2rviz_process("--no-viewer", "--port", str(port))
+    term.send("where\n")
+    term.expect("lost (the server stopped or restarted); reconnecting")
+    assert "motoman_sia20d (degrees):" in term.expect("joint_t")  # units restored
+    term.send("q\n")
+    assert term.finish()[0] == 0
+
+
+def test_client_module_names_the_bundled_commands_dir():
+    assert (client_module.COMMANDS_DIR / "motoman.txt").is_file()
