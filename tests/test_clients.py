@@ -1,7 +1,7 @@
 """The REPL and the player against a real server.
 
 ``main(argv)`` runs in-process where that keeps the test fast; a subprocess
-(pipes, or a pseudo-terminal from the ``pty``-free ``os.openpty``) where the
+(pipes, or a pseudo-terminal from ``os.openpty``: no pexpect needed) where the
 real process matters: prompts, Ctrl-C/Ctrl-D, exit statuses, retrying.
 """
 
