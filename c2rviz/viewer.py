@@ -303,7 +303,7 @@ class ViserScene:
         reach = max(reach, 0.5)
         look_at = np.array([0.0, 0.0, 0.4 * reach])
         self.server.initial_camera.look_at = look_at
-        self.server.initial_camera.position = look_at + reach * np.array([1.5, 1.1, 0.6])
+        self.server.initial_camera.position = look_at + reach * np.array([1.3, 1.0, 0.5])
 
     def _add_shape(self, name: str, shape: Shape, visible: bool) -> Any:
         scene = self.server.scene
@@ -330,6 +330,7 @@ class ViserScene:
     def _build_panel(self) -> None:
         gui = self.server.gui
         self._sliders: list[Any] = []
+        self._ranges: list[tuple[float, float]] = []
         with gui.add_folder("Joints"):
             for i, joint in enumerate(self.robot.joints):
                 if joint.prismatic:
@@ -339,6 +340,11 @@ class ViserScene:
                 else:
                     low, high = math.degrees(joint.lower), math.degrees(joint.upper)
                     step, unit = 0.1, "deg"
+                # Round the ends inward to a step: "-180.000421" reads badly, and the
+                # slider cannot pass a limit (values shown are clamped to the ends).
+                low = round(math.ceil(low / step - 1e-9) * step, 6)
+                high = round(math.floor(high / step + 1e-9) * step, 6)
+                self._ranges.append((low, high))
                 slider = gui.add_slider(
                     joint.name,
                     min=low,
@@ -410,12 +416,13 @@ class ViserScene:
     def _to_slider(self, index: int, value: float) -> float:
         """Joint value [rad or m] in slider units (deg or m), within the slider's range."""
         joint = self.robot.joints[index]
-        if joint.prismatic:
-            return float(value)
-        degrees = math.degrees(value)
+        shown = float(value) if joint.prismatic else math.degrees(value)
         if joint.continuous:
-            degrees = (degrees + 180.0) % 360.0 - 180.0
-        return degrees
+            shown = (shown + 180.0) % 360.0 - 180.0
+        if index < len(self._ranges):
+            low, high = self._ranges[index]
+            shown = min(max(shown, low), high)
+        return shown
 
     # the share-link tunnel stays off
 
