@@ -7,18 +7,23 @@ answered correctly, and the server still accepting new clients.
 
 from __future__ import annotations
 
+import dataclasses
 import http.client
+import inspect
 import logging
 import math
 import socket
 import struct
 import threading
 import time
+from pathlib import Path
 
 import pytest
 
-from c2rviz import replies
+from c2rviz import cli, config, replies
+from c2rviz.commands import _MAX_INDEX_DIGITS
 from c2rviz.errors import LineTooLong
+from c2rviz.server import _BATCH, CommandServer
 
 # A state away from home (so a stray home or joints shows) with long `where` replies.
 START_Q = (0.123456789, -0.234567891, 0.345678912, -0.456789123, 0.567891234, -0.678912345, 0.0)
@@ -419,3 +424,26 @@ def test_a_quit_after_thousands_of_lines_answers_the_rest_with_shutting_down(liv
         got.append(reply)
     assert got == [WHERE] * 3000 + ["ok"] + [replies.SHUTTING_DOWN] * 2000
     assert server.quit.is_set()
+
+
+def test_the_limits_table_matches_the_code():
+    """docs/limits.md: every default, flag, ini key and range is the one the code uses."""
+    text = (Path(__file__).parent.parent / "docs" / "limits.md").read_text()
+    table = text.split("| Past the limit |")[1].split("\n\n")[0]
+    rows = [[c.strip() for c in row.strip("|").split("|")] for row in table.splitlines()[2:]]
+    flags = {a.option_strings[0]: a.dest for a in cli.build_parser()._actions if a.option_strings}
+    defaults = {f.name: f.default for f in dataclasses.fields(config.Limits)}
+    seen = set()
+    for _limit, default, flag, key, allowed, _past in rows:
+        field, kind, low, high = config._OPTIONS[key.strip("`")]
+        assert flags[flag.strip("`")] == field
+        assert kind(default.split()[0]) == defaults[field]
+        assert [float(v) for v in allowed.split("..")] == [low, high]
+        seen.add(field)
+    assert seen == set(defaults)  # every limit is in the table
+    assert f"| {_BATCH} | `server._BATCH` |" in text
+    assert f"| {_MAX_INDEX_DIGITS} | `commands._MAX_INDEX_DIGITS` |" in text
+    grace = inspect.signature(CommandServer.stop).parameters["grace_s"].default
+    assert f"| {grace:g} s | `CommandServer.stop(grace_s)` |" in text
+    assert "| Command server | `127.0.0.1` | `--host` | `host` |" in text
+    assert config.Settings().host == config.Settings().viewer_host == "127.0.0.1"
