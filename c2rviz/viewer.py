@@ -211,8 +211,11 @@ class ViserScene:
             handle.position = placement.translation
             handle.wxyz = _wxyz(placement.rotation)
         ee = self.robot.base_placement.actInv(data.oMf[self.robot.ee_frame])
-        x, y, z = ee.translation
-        roll, pitch, yaw = np.degrees(pin.rpy.matrixToRpy(ee.rotation))
+        # round() then + 0.0: no "-0.0" in the readout
+        x, y, z = (round(float(v), 3) + 0.0 for v in ee.translation)
+        roll, pitch, yaw = (
+            round(float(v), 1) + 0.0 for v in np.degrees(pin.rpy.matrixToRpy(ee.rotation))
+        )
         self._ee_pose.value = (
             f"x {x:+.3f}  y {y:+.3f}  z {z:+.3f} m\nr {roll:+.1f}  p {pitch:+.1f}  y {yaw:+.1f} deg"
         )
@@ -303,7 +306,7 @@ class ViserScene:
         reach = max(reach, 0.5)
         look_at = np.array([0.0, 0.0, 0.4 * reach])
         self.server.initial_camera.look_at = look_at
-        self.server.initial_camera.position = look_at + reach * np.array([1.3, 1.0, 0.5])
+        self.server.initial_camera.position = look_at + reach * np.array([1.15, 0.9, 0.45])
 
     def _add_shape(self, name: str, shape: Shape, visible: bool) -> Any:
         scene = self.server.scene
@@ -422,7 +425,7 @@ class ViserScene:
         if index < len(self._ranges):
             low, high = self._ranges[index]
             shown = min(max(shown, low), high)
-        return shown
+        return round(shown, 6)  # 30, not 29.999999999999996 (which the page shows as "30.0")
 
     # the share-link tunnel stays off
 
