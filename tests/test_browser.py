@@ -153,7 +153,8 @@ def test_the_page_follows_commands_and_commands_the_robot(
     proc = c2rviz_process("--viser-port", "0")
     assert proc.viewer_url is not None and proc.viewer_url.startswith("http://127.0.0.1:")
     page = open_page(browser, proc.viewer_url)
-    assert page.get_by_text("Share").count() == 0  # no share-link button
+    # viser draws its share-link button as this icon (present by default); it is off.
+    assert page.locator("svg.tabler-icon-share").count() == 0
     wait_for_robot(page)
     home = settle(page, "1-home")
 

@@ -14,6 +14,7 @@ import socket
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import msgspec
@@ -193,6 +194,23 @@ def test_a_slider_from_the_page_commands_the_world_within_limits(
     h.call(lambda: h.scene._slider_moved(1, 500.0, 0))  # beyond joint_l's 1.91 rad
     assert h.world.q[1] == pytest.approx(h.robot.upper[1])
     assert h.world.q[0] == 0.0
+
+
+def test_the_buttons_and_the_collision_checkbox(harness: Callable[..., Harness]) -> None:
+    h = harness()
+    click = SimpleNamespace(client=object(), target=SimpleNamespace(value=True))
+    asyncio.run(h.scene._button_callback("randomize")(click))  # as on viser's loop
+    h.run(0.01)
+    assert h.world.q != h.world.home_q
+    asyncio.run(h.scene._button_callback("home")(click))
+    h.run(0.01)
+    assert h.world.q == h.world.home_q
+    collisions = [n for n in h.scene.server.scene._handle_from_node_name if "/collision_" in n]
+    assert collisions and not any(
+        h.scene.server.scene._handle_from_node_name[n].visible for n in collisions
+    )
+    asyncio.run(h.scene._collision_callback(click))
+    assert all(h.scene.server.scene._handle_from_node_name[n].visible for n in collisions)
 
 
 def test_markers_are_drawn_and_cleared(harness: Callable[..., Harness]) -> None:
