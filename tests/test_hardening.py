@@ -7,6 +7,7 @@ answered correctly, and the server still accepting new clients.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import http.client
 import inspect
@@ -313,38 +314,34 @@ def test_one_client_over_the_maximum_is_told_and_closed(live, connect):
 
 def test_a_client_that_never_reads_is_dropped_and_others_do_not_stall(live, connect):
     server, bystander, check = live(max_unread=64 * 1024)
-    hog = socket.socket()
-    hog.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)  # fill up fast
-    hog.settimeout(30)
-    hog.connect((server.host, server.port))
-    outcome = {}
+    with socket.socket() as hog:
+        hog.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)  # fill up fast
+        hog.settimeout(30)
+        hog.connect((server.host, server.port))
+        wait_for(lambda: client_count(server) == 2)
 
-    def flood():
-        try:
-            for _ in range(100):
-                hog.sendall(b"where\n" * 1000)  # 100,000 commands, replies never read
-            outcome["sent"] = "all"
-        except OSError as exc:
-            outcome["sent"] = type(exc).__name__
+        def flood():  # 100,000 lines and on: the kernel's buffers hold a few MB of replies
+            with contextlib.suppress(OSError):  # reset once the server drops it
+                for _ in range(1000):
+                    hog.sendall(b"where\n" * 1000)  # replies never read
 
-    flooder = threading.Thread(target=flood)
-    flooder.start()
-    round_trips = []
-    while flooder.is_alive() or len(round_trips) < 10:
-        start = time.perf_counter()
-        assert bystander.ask("where") == WHERE
-        round_trips.append(time.perf_counter() - start)
-    flooder.join()
-    print(
-        f"hog: {outcome['sent']}; bystander: {len(round_trips)} round trips, "
-        f"slowest {max(round_trips) * 1e3:.1f} ms"
-    )
-    wait_for(lambda: client_count(server) == 1)  # the hog was dropped
-    hog.settimeout(5)
-    with pytest.raises(OSError):  # reset: its unread replies were thrown away
-        while hog.recv(65536):
-            pass
-    hog.close()
+        flooder = threading.Thread(target=flood)
+        flooder.start()
+        round_trips = []
+        while client_count(server) == 2 or len(round_trips) < 10:  # while the hog is served
+            start = time.perf_counter()
+            assert bystander.ask("where") == WHERE
+            round_trips.append(time.perf_counter() - start)
+        flooder.join(timeout=30)
+        ran = server.call(lambda: len(server.scene.commands)) - len(round_trips)
+        print(
+            f"hog dropped after the server ran {ran} of its lines; bystander: "
+            f"{len(round_trips)} round trips meanwhile, slowest {max(round_trips) * 1e3:.1f} ms"
+        )
+        assert not flooder.is_alive()
+        with contextlib.suppress(OSError):  # whatever replies got through, then EOF or reset
+            while hog.recv(65536):
+                pass
     check()
 
 
@@ -368,10 +365,10 @@ def test_an_idle_client_between_lines_is_not_dropped(live, connect):
 
 def test_a_steady_stream_split_across_reads_is_not_dropped(live, connect):
     """Each line finishes in time, but some line is always unfinished at a read's end."""
-    server, _bystander, check = live(partial_timeout_s=0.3)
+    server, _bystander, check = live(partial_timeout_s=0.5)
     client = connect(server)
     client.send("wh")
-    for _ in range(8):  # 8 x 0.1 s: well past the timeout in total
+    for _ in range(10):  # 10 x 0.1 s: well past the timeout in total
         time.sleep(0.1)
         client.send("ere\nwh")
         assert client.read_line() == WHERE
@@ -382,11 +379,11 @@ def test_a_steady_stream_split_across_reads_is_not_dropped(live, connect):
 
 def test_a_sleep_does_not_count_against_the_partial_timeout(live, connect):
     """While a client sleeps the server is not reading it: its line cannot finish."""
-    server, _bystander, check = live(partial_timeout_s=0.3)
+    server, _bystander, check = live(partial_timeout_s=0.5)
     client = connect(server)
     client.send("wh")
     time.sleep(0.1)
-    client.send("ere\nsleep 0.6\nwh")
+    client.send("ere\nsleep 1\nwh")
     assert client.read_line() == WHERE
     time.sleep(0.1)
     client.send("ere\n")

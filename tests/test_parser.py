@@ -169,4 +169,4 @@ def test_hostile_lines_are_rejected_in_linear_time(line):
     start = time.perf_counter()
     with pytest.raises(C2rvizError):
         parse_line(line)
-    assert time.perf_counter() - start < 0.25
+    assert time.perf_counter() - start < 0.5  # linear: about 1 ms

@@ -48,7 +48,8 @@ def open_clients(port: int) -> dict[str, list[socket.socket]]:
             assert sock.recv(100) == (HOME + "\n").encode()  # connected and served
             clients[kind].append(sock)
     for sock in clients["sleeping"]:  # a sleep with lines queued behind it
-        sock.sendall(b"sleep 30\nwhere\n# a comment\nmove 0 1\n")
+        sock.sendall(b"where\nsleep 30\nwhere\n# a comment\nmove 0 1\n")
+        assert sock.recv(100) == (HOME + "\n").encode()  # read, so now asleep
     for sock in clients["partial"]:
         sock.sendall(b"move 0 0.")
     for sock in clients["sent-bye"]:
