@@ -217,7 +217,7 @@ class ViserScene:
             round(float(v), 1) + 0.0 for v in np.degrees(pin.rpy.matrixToRpy(ee.rotation))
         )
         self._ee_pose.value = (
-            f"x {x:+.3f}  y {y:+.3f}  z {z:+.3f} m\nr {roll:+.1f}  p {pitch:+.1f}  y {yaw:+.1f} deg"
+            f"x {x:+.3f}  y {y:+.3f}  z {z:+.3f} m\nR {roll:+.1f}  P {pitch:+.1f}  Y {yaw:+.1f} deg"
         )
 
     def _sync_sliders(self, q: Sequence[float]) -> None:
