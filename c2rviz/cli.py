@@ -131,7 +131,15 @@ async def serve(settings: Settings, robot: Robot) -> int:
     """Run the viewer and the command server until ``quit``, SIGINT or SIGTERM."""
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
-    scene = _open_scene(settings, robot)
+    try:
+        scene = _open_scene(settings, robot)
+    except OSError as exc:
+        print(
+            f"c2rviz: cannot serve the viewer on {settings.viewer_host}:{settings.viewer_port}: "
+            f"{exc.strerror or exc}",
+            file=sys.stderr,
+        )
+        return 2
     world = World(robot, scene)
     bind = getattr(scene, "bind", None)
     if bind is not None:

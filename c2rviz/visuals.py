@@ -19,7 +19,6 @@ import io
 import logging
 import warnings
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import trimesh
@@ -189,7 +188,8 @@ class _MeshLoader:
     def _read(self, uri: str) -> list[trimesh.Trimesh] | None:
         path = self.source.resolve(uri)
         if path is None:
-            log.warning("mesh %s not found; looked in: %s", uri, self._searched(uri))
+            searched = ", ".join(map(str, self.source.searched(uri))) or "nowhere (remote URI)"
+            log.warning("mesh %s not found; looked in: %s", uri, searched)
             return None
         try:
             with warnings.catch_warnings(record=True) as caught:
@@ -208,11 +208,3 @@ class _MeshLoader:
             log.warning("mesh %s (%s) holds no triangles", uri, path)
             return None
         return pieces
-
-    def _searched(self, uri: str) -> str:
-        """The places ``uri`` was looked up in, for the warning."""
-        if uri.startswith("package://"):
-            name, _, rest = uri[len("package://") :].partition("/")
-            return ", ".join(str(folder / rest) for folder in self.source.package_dirs(name))
-        path = Path(uri[len("file://") :] if uri.startswith("file://") else uri)
-        return str(path if path.is_absolute() else self.source.folder / path)
