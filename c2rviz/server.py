@@ -2,7 +2,8 @@
 
 Each connection is an ``asyncio.Protocol``: it splits what arrives into lines,
 runs every complete line through the parser and its ``Session``, and answers
-all lines of one read with one write. Nothing here knows kinematics or
+all lines of one read (up to ``_BATCH_BYTES`` of them: a big read is run in
+batches, one loop turn each) with one write. Nothing here knows kinematics or
 drawing. The limits in ``config.Limits`` bound what one client can cost; a
 client that breaks one is told why and closed, and no other client notices.
 """
@@ -11,9 +12,8 @@ from __future__ import annotations
 
 import asyncio
 import logging
-from collections.abc import Callable, Iterator
-from itertools import islice
-from operator import length_hint
+from collections.abc import Callable
+from itertools import chain
 
 from . import replies
 from .commands import USAGE, Bye, ForeignProtocol, Quit, Sleep, parse_line
@@ -39,7 +39,7 @@ class Connection(asyncio.Protocol):
         self.transport: asyncio.Transport | None = None
         self.peer = "?"
         self.buffer = b""
-        self.backlog: Iterator[Line] = iter(())  # lines read, waiting behind a sleep or a yield
+        self.backlog: list[Line] = []  # lines read but waiting behind a sleep
         self.wake_timer: asyncio.Handle | None = None  # set while reading is paused
         self.sleeping = False  # the pause is a `sleep`, which is answered when it ends
         self.partial_timer: asyncio.TimerHandle | None = None
@@ -94,19 +94,23 @@ class Connection(asyncio.Protocol):
     # line handling
 
     def _consume(self, buffer: bytes) -> None:
-        """Run every complete line in ``buffer``; keep the unfinished rest."""
-        cut = buffer.rfind(b"\n")
+        """Run the complete lines in ``buffer``, one batch of them; keep the rest."""
+        cut = buffer.rfind(b"\n", 0, _BATCH_BYTES)
+        if cut < 0:
+            cut = buffer.find(b"\n")  # the first line is longer than a batch
         if cut >= 0:
             self.buffer = buffer[cut + 1 :]
             if self.partial_timer is not None:  # the line it timed is finished
                 self.partial_timer.cancel()
                 self.partial_timer = None
-            self._run(iter(self._decode(buffer[:cut])))
+            self._run(self._decode(buffer[:cut]))
         else:
             self.buffer = buffer
         if self.closing or self.wake_timer is not None:
             return  # while paused we do not read, so an unfinished line is not the client's fault
-        if len(self.buffer) > self.limits.max_line:
+        if b"\n" in self.buffer:  # more complete lines: let the other clients in first
+            self._pause([], 0.0, sleeping=False)
+        elif len(self.buffer) > self.limits.max_line:
             self._close_with(replies.error(LineTooLong(self.limits.max_line)))
         elif self.buffer and self.partial_timer is None:
             self.partial_timer = asyncio.get_running_loop().call_later(
@@ -136,17 +140,13 @@ class Connection(asyncio.Protocol):
                 lines.append(LineError(replies.NOT_UTF8))
         return lines
 
-    def _run(self, lines: Iterator[Line]) -> None:
-        """Answer ``lines`` in order, stopping at a sleep, bye, quit or fatal line.
-
-        At most ``_BATCH`` lines run in one go; the rest wait one loop turn, so a
-        client that sends thousands of lines in one read cannot stall the others.
-        """
+    def _run(self, lines: list[Line]) -> None:
+        """Answer ``lines`` in order, stopping at a sleep, bye, quit or fatal line."""
         out: list[str] = []
         reply = out.append
         execute = self.session.execute
         note = self.server.world.note_command
-        for line in islice(lines, _BATCH):
+        for i, line in enumerate(lines):
             try:
                 if line.__class__ is not str:
                     raise line  # type: ignore[misc]
@@ -163,7 +163,7 @@ class Connection(asyncio.Protocol):
                             USAGE["sleep"],
                         )
                     self._write(out)
-                    self._connection_command(command, lines)
+                    self._connection_command(command, lines[i + 1 :])
                     return
                 reply(execute(command))
             except (ForeignProtocol, LineTooLong) as exc:
@@ -177,10 +177,8 @@ class Connection(asyncio.Protocol):
                 log.exception("internal error on %r from %s", line, self.peer)
                 reply(replies.error("internal error (see the server log)"))
         self._write(out)
-        if length_hint(lines) and not self.closing:  # exact for a list's iterator
-            self._pause(lines, 0.0, sleeping=False)
 
-    def _connection_command(self, command: object, rest: Iterator[Line]) -> None:
+    def _connection_command(self, command: object, rest: list[Line]) -> None:
         if isinstance(command, Sleep):
             self._pause(rest, command.seconds, sleeping=True)
         elif isinstance(command, Bye):
@@ -188,11 +186,11 @@ class Connection(asyncio.Protocol):
             self._close()
         elif isinstance(command, Quit):
             self._write([replies.OK])
-            self._write([replies.SHUTTING_DOWN for line in rest if _is_command(line)])
+            self._write([replies.SHUTTING_DOWN] * self._unanswered(rest))
             self._close()
             self.server.request_quit()
 
-    def _pause(self, rest: Iterator[Line], seconds: float, sleeping: bool) -> None:
+    def _pause(self, rest: list[Line], seconds: float, sleeping: bool) -> None:
         """Stop reading; after ``seconds`` (0: the next loop turn) run ``rest`` and go on."""
         self.backlog = rest
         self.sleeping = sleeping
@@ -211,7 +209,7 @@ class Connection(asyncio.Protocol):
         if self.sleeping:
             self.sleeping = False
             self._write([replies.OK])
-        backlog, self.backlog = self.backlog, iter(())
+        backlog, self.backlog = self.backlog, []
         self._run(backlog)
         if self.closing or self.wake_timer is not None:
             return
@@ -262,10 +260,15 @@ class Connection(asyncio.Protocol):
         """The program is stopping: answer what was read, then close."""
         if self.closing:
             return
-        unanswered = self.sleeping + sum(map(_is_command, self.backlog))
-        self._write([replies.SHUTTING_DOWN] * unanswered)
-        self.backlog = iter(())
+        self._write([replies.SHUTTING_DOWN] * (self.sleeping + self._unanswered(self.backlog)))
+        self.backlog = []
         self._close()
+
+    def _unanswered(self, rest: list[Line]) -> int:
+        """How many of ``rest`` and the complete lines still buffered would get a reply."""
+        cut = self.buffer.rfind(b"\n")
+        buffered = self._decode(self.buffer[:cut]) if cut >= 0 else []
+        return sum(map(_is_command, chain(rest, buffered)))
 
 
 def _is_command(line: Line) -> bool:
@@ -279,7 +282,7 @@ def _is_command(line: Line) -> bool:
 
 
 _CONNECTION_COMMANDS = frozenset({Sleep, Bye, Quit})
-_BATCH = 1024  # lines run per loop turn per client (a few ms of work)
+_BATCH_BYTES = 8192  # complete lines run per client per loop turn: at most ~20 ms of work
 
 
 class CommandServer:
