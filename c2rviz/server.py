@@ -43,6 +43,7 @@ class Connection(asyncio.Protocol):
         self.wake_timer: asyncio.Handle | None = None  # set while reading is paused
         self.sleeping = False  # the pause is a `sleep`, which is answered when it ends
         self.partial_timer: asyncio.TimerHandle | None = None
+        self.linger_timer: asyncio.TimerHandle | None = None
         self.closing = False
         self.eof = False
         self.closed = asyncio.get_running_loop().create_future()
@@ -55,6 +56,7 @@ class Connection(asyncio.Protocol):
         peer = transport.get_extra_info("peername")
         self.peer = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
         server = self.server
+        server.open.add(self)
         if server.stopping:
             self._close_with(replies.SHUTTING_DOWN)
         elif len(server.connections) >= self.limits.max_clients:
@@ -69,6 +71,7 @@ class Connection(asyncio.Protocol):
         self._cancel_timers()
         self.closing = True
         server = self.server
+        server.open.discard(self)
         if self in server.connections:
             server.connections.discard(self)
             server.world.set_client_count(len(server.connections))
@@ -87,6 +90,8 @@ class Connection(asyncio.Protocol):
 
     def eof_received(self) -> bool:
         self.eof = True
+        if self.closing:
+            return False  # done lingering: asyncio closes the transport
         if self.wake_timer is None:
             self._close()
         return True  # keep the write side open until the replies are out
@@ -187,8 +192,8 @@ class Connection(asyncio.Protocol):
         elif isinstance(command, Quit):
             self._write([replies.OK])
             self._write([replies.SHUTTING_DOWN] * self._unanswered(rest))
+            self.server.request_quit()  # before the close: a client seeing EOF sees it done
             self._close()
-            self.server.request_quit()
 
     def _pause(self, rest: list[Line], seconds: float, sleeping: bool) -> None:
         """Stop reading; after ``seconds`` (0: the next loop turn) run ``rest`` and go on."""
@@ -230,7 +235,7 @@ class Connection(asyncio.Protocol):
     # output and closing
 
     def _write(self, out: list[str]) -> None:
-        if not out or self.transport is None or self.transport.is_closing():
+        if not out or self.closing or self.transport is None or self.transport.is_closing():
             return
         self.transport.write(("\n".join(out) + "\n").encode())
         unread = self.transport.get_write_buffer_size()
@@ -244,17 +249,31 @@ class Connection(asyncio.Protocol):
         self._close()
 
     def _close(self) -> None:
+        """Send what is queued, then close.
+
+        A socket closed with input still unread sends RST, and RST throws away
+        replies not yet delivered. So unless the client has finished sending, we
+        half-close (FIN after the replies) and read and drop its input until it
+        closes too, for at most ``_LINGER_S``.
+        """
         self.closing = True
         self.buffer = b""
         self._cancel_timers()
-        if self.transport is not None:
-            self.transport.close()
+        transport = self.transport
+        if transport is None or transport.is_closing():
+            return
+        if self.eof:
+            transport.close()  # nothing more will come: nothing to linger for
+            return
+        transport.write_eof()
+        transport.resume_reading()
+        self.linger_timer = asyncio.get_running_loop().call_later(_LINGER_S, transport.abort)
 
     def _cancel_timers(self) -> None:
-        for timer in (self.wake_timer, self.partial_timer):
+        for timer in (self.wake_timer, self.partial_timer, self.linger_timer):
             if timer is not None:
                 timer.cancel()
-        self.wake_timer = self.partial_timer = None
+        self.wake_timer = self.partial_timer = self.linger_timer = None
 
     def shutdown(self) -> None:
         """The program is stopping: answer what was read, then close."""
@@ -283,6 +302,7 @@ def _is_command(line: Line) -> bool:
 
 _CONNECTION_COMMANDS = frozenset({Sleep, Bye, Quit})
 _BATCH_BYTES = 8192  # complete lines run per client per loop turn: at most ~20 ms of work
+_LINGER_S = 2.0  # after the last reply, how long a closing client's input is read and dropped
 
 
 class CommandServer:
@@ -304,7 +324,8 @@ class CommandServer:
         self.world = world
         self.limits = limits if limits is not None else Limits()
         self.on_quit = on_quit
-        self.connections: set[Connection] = set()
+        self.connections: set[Connection] = set()  # the clients being served
+        self.open: set[Connection] = set()  # those and the refused ones, until their socket closes
         self.stopping = False
         self.quit_requested = False
         self._server: asyncio.Server | None = None
@@ -330,11 +351,13 @@ class CommandServer:
             self._server.close()
         for connection in list(self.connections):
             connection.shutdown()
-        pending = [c.closed for c in self.connections if not c.closed.done()]
-        if pending:
-            await asyncio.wait(pending, timeout=grace_s)
-        for connection in list(self.connections):
+        if self.open:  # each gets its last replies and then closes, or is cut off
+            await asyncio.wait([c.closed for c in self.open], timeout=grace_s)
+        left = list(self.open)
+        for connection in left:
             if connection.transport is not None:
                 connection.transport.abort()
+        if left:  # let connection_lost run, so every socket is closed when we return
+            await asyncio.wait([c.closed for c in left], timeout=1.0)
         if self._server is not None:
             await self._server.wait_closed()

@@ -178,16 +178,31 @@ def test_case_whitespace_and_crlf_are_accepted(live, connect, line):
 def test_an_over_long_line_without_newline_is_refused_and_closed(live, connect):
     server, _bystander, check = live(max_line=1024)
     client = connect(server)
-    sent = 0
-    try:  # keep pushing: the server must close long before it would hold all of this
-        for _ in range(20 * 1024):
+    held = [0]  # the most the server held for this client between reads
+    sending = threading.Event()
+    sending.set()
+
+    def watch():
+        while sending.is_set():
+            sizes = server.call(lambda: [len(c.buffer) for c in server.server.connections])
+            held[0] = max(held[0], *sizes)
+
+    client.send(b"x" * 1000)  # under the limit: held, waiting for its newline
+    wait_for(lambda: max(server.call(lambda: [len(c.buffer) for c in server.server.connections])))
+    watcher = threading.Thread(target=watch)
+    watcher.start()
+    sent = 1000
+    with contextlib.suppress(OSError):  # once the server stops reading and drops the rest
+        for _ in range(20 * 1024):  # 20 MiB with no newline
             client.sock.sendall(b"x" * 1024)
             sent += 1024
-    except OSError:  # reset or broken pipe once the server has closed
-        pass
-    assert sent < 20 * 1024 * 1024
+    sending.clear()
+    watcher.join()
+    print(f"over-long line: {sent >> 20} MiB sent, the server held at most {held[0]} bytes")
+    assert 1000 <= held[0] <= 1024
     assert client.read_line() == replies.error(LineTooLong(1024))
     assert client.closed_by_server()
+    client.close()
     wait_for(lambda: client_count(server) == 1)
     check()
 
@@ -302,6 +317,7 @@ def test_one_client_over_the_maximum_is_told_and_closed(live, connect):
     others = [connect(server), connect(server)]
     wait_for(lambda: client_count(server) == 3)
     extra = connect(server)
+    extra.send("where\n" * 1000)  # talks at once: the refusal must still reach it
     assert extra.read_line() == replies.too_many_clients(3)
     assert extra.closed_by_server()
     for other in others:
@@ -420,7 +436,7 @@ def test_a_quit_after_thousands_of_lines_answers_the_rest_with_shutting_down(liv
     while reply := client.read_line():
         got.append(reply)
     assert got == [WHERE] * 3000 + ["ok"] + [replies.SHUTTING_DOWN] * 2000
-    assert server.quit.is_set()
+    assert server.quit.wait(timeout=5)
 
 
 def test_the_limits_table_matches_the_code():

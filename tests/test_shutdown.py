@@ -139,3 +139,24 @@ def test_binding_beyond_loopback_warns_and_needs_an_explicit_host(c2rviz_process
         sock.sendall(b"where\nquit\n")
         assert read_all(sock) == [HOME, "ok"]
     assert proc.wait(timeout=10) == 0
+
+
+def test_a_stop_mid_flood_answers_what_was_read_in_order(start_server):
+    """Lines already read (run, waiting their turn, or buffered) are answered; then EOF."""
+    import threading
+
+    server = start_server()
+    sock = socket.create_connection((server.host, server.port), timeout=10)
+    replies_seen: list[str] = []
+    reader = threading.Thread(target=lambda: replies_seen.extend(read_all(sock)))
+    reader.start()
+    sock.sendall(b"where\n" * 100_000)  # lands in kernel buffers; the server is still reading
+    time.sleep(0.05)
+    server.stop()
+    reader.join(timeout=10)
+    sock.close()
+    answered = replies_seen.count(HOME)
+    assert replies_seen  # without a reset (a reset raises in read_all), ...
+    assert replies_seen[:answered] == [HOME] * answered  # ... in order: answers, then ...
+    assert set(replies_seen[answered:]) == {replies.SHUTTING_DOWN}  # ... the rest
+    print(f"stop mid-flood: {answered} answered, {len(replies_seen) - answered} shutting down")
