@@ -24,7 +24,7 @@ import pytest
 from c2rviz import cli, config, replies
 from c2rviz.commands import _MAX_INDEX_DIGITS
 from c2rviz.errors import LineTooLong
-from c2rviz.server import _BATCH_BYTES, CommandServer
+from c2rviz.server import _BATCH_BYTES, _LINGER_S, CommandServer
 
 # A state away from home (so a stray home or joints shows) with long `where` replies.
 START_Q = (0.123456789, -0.234567891, 0.345678912, -0.456789123, 0.567891234, -0.678912345, 0.0)
@@ -455,6 +455,7 @@ def test_the_limits_table_matches_the_code():
         seen.add(field)
     assert seen == set(defaults)  # every limit is in the table
     assert f"| {_BATCH_BYTES} | `server._BATCH_BYTES` |" in text
+    assert f"| {_LINGER_S:g} s | `server._LINGER_S` |" in text
     assert f"| {_MAX_INDEX_DIGITS} | `commands._MAX_INDEX_DIGITS` |" in text
     grace = inspect.signature(CommandServer.stop).parameters["grace_s"].default
     assert f"| {grace:g} s | `CommandServer.stop(grace_s)` |" in text
