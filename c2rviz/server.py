@@ -125,7 +125,7 @@ class Connection(asyncio.Protocol):
     def _decode(self, complete: bytes) -> list[Line]:
         """Split complete lines; mark the undecodable and the over-long ones."""
         max_line = self.limits.max_line
-        if complete.isascii():  # the usual case: one decode and one split for the whole read
+        if complete.isascii():  # the usual case: one decode and one split for the batch
             lines = complete.decode("ascii").split("\n")
             if len(complete) <= max_line or max(map(len, lines)) <= max_line:
                 return lines  # type: ignore[return-value]
