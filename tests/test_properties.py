@@ -124,7 +124,9 @@ def live():
     """One server for the module, small limits so they are reached, and a bystander."""
     server = ServerThread(load_robot(), LIMITS).start()
     bystander = socket.create_connection((server.host, server.port), timeout=10)
-    yield server, bystander.makefile("rwb", buffering=0)
+    stream = bystander.makefile("rwb", buffering=0)
+    yield server, stream
+    stream.close()
     bystander.close()
     server.stop()
 
@@ -163,12 +165,10 @@ def predict(data: bytes, session: Session) -> tuple[list[str], bool]:
 
 
 def read_replies(sock: socket.socket, count: int, closes: bool) -> list[str]:
-    got = []
-    stream = sock.makefile("rb")
-    for _ in range(count):
-        got.append(stream.readline().decode().rstrip("\n"))
-    if closes:
-        assert stream.read() == b""
+    with sock.makefile("rb") as stream:
+        got = [stream.readline().decode().rstrip("\n") for _ in range(count)]
+        if closes:
+            assert stream.read() == b""
     return got
 
 
