@@ -17,5 +17,5 @@ python3 -m venv .venv
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q -e ".[test]"
 
-.venv/bin/python -m ruff check c2rviz clients tests benchmarks
+.venv/bin/python -m ruff check .
 .venv/bin/python -m pytest "$@"
