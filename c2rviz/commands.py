@@ -194,7 +194,13 @@ _NUMBER_LIST_RE = re.compile(rf"{_NUMBER}(?:,{_NUMBER})*")
 _INDEX_RE = re.compile(r"[0-9]+")
 _INDEX_LIST_RE = re.compile(r"[0-9]+(?:,[0-9]+)*")
 _AROUND_COMMA_RE = re.compile(r"[ \t]*,[ \t]*")
-_HTTP_RE = re.compile(r"[A-Z]+ \S+ HTTP/[0-9.]+|[A-Za-z][A-Za-z0-9-]*:( .*)?")
+# An HTTP request line, or one of the headers every HTTP client sends. Only
+# these: a typo such as "where:" stays an unknown command, not a disconnect.
+_HTTP_RE = re.compile(
+    r"[A-Z]+ \S+ HTTP/[0-9.]+"
+    r"|(?i:host|user-agent|accept|accept-encoding|accept-language|connection|content-length"
+    r"|content-type|cookie|upgrade|origin|referer|sec-websocket-key):.*"
+)
 _MAX_INDEX_DIGITS = 9
 
 
@@ -328,7 +334,7 @@ def _clean(line: str) -> str:
     for column, char in enumerate(line, start=1):
         if not (char.isascii() and char.isprintable()):
             raise LineError(
-                f"character {char!r} at column {column} is not allowed: "
+                f"character {ascii(char)} at column {column} is not allowed: "
                 "commands are plain ASCII text"
             )
     return line  # pragma: no cover - the loop always finds the character

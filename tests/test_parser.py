@@ -139,6 +139,8 @@ BAD = [
     ("POST /api HTTP/1.0\r\n", ForeignProtocol, "not HTTP", "http-post"),
     ("Host: 127.0.0.1:31000", ForeignProtocol, "not HTTP", "http-host-header"),
     ("User-Agent: curl/8.0", ForeignProtocol, "not HTTP", "http-user-agent"),
+    ("where:", UnknownCommand, "unknown command 'where:'", "typo-with-colon-is-not-http"),
+    ("home: now", UnknownCommand, "unknown command 'home:'", "verb-colon-is-not-http"),
 ]
 
 
