@@ -12,7 +12,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Protocol
 
-__all__ = ["Marker", "NullScene", "RecordingScene", "Scene"]
+__all__ = ["MAX_MARKERS", "Marker", "NullScene", "RecordingScene", "Scene"]
+
+MAX_MARKERS = 1000
+"""Markers kept at once; beyond it the oldest goes first, so a flood of ``mark``
+costs neither the server's memory nor the page's frame rate."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -34,7 +34,7 @@ import viser
 from viser import _messages as viser_messages
 
 from .robot import Robot
-from .scene import Marker
+from .scene import MAX_MARKERS, Marker
 from .visuals import Shape, load_link_geometry
 from .world import World
 
@@ -43,7 +43,6 @@ __all__ = ["ViserScene"]
 log = logging.getLogger("c2rviz.viewer")
 
 RECENT_COMMANDS = 8  # lines kept for the 'last commands' readout
-MAX_MARKERS = 1000  # oldest markers go first beyond this, to keep the page alive
 MARKER_SIZE_M = 0.03
 SHOWN_LINE_CHARS = 80
 

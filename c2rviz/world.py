@@ -13,7 +13,7 @@ import numpy as np
 import pinocchio as pin
 
 from .robot import Robot
-from .scene import Marker, NullScene, Scene
+from .scene import MAX_MARKERS, Marker, NullScene, Scene
 
 __all__ = ["World"]
 
@@ -61,6 +61,8 @@ class World:
             (float(px), float(py), float(pz)), (float(w), float(x), float(y), float(z)), rgb, shape
         )
         self.markers.append(marker)
+        if len(self.markers) > MAX_MARKERS:
+            del self.markers[0]
         self.scene.add_marker(marker)
         return marker
 

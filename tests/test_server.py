@@ -11,6 +11,7 @@ import pinocchio as pin
 import pytest
 
 from c2rviz import replies
+from c2rviz.scene import MAX_MARKERS
 
 MOTOMAN_LIMITS_DEG = [180.0, 109.4, 169.6, 129.5, 180.0, 109.4, 180.0]
 
@@ -173,6 +174,15 @@ def test_markers_reach_the_scene(server, connect):
     assert client.ask("clear") == "ok"
     assert server.call(lambda: list(server.scene.markers)) == []
     assert server.q == (0.0,) * 7
+
+
+def test_markers_are_bounded_oldest_first(server, connect):
+    client = connect(server)
+    client.send("".join(f"mark {k / 1000},0,0,0,0,0\n" for k in range(MAX_MARKERS + 5)))
+    assert all(client.read_line() == "ok" for _ in range(MAX_MARKERS + 5))
+    markers = server.call(lambda: list(server.world.markers))
+    assert len(markers) == MAX_MARKERS
+    assert markers[0].position[0] == pytest.approx(5 / 1000)
 
 
 def test_marker_style_is_per_connection(server, connect):
