@@ -1,0 +1,59 @@
+"""The benchmark script cannot rot: ``benchmarks/run.py --quick`` prints its whole table.
+
+No timing is checked here (the figures depend on the machine); only that every
+row is measured for c2rviz and for the ceiling, and that the script exits cleanly.
+"""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+
+ROWS = [
+    "1 pipelined, 1 client",
+    "1 pipelined: server CPU",
+    "2 request/reply p50",
+    "2 request/reply p99",
+    "3 50 clients",
+    "3 50 clients p99",
+    "4 command->frame p50",
+    "4 command->frame p99",
+    "5 flood: viewer frames",
+    "5 flood: TCP meanwhile",
+    "6 launch->port open",
+    "6 launch->scene ready",
+    "6 RSS after start",
+    "6 RSS after 100k cmds",
+]
+NUMBER = r"[0-9][0-9,]*(\.[0-9]+)?"
+
+
+@pytest.mark.timeout(600)
+def test_quick_run_prints_every_row() -> None:
+    done = subprocess.run(
+        [sys.executable, str(ROOT / "benchmarks" / "run.py"), "--quick"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=540,
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert done.stdout.startswith("machine: "), done.stdout
+    cells = {}
+    for line in done.stdout.splitlines():
+        if line.startswith("| "):
+            row = [cell.strip() for cell in line.strip("|").split("|")]
+            cells[row[0]] = row
+    for label in ROWS:
+        assert label in cells, f"row {label!r} missing from:\n{done.stdout}"
+        _, unit, ours, ceiling, ratio, _target, _met = cells[label]
+        assert unit, label
+        assert re.fullmatch(NUMBER, ours), f"{label}: c2rviz figure {ours!r}"
+        assert re.fullmatch(NUMBER, ceiling), f"{label}: ceiling figure {ceiling!r}"
+        assert re.fullmatch(NUMBER, ratio), f"{label}: ratio {ratio!r}"
