@@ -9,6 +9,7 @@ reader only: never Pinocchio or viser, so the clients start in a blink.
 
 from __future__ import annotations
 
+import argparse
 import select
 import socket
 import time
@@ -26,6 +27,7 @@ __all__ = [
     "Client",
     "ConnectionLost",
     "ServerUnavailable",
+    "add_connection_args",
     "default_address",
     "find_script",
 ]
@@ -58,6 +60,21 @@ class ConnectionLost(C2rvizError):
         self.host = host
         self.port = port
         super().__init__(f"connection to {host}:{port} lost (the server stopped or restarted)")
+
+
+def add_connection_args(parser: argparse.ArgumentParser) -> None:
+    """The flags every client shares: where the server is and how long to retry."""
+    add = parser.add_argument
+    add("--host", help="command server (default from cmdinterpreter.ini: 127.0.0.1)")
+    add("--port", type=int, help="command port (default from cmdinterpreter.ini: 31000)")
+    add("--config", metavar="PATH", help="ini file for host and port")
+    add(
+        "--timeout",
+        type=float,
+        default=10.0,
+        metavar="S",
+        help="keep retrying the connection for S seconds, then give up (default 10)",
+    )
 
 
 def default_address(config: str | Path | None = None) -> tuple[str, int]:

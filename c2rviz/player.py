@@ -28,7 +28,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TextIO
 
-from .client import Client, ConnectionLost, ServerUnavailable, default_address, find_script
+from .client import (
+    Client,
+    ConnectionLost,
+    ServerUnavailable,
+    add_connection_args,
+    default_address,
+    find_script,
+)
 from .commands import Bye, Command, Joints, Move, Quit, Sleep, parse_line
 from .errors import C2rvizError, JointCountError, JointIndexError
 
@@ -224,9 +231,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add = parser.add_argument
     add("file", metavar="FILE", help="command file, e.g. commands/motoman.txt")
-    add("--host", help="command server (default from cmdinterpreter.ini: 127.0.0.1)")
-    add("--port", type=int, help="command port (default from cmdinterpreter.ini: 31000)")
-    add("--config", metavar="PATH", help="ini file for host and port")
+    add_connection_args(parser)
     add(
         "--speed",
         type=_positive,
@@ -237,13 +242,6 @@ def build_parser() -> argparse.ArgumentParser:
     add("--loop", type=int, default=1, metavar="N", help="play N times; 0: until Ctrl-C")
     add("--keep-going", action="store_true", help="go on after an error reply")
     add("--check", action="store_true", help="only parse the file; do not connect")
-    add(
-        "--timeout",
-        type=float,
-        default=10.0,
-        metavar="S",
-        help="keep retrying the connection for S seconds (default 10)",
-    )
     add(
         "--window",
         type=int,

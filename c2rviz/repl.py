@@ -26,7 +26,14 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TextIO
 
-from .client import Client, ConnectionLost, ServerUnavailable, default_address, find_script
+from .client import (
+    Client,
+    ConnectionLost,
+    ServerUnavailable,
+    add_connection_args,
+    default_address,
+    find_script,
+)
 from .commands import USAGE, Joints, Sleep, parse_line
 from .errors import BadArguments, C2rvizError, JointCountError
 from .player import Progress, check_robot, load_script, play
@@ -306,16 +313,7 @@ def build_parser() -> argparse.ArgumentParser:
         "Local commands: " + ", ".join(LOCAL_USAGE) + " ('help' explains them).",
     )
     add = parser.add_argument
-    add("--host", help="command server (default from cmdinterpreter.ini: 127.0.0.1)")
-    add("--port", type=int, help="command port (default from cmdinterpreter.ini: 31000)")
-    add("--config", metavar="PATH", help="ini file for host and port")
-    add(
-        "--timeout",
-        type=float,
-        default=10.0,
-        metavar="S",
-        help="keep retrying the connection for S seconds, then give up (default 10)",
-    )
+    add_connection_args(parser)
     add(
         "--step",
         type=float,
