@@ -84,6 +84,7 @@ class Session:
     def __init__(self, world: World) -> None:
         self.world = world
         self.robot = world.robot
+        self._n = world.robot.n  # Robot.n is a property; this is read per command
         self._tables = (UnitTable.build(self.robot, False), UnitTable.build(self.robot, True))
         self.degrees = False
         self.table = self._tables[0]
@@ -164,7 +165,7 @@ class Session:
     def _joints(self, command: Command) -> str:
         assert isinstance(command, Joints)
         values = command.values
-        n = self.robot.n
+        n = self._n
         if len(values) != n:
             raise JointCountError(n, len(values))
         table = self.table
@@ -177,7 +178,7 @@ class Session:
 
     def _move(self, command: Command) -> str:
         assert isinstance(command, Move)
-        n = self.robot.n
+        n = self._n
         for index in command.indices:
             if index >= n:
                 raise JointIndexError(index, self.robot.name, n)
