@@ -1,6 +1,6 @@
 """Benchmark c2rviz against the raw-socket ceiling, in one run; print one table.
 
-Usage: ``python benchmarks/run.py [--quick] [--reps N] [--no-viewer]``.
+Usage: ``python benchmarks/run.py [--quick] [--reps N] [--no-viewer] [--no-pin]``.
 
 Each repetition launches, as separate processes, the real program
 (``python -m c2rviz --port 0 --viser-port P``) and the ceiling
@@ -15,25 +15,18 @@ from __future__ import annotations
 
 import argparse
 import asyncio
-import contextlib
 import os
-import platform
 import re
-import signal
 import socket
-import statistics
-import subprocess
 import sys
-import threading
 import time
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
-from pathlib import Path
+from collections.abc import Sequence
+from dataclasses import dataclass
 
-import clients
+import loadgen
+from processes import ROOT, Launched, launch_ceiling, launch_ours, pin_cpus
+from report import Figures, machine, table
 
-ROOT = Path(__file__).resolve().parent.parent
-HOST = "127.0.0.1"
 N_JOINTS = 7  # the default robot, motoman_sia20d
 
 
@@ -61,128 +54,6 @@ QUICK = Plan(
 )
 
 
-# Processes under test.
-
-
-@dataclass
-class Launched:
-    """A server process, its addresses and when they came up."""
-
-    popen: subprocess.Popen[str]
-    launched_at: float
-    port: int | None = None
-    url: str | None = None
-    port_open_s: float | None = None
-    viewer_s: float | None = None
-    output: list[str] = field(default_factory=list)
-    _ready: threading.Event = field(default_factory=threading.Event)
-
-    @property
-    def address(self) -> tuple[str, int]:
-        assert self.port is not None
-        return HOST, self.port
-
-    def cpu_s(self) -> float:
-        """CPU time [s] used so far by every thread of the process (schedstat, ns)."""
-        total = 0
-        for task in Path(f"/proc/{self.popen.pid}/task").iterdir():
-            with contextlib.suppress(FileNotFoundError, ProcessLookupError):  # a thread ended
-                total += int((task / "schedstat").read_text().split()[0])
-        return total / 1e9
-
-    def rss_mb(self) -> float:
-        """Resident memory [MB] (VmRSS)."""
-        status = Path(f"/proc/{self.popen.pid}/status").read_text()
-        kib = int(re.search(r"VmRSS:\s+(\d+)", status).group(1))  # type: ignore[union-attr]
-        return kib / 1024
-
-    def stop(self) -> None:
-        if self.popen.poll() is None:
-            self.popen.send_signal(signal.SIGTERM)
-            try:
-                self.popen.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                self.popen.kill()
-                self.popen.wait(timeout=10)
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind((HOST, 0))
-        return sock.getsockname()[1]
-
-
-# CPUs for the servers and for the clients (this process); None: wherever the OS likes.
-SERVER_CPUS: set[int] | None = None
-CLIENT_CPUS: set[int] | None = None
-
-
-def pin_cpus(enabled: bool) -> str:
-    """Give the servers one CPU and the clients another, if there are two and we may.
-
-    Unpinned, a request/reply round trip takes ~25 us when the scheduler happens to put
-    client and server on one CPU and ~90 us when it wakes the other: medians jump between
-    the two. Pinned, every run is the (realistic) two-CPU case.
-    """
-    global SERVER_CPUS, CLIENT_CPUS
-    cpus = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
-    if not enabled or len(cpus) < 2:
-        return "not pinned"
-    SERVER_CPUS, CLIENT_CPUS = {cpus[-1]}, set(cpus[:-1])
-    os.sched_setaffinity(0, CLIENT_CPUS)
-    return f"servers on CPU {cpus[-1]}, clients on CPU {','.join(map(str, cpus[:-1]))}"
-
-
-def launch(argv: list[str], viewer: bool, timeout_s: float = 60.0) -> Launched:
-    """Start ``argv``; return once it prints its command port (and viewer URL)."""
-    started = time.perf_counter()
-    popen = subprocess.Popen(
-        argv,
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        env={**os.environ, "PYTHONUNBUFFERED": "1"},
-    )
-    if SERVER_CPUS is not None:  # before it starts any thread: they inherit it
-        with contextlib.suppress(ProcessLookupError):
-            os.sched_setaffinity(popen.pid, SERVER_CPUS)
-    proc = Launched(popen, started)
-
-    def read() -> None:
-        assert popen.stdout is not None
-        for line in popen.stdout:
-            now = time.perf_counter()
-            proc.output.append(line)
-            if (m := re.search(r"commands on [\d.]+:(\d+)", line)) and proc.port is None:
-                proc.port = int(m.group(1))
-                proc.port_open_s = now - started
-            if (m := re.search(r"viewer at (\S+)", line)) and proc.url is None:
-                proc.url = m.group(1)
-                proc.viewer_s = now - started
-            if proc.port is not None and (proc.url is not None or not viewer):
-                proc._ready.set()
-        proc._ready.set()  # the process ended
-
-    threading.Thread(target=read, daemon=True).start()
-    if not proc._ready.wait(timeout_s) or proc.port is None:
-        proc.stop()
-        raise RuntimeError(f"{argv} did not start:\n{''.join(proc.output)}")
-    return proc
-
-
-def launch_ours(viewer: bool) -> Launched:
-    argv = [sys.executable, "-m", "c2rviz", "--port", "0"]
-    argv += ["--viser-port", str(free_port())] if viewer else ["--no-viewer"]
-    return launch(argv, viewer)
-
-
-def launch_ceiling(viewer: bool) -> Launched:
-    argv = [sys.executable, str(ROOT / "benchmarks" / "ceiling.py"), "--port", "0"]
-    argv += ["--viser-port", str(free_port())] if viewer else []
-    return launch(argv, viewer)
-
-
 # Measurements.
 
 
@@ -195,7 +66,7 @@ def ws_url(http_url: str) -> str:
     return re.sub(r"^http", "ws", http_url.rstrip("/"))
 
 
-def _has_mesh(frame: clients.Frame) -> bool:
+def _has_mesh(frame: loadgen.Frame) -> bool:
     return any("Mesh" in kind or "Glb" in kind or "Box" in kind for kind in frame.types)
 
 
@@ -206,7 +77,7 @@ async def _scene_ready(proc: Launched) -> float:
     box): a page that connects then draws the robot.
     """
     assert proc.url is not None
-    viewer = clients.ViewerClient(ws_url(proc.url))
+    viewer = loadgen.ViewerClient(ws_url(proc.url))
     got_mesh = asyncio.Event()
     viewer.on_frame = lambda frame: got_mesh.set() if _has_mesh(frame) else None
     task = asyncio.create_task(viewer.run())
@@ -224,10 +95,10 @@ async def _scene_ready(proc: Launched) -> float:
 async def _frame_latency(proc: Launched, samples: int) -> list[float]:
     """Seconds from sending ``move`` to the first websocket frame that moves a node."""
     assert proc.url is not None
-    viewer = clients.ViewerClient(ws_url(proc.url))
+    viewer = loadgen.ViewerClient(ws_url(proc.url))
     waiting: list[asyncio.Future[float]] = []
 
-    def on_frame(frame: clients.Frame) -> None:
+    def on_frame(frame: loadgen.Frame) -> None:
         if frame.poses and waiting and not waiting[0].done():
             waiting[0].set_result(frame.at)
 
@@ -236,7 +107,7 @@ async def _frame_latency(proc: Launched, samples: int) -> list[float]:
     reader, writer = await asyncio.open_connection(*proc.address)
     sock = writer.get_extra_info("socket")
     sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-    lines = clients.move_lines(samples + 1)
+    lines = loadgen.move_lines(samples + 1)
     out: list[float] = []
     try:
         await asyncio.wait_for(viewer.replay_done.wait(), 30)
@@ -265,13 +136,13 @@ async def _frame_latency(proc: Launched, samples: int) -> list[float]:
 async def _flood_frames(proc: Launched, seconds: float) -> tuple[float, float]:
     """Frames/s reaching the viewer and commands/s while one client floods ``joints``."""
     assert proc.url is not None
-    viewer = clients.ViewerClient(ws_url(proc.url))
+    viewer = loadgen.ViewerClient(ws_url(proc.url))
     task = asyncio.create_task(viewer.run())
     try:
         await asyncio.wait_for(viewer.replay_done.wait(), 30)
         await asyncio.sleep(0.2)
-        lines = clients.joints_lines(N_JOINTS, 1000)
-        result = await asyncio.to_thread(clients.flood, proc.address, lines, seconds)
+        lines = loadgen.joints_lines(N_JOINTS, 1000)
+        result = await asyncio.to_thread(loadgen.flood, proc.address, lines, seconds)
         await asyncio.sleep(0.1)  # frames of the last moments of the window
     finally:
         task.cancel()
@@ -280,20 +151,17 @@ async def _flood_frames(proc: Launched, seconds: float) -> tuple[float, float]:
     return frames / (result.end - result.start), result.rate
 
 
-Figures = dict[str, float]
-
-
 def measure_tcp(proc: Launched, plan: Plan, figures: Figures) -> None:
-    lines = clients.joints_lines(N_JOINTS, 1000)
+    lines = loadgen.joints_lines(N_JOINTS, 1000)
     figures["rss_start"] = proc.rss_mb()
     cpu = proc.cpu_s()
-    figures["pipelined"] = clients.pipelined(proc.address, lines, plan.pipelined // len(lines))
+    figures["pipelined"] = loadgen.pipelined(proc.address, lines, plan.pipelined // len(lines))
     figures["cpu_per_cmd"] = (proc.cpu_s() - cpu) / plan.pipelined * 1e6
     figures["rss_after"] = proc.rss_mb()
-    times = clients.request_reply(proc.address, lines, plan.round_trips)
+    times = loadgen.request_reply(proc.address, lines, plan.round_trips)
     figures["rr_p50"] = percentile(times, 50) * 1e6
     figures["rr_p99"] = percentile(times, 99) * 1e6
-    rate, times = clients.concurrent(proc.address, lines, plan.clients, plan.per_client)
+    rate, times = loadgen.concurrent(proc.address, lines, plan.clients, plan.per_client)
     figures["many_rate"] = rate
     figures["many_p99"] = percentile(times, 99) * 1e6
 
@@ -315,8 +183,8 @@ def run_ceiling(plan: Plan, viewer: bool) -> Figures:
         assert proc.port_open_s is not None
         figures["port_open"] = proc.port_open_s
         measure_tcp(proc, plan, figures)
-        lines = clients.joints_lines(N_JOINTS, 1000)
-        figures["flood_rate"] = clients.flood(proc.address, lines, plan.flood_s).rate
+        lines = loadgen.joints_lines(N_JOINTS, 1000)
+        figures["flood_rate"] = loadgen.flood(proc.address, lines, plan.flood_s).rate
     finally:
         proc.stop()
     if viewer:
@@ -342,101 +210,11 @@ def run_ours(plan: Plan, viewer: bool) -> Figures:
         if viewer:
             figures["flood_rate"] = measure_viewer(proc, plan, figures)
         else:
-            lines = clients.joints_lines(N_JOINTS, 1000)
-            figures["flood_rate"] = clients.flood(proc.address, lines, plan.flood_s).rate
+            lines = loadgen.joints_lines(N_JOINTS, 1000)
+            figures["flood_rate"] = loadgen.flood(proc.address, lines, plan.flood_s).rate
     finally:
         proc.stop()
     return figures
-
-
-# The table.
-
-
-@dataclass(frozen=True)
-class Row:
-    key: str
-    label: str
-    unit: str
-    fmt: str
-    target: str
-    check: Callable[[float, float | None], bool] | None = None
-    """(ours, ratio) -> met."""
-    viewer: bool = False
-
-
-ROWS = [
-    Row("pipelined", "1 pipelined, 1 client", "cmd/s", ",.0f", ">= 0.5x", lambda v, r: r >= 0.5),
-    Row("cpu_per_cmd", "1 pipelined: server CPU", "us/cmd", ".2f", ""),
-    Row("rr_p50", "2 request/reply p50", "us", ".0f", ""),
-    Row("rr_p99", "2 request/reply p99", "us", ".0f", "<= 1.5x", lambda v, r: r <= 1.5),
-    Row("many_rate", "3 50 clients", "cmd/s", ",.0f", ">= 0.6x", lambda v, r: r >= 0.6),
-    Row("many_p99", "3 50 clients p99", "us", ".0f", ""),
-    Row("frame_p50", "4 command->frame p50", "ms", ".2f", "<= 5 ms", lambda v, r: v <= 5, True),
-    Row("frame_p99", "4 command->frame p99", "ms", ".2f", "<= 20 ms", lambda v, r: v <= 20, True),
-    Row("flood_fps", "5 flood: viewer frames", "fps", ".0f", ">= 50", lambda v, r: v >= 50, True),
-    Row("flood_rate", "5 flood: TCP meanwhile", "cmd/s", ",.0f", ">= 0.4x", lambda v, r: r >= 0.4),
-    Row("port_open", "6 launch->port open", "s", ".3f", "<= 2 s", lambda v, r: v <= 2),
-    Row("scene_ready", "6 launch->scene ready", "s", ".3f", "<= 3 s", lambda v, r: v <= 3, True),
-    Row("rss_start", "6 RSS after start", "MB", ".0f", "<= 250 MB", lambda v, r: v <= 250),
-    Row("rss_after", "6 RSS after 100k cmds", "MB", ".0f", "<= 250 MB", lambda v, r: v <= 250),
-]
-
-
-def summary(values: list[float], fmt: str) -> str:
-    if not values:
-        return "n/a"
-    med = format(statistics.median(values), fmt)
-    if len(values) == 1:
-        return med
-    return f"{med} ({format(min(values), fmt)}..{format(max(values), fmt)})"
-
-
-def table(ours: list[Figures], ceiling: list[Figures], viewer: bool) -> str:
-    header = ("row", "unit", "c2rviz median (min..max)", "ceiling median (min..max)", "ours/ceil",
-              "target", "met")  # fmt: skip
-    rows = [header]
-    for row in ROWS:
-        mine = [f[row.key] for f in ours if row.key in f]
-        theirs = [f[row.key] for f in ceiling if row.key in f]
-        ratio = None
-        if mine and theirs and statistics.median(theirs):
-            ratio = statistics.median(mine) / statistics.median(theirs)
-        met = "-"
-        if row.check is not None and mine and (ratio is not None or "x" not in row.target):
-            met = "yes" if row.check(statistics.median(mine), ratio) else "NO"
-        if row.viewer and not viewer:
-            met = "no viewer"
-        rows.append((
-            row.label,
-            row.unit,
-            summary(mine, row.fmt),
-            summary(theirs, row.fmt),
-            f"{ratio:.2f}" if ratio is not None else "n/a",
-            row.target,
-            met,
-        ))  # fmt: skip
-    widths = [max(len(r[i]) for r in rows) for i in range(len(header))]
-    lines = []
-    for k, r in enumerate(rows):
-        lines.append("| " + " | ".join(c.ljust(w) for c, w in zip(r, widths)) + " |")
-        if k == 0:
-            lines.append("|" + "|".join("-" * (w + 2) for w in widths) + "|")
-    return "\n".join(lines)
-
-
-def machine() -> str:
-    cpu = "?"
-    for line in Path("/proc/cpuinfo").read_text().splitlines():
-        if line.startswith("model name"):
-            cpu = line.split(":", 1)[1].strip()
-            break
-    mem_kib = int(re.search(r"MemTotal:\s+(\d+)", Path("/proc/meminfo").read_text()).group(1))  # type: ignore[union-attr]
-    load = " ".join(f"{x:.2f}" for x in os.getloadavg())
-    return (
-        f"machine: {cpu}, {os.cpu_count()} cores, {mem_kib / 2**20:.0f} GiB; "
-        f"{platform.system()} {platform.release()}; Python {platform.python_version()}; "
-        f"load average {load}"
-    )
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -476,6 +254,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"{plan.round_trips:,} round trips; {plan.clients} clients x {plan.per_client:,}; "
         f"{plan.frame_samples} command->frame samples; flood {plan.flood_s:g} s"
         + ("" if viewer else "; viewer rows skipped (no c2rviz/viewer.py or --no-viewer)")
+    )
+    print(
+        "ours/ceil is the ratio of the medians: higher is better for rates, lower for times "
+        "and memory; rows 4, 5 (frames) and scene ready compare with the viser floor"
     )
     print(table(ours, ceiling, viewer))
     print(f"load average at the end: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
