@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import itertools
+import math
+import re
 import time
 
 import pytest
@@ -172,3 +175,17 @@ def test_hostile_lines_are_rejected_in_linear_time(line):
     with pytest.raises(C2rvizError):
         parse_line(line)
     assert time.perf_counter() - start < 0.5  # linear: about 1 ms
+
+
+def test_every_short_spelling_from_number_characters_parses_as_the_grammar_says():
+    """The parser lets float() judge lists spelled with [0-9.,eE+-] alone; it must agree
+    with the grammar (sign, digits, fraction, exponent; finite) on every such string up to 6."""
+    grammar = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
+    for length in range(1, 7):
+        for chars in itertools.product("01+-.eE", repeat=length):
+            text = "".join(chars)
+            if grammar.fullmatch(text) and math.isfinite(float(text)):
+                assert parse_line(f"joints {text}") == Joints((float(text),)), text
+            else:
+                with pytest.raises(BadArguments):
+                    parse_line(f"joints {text}")
