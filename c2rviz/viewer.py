@@ -24,6 +24,7 @@ import logging
 import math
 import re
 import socket
+import time
 from collections import deque
 from collections.abc import Iterator, Sequence
 from typing import Any
@@ -206,9 +207,22 @@ class ViserScene:
         pin.forwardKinematics(model, data, self.robot.configuration(q))
         pin.updateFramePlacements(model, data)
         for frame_id, handle in self._link_frames:
+            # What ``handle.position = ...`` / ``handle.wxyz = ...`` send, without their
+            # np.allclose change test (~15 us each, two per link per send).
             placement = data.oMf[frame_id]
-            handle.position = placement.translation
-            handle.wxyz = _wxyz(placement.rotation)
+            state = handle._impl
+            position = placement.translation
+            if (state.position != position).any():
+                state.position[:] = position
+                state.api._queue_scene_message(
+                    viser_messages.SetPositionMessage(state.name, tuple(position.tolist()))
+                )
+            wxyz = _wxyz(placement.rotation)
+            if (state.wxyz != wxyz).any():
+                state.wxyz[:] = wxyz
+                state.api._queue_scene_message(
+                    viser_messages.SetOrientationMessage(state.name, tuple(wxyz.tolist()))
+                )
         ee = self.robot.base_placement.actInv(data.oMf[self.robot.ee_frame])
         # round() then + 0.0: no "-0.0" in the readout
         x, y, z = (round(float(v), 3) + 0.0 for v in ee.translation)
@@ -220,13 +234,24 @@ class ViserScene:
         )
 
     def _sync_sliders(self, q: Sequence[float]) -> None:
-        """Move each slider to the commanded value, unless the page is moving it."""
+        """Move each slider to the commanded value, unless the page is moving it.
+
+        This is ``slider.value = shown`` without its call of our on_update callback:
+        the callback is async, so viser would hand it to its own thread
+        (run_coroutine_threadsafe: a wake-up and a task per slider per send) only for
+        it to ignore an update that came from us.
+        """
         for i, (slider, value) in enumerate(zip(self._sliders, q)):
             if self._page_serial[i] != self._applied_serial[i]:
                 continue
             shown = self._to_slider(i, value)
-            if abs(slider.value - shown) > 1e-9:
-                slider.value = shown  # fires on_update with client None: ignored
+            state = slider._impl
+            if abs(state.value - shown) > 1e-9:
+                state.gui_api._websock_interface.queue_message(
+                    viser_messages.GuiUpdateMessage(state.uuid, {"value": shown})
+                )
+                state.value = shown
+                state.update_timestamp = time.time()
 
     def _draw_markers(self) -> None:
         if self._clear_markers:
