@@ -37,6 +37,7 @@ __all__ = [
     "Mark",
     "MarkerShape",
     "Move",
+    "Limits",
     "Names",
     "Pose",
     "Quit",
@@ -132,6 +133,11 @@ class Pose:
 
 
 @dataclass(frozen=True, slots=True)
+class Limits:
+    """Ask for each chain joint's limits and unit."""
+
+
+@dataclass(frozen=True, slots=True)
 class Names:
     """Ask for the robot name and the chain's joint names."""
 
@@ -160,7 +166,7 @@ class Quit:
 
 Command = (
     Rand | Home | Units | Joints | Move | Clear | Mark | Color | MarkerShape
-    | Where | Pose | Names | Help | Sleep | Bye | Quit
+    | Where | Pose | Limits | Names | Help | Sleep | Bye | Quit
 )  # fmt: skip
 
 # Usage of every verb, in the order ``help`` lists them.
@@ -179,6 +185,7 @@ USAGE: dict[str, str] = {
     "marker": "marker " + "|".join(MARKER_SHAPES),
     "where": "where",
     "pose": "pose",
+    "limits": "limits",
     "names": "names",
     "help": "help",
     "sleep": "sleep seconds",
@@ -328,6 +335,7 @@ _PARSERS: dict[str, Callable[[str, list[str]], Command]] = {
     "marker": _marker,
     "where": _no_args(Where()),
     "pose": _no_args(Pose()),
+    "limits": _no_args(Limits()),
     "names": _no_args(Names()),
     "help": _no_args(Help()),
     "sleep": _sleep,

@@ -24,6 +24,7 @@ from .commands import (
     Help,
     Home,
     Joints,
+    Limits,
     Mark,
     MarkerShape,
     Move,
@@ -102,6 +103,7 @@ class Session:
             MarkerShape: self._marker_shape,
             Where: self._where,
             Pose: self._pose,
+            Limits: self._limits,
             Names: self._names,
             Help: self._help,
         }
@@ -221,6 +223,15 @@ class Session:
         angle = 180.0 / math.pi if self.degrees else 1.0
         rpy = pin.rpy.matrixToRpy(pose.rotation) * angle
         return replies.ok(replies.numbers([*pose.translation, *rpy]))
+
+    def _limits(self, command: Command) -> str:
+        table = self.table
+        return replies.ok(
+            ",".join(
+                f"{replies.numbers([lo])}..{replies.numbers([hi])} {unit}"
+                for lo, hi, unit in zip(table.lower, table.upper, table.unit)
+            )
+        )
 
     def _names(self, command: Command) -> str:
         return replies.ok(f"{self.robot.name} {','.join(self.robot.joint_names)}")

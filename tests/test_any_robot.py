@@ -237,6 +237,9 @@ def test_prismatic_joint_takes_metres_in_every_mode(client: Client, mode: str) -
     assert (x, y, z) == pytest.approx((0.3, 0, 0.4 - 0.35), abs=1e-9)
     reply = client.ask("move 0 30")
     assert reply.startswith("error: lift (index 0) = 30 m is outside its limits 0..0.5 m")
+    unit = "deg" if mode == "degrees" else "rad"
+    assert client.ask("limits").startswith("ok 0..0.5 m,")  # the lift says metres
+    assert client.ask("limits").endswith(f",-inf..inf {unit}")  # the wrist is continuous
 
 
 def test_continuous_joint_takes_any_angle(client: Client, tree_server: ServerThread) -> None:

@@ -147,6 +147,17 @@ def test_pose_is_pinocchio_fk(server, connect):
     assert deg[3:] == pytest.approx(np.degrees([roll, pitch, yaw]), abs=1e-7)
 
 
+def test_limits_in_the_clients_units(server, connect):
+    client = connect(server)
+    assert client.ask("limits") == (
+        "ok -3.1416..3.1416 rad,-1.91..1.91 rad,-2.96..2.96 rad,-2.26..2.26 rad,"
+        "-3.1416..3.1416 rad,-1.91..1.91 rad,-3.1416..3.1416 rad"
+    )
+    client.ask("degrees")
+    first = client.ask("limits")[3:].split(",")[1]
+    assert first == f"{-math.degrees(1.91):.10g}..{math.degrees(1.91):.10g} deg"
+
+
 def test_names_help_and_unknown(server, connect):
     client = connect(server)
     assert client.ask("names") == (
