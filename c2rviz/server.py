@@ -126,9 +126,9 @@ class Connection(asyncio.Protocol):
         """Split complete lines; mark the undecodable and the over-long ones."""
         max_line = self.limits.max_line
         if complete.isascii():  # the usual case: one decode and one split for the batch
-            lines = complete.decode("ascii").split("\n")
-            if len(complete) <= max_line or max(map(len, lines)) <= max_line:
-                return lines  # type: ignore[return-value]
+            split = complete.decode("ascii").split("\n")
+            if len(complete) <= max_line or max(map(len, split)) <= max_line:
+                return split  # type: ignore[return-value]
         elif len(complete) <= max_line:
             try:
                 return complete.decode().split("\n")  # type: ignore[return-value]

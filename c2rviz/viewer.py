@@ -343,7 +343,8 @@ class ViserScene:
         rgb, alpha = shape.rgba[:3], shape.rgba[3]
         common["opacity"] = None if alpha >= 1.0 else alpha
         if shape.kind == "box":
-            return scene.add_box(name, color=rgb, dimensions=shape.size, **common)
+            sx, sy, sz = shape.size
+            return scene.add_box(name, color=rgb, dimensions=(sx, sy, sz), **common)
         if shape.kind == "cylinder":
             radius, length = shape.size
             return scene.add_cylinder(name, radius=radius, height=length, color=rgb, **common)
@@ -389,15 +390,16 @@ class ViserScene:
         collision = gui.add_checkbox("Show collision geometry", False)
         collision.on_update(self._collision_callback)
         with gui.add_folder("State"):
-            self._ee_pose = gui.add_text(
+            # Typed Any: mypy reads viser's GuiTextHandle.value as read-only, though it is not.
+            self._ee_pose: Any = gui.add_text(
                 "End effector",
                 "",
                 multiline=True,
                 disabled=True,
                 hint=f"{self.robot.eelink} in {self.robot.base} frame",
             )
-            self._clients = gui.add_text("TCP clients", "0", disabled=True)
-            self._recent = gui.add_text("Last commands", "", multiline=True, disabled=True)
+            self._clients: Any = gui.add_text("TCP clients", "0", disabled=True)
+            self._recent: Any = gui.add_text("Last commands", "", multiline=True, disabled=True)
 
     # page input (viser's thread), handed to the asyncio loop
 

@@ -18,4 +18,6 @@ python3 -m venv .venv
 .venv/bin/python -m pip install -q -e ".[test]"
 
 .venv/bin/python -m ruff check .
+.venv/bin/python -m ruff format --check .
+.venv/bin/python -m mypy
 .venv/bin/python -m pytest "$@"
