@@ -309,6 +309,21 @@ class Client:
             self._names = tuple(names.split(","))
         return self._names
 
+    def limits(self) -> list[tuple[float, float, str]]:
+        """Each chain joint's (lower, upper, unit), in the connection's units."""
+        reply = self.ask("limits")
+        try:
+            if not reply.startswith("ok "):
+                raise ValueError(reply)
+            out = []
+            for item in reply[3:].split(","):
+                span, unit = item.split(" ")
+                lower, upper = span.split("..")
+                out.append((float(lower), float(upper), unit))
+            return out
+        except ValueError:
+            raise C2rvizError(f"unexpected reply to 'limits': {reply!r}") from None
+
     def where(self) -> list[float]:
         """The joint values in the connection's units."""
         reply = self.ask("where")

@@ -35,7 +35,7 @@ from .client import (
     find_script,
 )
 from .commands import USAGE, Joints, Sleep, parse_line
-from .errors import BadArguments, C2rvizError, JointCountError
+from .errors import BadArguments, C2rvizError, JointCountError, JointLimitError
 from .player import Progress, check_robot, load_script, play
 
 __all__ = ["LOCAL_USAGE", "Repl", "build_parser", "main"]
@@ -242,6 +242,13 @@ class Repl:
         n = len(client.joint_names())
         if len(target) != n:
             raise BadArguments("goto", str(JointCountError(n, len(target))), usage)
+        names = client.joint_names()
+        for i, (value, (lower, upper, unit)) in enumerate(zip(target, client.limits())):
+            slack = 1e-9 * max(1.0, abs(value))  # the server's own slack at a limit
+            if not lower - slack <= value <= upper + slack:  # refuse before the first step
+                raise BadArguments(
+                    "goto", str(JointLimitError(names[i], i, value, lower, upper, unit)), usage
+                )
         current = client.where()
         default_step = DEFAULT_STEP_DEG if client.degrees else math.radians(DEFAULT_STEP_DEG)
         step = options.get("step", self.step or default_step)

@@ -284,15 +284,17 @@ def test_repl_goto_in_radians_and_its_errors(server, monkeypatch, capsys):
         "goto 0,0,0,0,0,0,0 speed=3\n"
         "goto 0,0,0,9,0,0,0 step=1 rate=1000\n"  # joint_u's limit is 2.26 rad
         "help\n"
+        "goto 0.5,1.91,0,0,0,0,0 step=1 rate=1000\n"  # exactly at joint_l's limit
     )
     assert run_repl(monkeypatch, text, "--port", str(server.port)) == 0
     out = capsys.readouterr().out
     assert "ok (goto: 15 steps" in out
     assert "error: goto: joints needs 7 values, got 2" in out
     assert "error: goto: unknown option 'speed'" in out
-    assert "goto: stopped at step 3/9: error: joint_u (index 3)" in out
+    assert "error: goto: joint_u (index 3) = 9 rad is outside its limits -2.26..2.26 rad" in out
     assert "file NAME [speed=X]" in out and "marker sphere|cube|arrow|cylinder" in out
-    assert math.isclose(server.q[0], 0.5 - 0.5 * 2 / 9)  # stopped before the limit
+    assert "ok (goto: 2 steps" in out  # the refused goto moved nothing: 1.91 rad to go
+    assert server.q[:2] == pytest.approx((0.5, 1.91))
 
 
 def test_repl_file_stops_at_the_first_error(server, tmp_path, monkeypatch, capsys):
