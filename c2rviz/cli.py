@@ -141,9 +141,7 @@ async def serve(settings: Settings, robot: Robot) -> int:
         )
         return 2
     world = World(robot, scene)
-    bind = getattr(scene, "bind", None)
-    if bind is not None:
-        bind(world, loop)
+    scene.start(world, loop)
     server = CommandServer(world, settings.limits, on_quit=stop.set)
     try:
         host, port = await server.start(settings.host, settings.port)
@@ -152,7 +150,7 @@ async def serve(settings: Settings, robot: Robot) -> int:
             f"c2rviz: cannot listen on {settings.host}:{settings.port}: {exc.strerror}",
             file=sys.stderr,
         )
-        getattr(scene, "stop", lambda: None)()
+        scene.stop()
         return 2
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, stop.set)
@@ -163,9 +161,8 @@ async def serve(settings: Settings, robot: Robot) -> int:
         flush=True,
     )
     print(f"c2rviz: commands on {host}:{port} (try: nc {host} {port}, then 'help')", flush=True)
-    url = getattr(scene, "url", None)
-    if url:
-        print(f"c2rviz: viewer at {url}", flush=True)
+    if scene.url:
+        print(f"c2rviz: viewer at {scene.url}", flush=True)
     for what, address in (("command server", settings.host), ("viewer", settings.viewer_host)):
         if not _is_loopback(address) and (what == "command server" or settings.viewer):
             print(
@@ -180,7 +177,7 @@ async def serve(settings: Settings, robot: Robot) -> int:
         for sig in (signal.SIGINT, signal.SIGTERM):
             loop.remove_signal_handler(sig)
         await server.stop()
-        getattr(scene, "stop", lambda: None)()
+        scene.stop()
     print("c2rviz: stopped", flush=True)
     return 0
 

@@ -5,6 +5,9 @@ of every command (how many numbers, which words) but not the robot, so joint
 counts, index ranges and limits are checked later by the session. Numbers are
 returned exactly as written, in the client's units; the session converts.
 
+Every verb is one entry of ``registry.VERBS``, declared here on its command
+class with ``@verb``; its handler lives on the session side (``handlers``).
+
 Grammar (see the README for the full table):
 
 - verbs are case-insensitive; ``#`` starts a comment; blank lines are ``None``;
@@ -18,14 +21,15 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable
 from dataclasses import dataclass
 
 from .errors import BadArguments, LineError, UnknownCommand, shown
+from .registry import LOOKUP, VERBS, usage, verb
 
 __all__ = [
     "MARKER_SHAPES",
     "USAGE",
+    "VERBS",
     "Bye",
     "Clear",
     "Color",
@@ -61,137 +65,7 @@ class ForeignProtocol(LineError):
         )
 
 
-@dataclass(frozen=True, slots=True)
-class Rand:
-    """Move every chain joint to a random value within its limits."""
-
-
-@dataclass(frozen=True, slots=True)
-class Home:
-    """Move every chain joint to zero."""
-
-
-@dataclass(frozen=True, slots=True)
-class Units:
-    """Switch this connection's angle unit (``degrees=True``) or back to radians."""
-
-    degrees: bool
-
-
-@dataclass(frozen=True, slots=True)
-class Joints:
-    """Set all chain joints, in the client's units."""
-
-    values: tuple[float, ...]
-
-
-@dataclass(frozen=True, slots=True)
-class Move:
-    """Set the joints at ``indices`` to ``values`` (client's units)."""
-
-    indices: tuple[int, ...]
-    values: tuple[float, ...]
-
-
-@dataclass(frozen=True, slots=True)
-class Clear:
-    """Home the robot and remove every marker."""
-
-
-@dataclass(frozen=True, slots=True)
-class Mark:
-    """Drop a marker at ``pose`` (x, y, z [m], roll, pitch, yaw [client's units]).
-
-    ``pose`` is None for a marker at the current end-effector pose.
-    """
-
-    pose: tuple[float, float, float, float, float, float] | None
-
-
-@dataclass(frozen=True, slots=True)
-class Color:
-    """Colour of this connection's next markers, each channel 0..1."""
-
-    rgb: tuple[float, float, float]
-
-
-@dataclass(frozen=True, slots=True)
-class MarkerShape:
-    """Shape of this connection's next markers, one of ``MARKER_SHAPES``."""
-
-    shape: str
-
-
-@dataclass(frozen=True, slots=True)
-class Where:
-    """Ask for the chain's joint values."""
-
-
-@dataclass(frozen=True, slots=True)
-class Pose:
-    """Ask for the end-effector pose in the base frame."""
-
-
-@dataclass(frozen=True, slots=True)
-class Limits:
-    """Ask for each chain joint's limits and unit."""
-
-
-@dataclass(frozen=True, slots=True)
-class Names:
-    """Ask for the robot name and the chain's joint names."""
-
-
-@dataclass(frozen=True, slots=True)
-class Help:
-    """Ask for the list of commands."""
-
-
-@dataclass(frozen=True, slots=True)
-class Sleep:
-    """Pause this connection for ``seconds`` [s]."""
-
-    seconds: float
-
-
-@dataclass(frozen=True, slots=True)
-class Bye:
-    """Close this connection."""
-
-
-@dataclass(frozen=True, slots=True)
-class Quit:
-    """Stop the whole program."""
-
-
-Command = (
-    Rand | Home | Units | Joints | Move | Clear | Mark | Color | MarkerShape
-    | Where | Pose | Limits | Names | Help | Sleep | Bye | Quit
-)  # fmt: skip
-
-# Usage of every verb, in the order ``help`` lists them.
-USAGE: dict[str, str] = {
-    "rand": "rand",
-    "home": "home",
-    "degrees": "degrees",
-    "radians": "radians",
-    "joints": "joints v0,...,vn-1",
-    "j": "j v0,...,vn-1",
-    "move": "move i[,j,...] vi[,vj,...]",
-    "clear": "clear",
-    "mark": "mark [x,y,z,roll,pitch,yaw]",
-    "color": "color r,g,b (0..1)",
-    "rgb": "rgb r,g,b (0..255)",
-    "marker": "marker " + "|".join(MARKER_SHAPES),
-    "where": "where",
-    "pose": "pose",
-    "limits": "limits",
-    "names": "names",
-    "help": "help",
-    "sleep": "sleep seconds",
-    "bye": "bye",
-    "quit": "quit",
-}
+# The grammar's pieces, shared by every verb's parser.
 
 # Unambiguous (digits, then an optional fraction): a regex that could split a run of digits
 # two ways backtracks quadratically, and one 8 KiB line held the event loop for 3 s.
@@ -211,7 +85,7 @@ _HTTP_RE = re.compile(
 _MAX_INDEX_DIGITS = 9
 
 
-def _numbers(verb: str, text: str) -> tuple[float, ...]:
+def numbers(verb: str, text: str) -> tuple[float, ...]:
     """Parse a comma list of ASCII decimals; reject malformed and non-finite values."""
     values = None
     if _NUMBER_CHARS_RE.fullmatch(text) is not None:
@@ -227,122 +101,284 @@ def _numbers(verb: str, text: str) -> tuple[float, ...]:
         for item in text.split(","):
             if _NUMBER_RE.fullmatch(item) is None:
                 problem = "empty value in list" if not item else f"bad number {shown(item)}"
-                raise BadArguments(verb, problem, USAGE[verb])
+                raise BadArguments(verb, problem, usage(verb))
         values = tuple(map(float, text.split(",")))
     # A sum is finite only if every value is (none is nan): one C call in the usual case.
     if not math.isfinite(sum(values)) and not all(map(math.isfinite, values)):
         big = next(item for item in text.split(",") if not math.isfinite(float(item)))
-        raise BadArguments(verb, f"value {shown(big)} is not a finite number", USAGE[verb])
+        raise BadArguments(verb, f"value {shown(big)} is not a finite number", usage(verb))
     return values
 
 
-def _indices(verb: str, text: str) -> tuple[int, ...]:
+def indices(verb: str, text: str) -> tuple[int, ...]:
     """Parse a comma list of joint indices (ASCII digits, no sign)."""
     if _INDEX_LIST_RE.fullmatch(text) is None:
         for item in text.split(","):
             if _INDEX_RE.fullmatch(item) is None:
                 problem = "empty index in list" if not item else f"bad joint index {shown(item)}"
-                raise BadArguments(verb, problem, USAGE[verb])
+                raise BadArguments(verb, problem, usage(verb))
     items = text.split(",")
     for item in items:
         if len(item) > _MAX_INDEX_DIGITS:
-            raise BadArguments(verb, f"joint index {shown(item, 12)} is too large", USAGE[verb])
+            raise BadArguments(verb, f"joint index {shown(item, 12)} is too large", usage(verb))
     return tuple(map(int, items))
 
 
-def _count(verb: str, values: tuple[float, ...], needed: int) -> tuple[float, ...]:
+def count(verb: str, values: tuple[float, ...], needed: int) -> tuple[float, ...]:
+    """``values`` if there are ``needed`` of them, else ``BadArguments``."""
     if len(values) != needed:
-        raise BadArguments(verb, f"needs {needed} values, got {len(values)}", USAGE[verb])
+        raise BadArguments(verb, f"needs {needed} values, got {len(values)}", usage(verb))
     return values
 
 
-def _no_args(command: Command) -> Callable[[str, list[str]], Command]:
-    def parse(verb: str, words: list[str]) -> Command:
-        if words:
-            raise BadArguments(verb, "takes no arguments", USAGE[verb])
-        return command
-
-    return parse
-
-
-def _one_word(verb: str, words: list[str]) -> str:
+def one_word(verb: str, words: list[str]) -> str:
+    """The single argument of ``verb``, else ``BadArguments``."""
     if len(words) != 1:
         problem = "needs an argument" if not words else f"takes 1 argument, got {len(words)}"
-        raise BadArguments(verb, problem, USAGE[verb])
+        raise BadArguments(verb, problem, usage(verb))
     return words[0]
 
 
-def _joints(verb: str, words: list[str]) -> Joints:
-    return Joints(_numbers(verb, _one_word(verb, words)))
+def numbers_arg(verb: str, words: list[str], needed: int) -> tuple[float, ...]:
+    """The single argument of ``verb`` as exactly ``needed`` numbers."""
+    return count(verb, numbers(verb, one_word(verb, words)), needed)
 
 
-def _move(verb: str, words: list[str]) -> Move:
-    if len(words) != 2:
-        raise BadArguments(verb, f"takes 2 arguments, got {len(words)}", USAGE[verb])
-    indices = _indices(verb, words[0])
-    values = _numbers(verb, words[1])
-    if len(indices) != len(values):
-        raise BadArguments(verb, f"{len(indices)} indices but {len(values)} values", USAGE[verb])
-    if len(set(indices)) != len(indices):
-        twice = next(i for i in indices if indices.count(i) > 1)
-        raise BadArguments(verb, f"joint {twice} is given twice", USAGE[verb])
-    return Move(indices, values)
+# The verbs, in the order `help` lists them.
 
 
-def _mark(verb: str, words: list[str]) -> Mark:
-    if not words:
-        return Mark(None)
-    x, y, z, roll, pitch, yaw = _count(verb, _numbers(verb, _one_word(verb, words)), 6)
-    return Mark((x, y, z, roll, pitch, yaw))
+@verb("rand", "", "every chain joint to a random value within its limits")
+@dataclass(frozen=True, slots=True)
+class Rand:
+    """Move every chain joint to a random value within its limits."""
 
 
-def _colour(verb: str, words: list[str], top: float) -> Color:
-    r, g, b = _count(verb, _numbers(verb, _one_word(verb, words)), 3)
-    for channel in (r, g, b):
-        if not 0.0 <= channel <= top:
-            raise BadArguments(verb, f"channel {channel:g} is outside 0..{top:g}", USAGE[verb])
-    return Color((r / top, g / top, b / top))
+@verb(
+    "home", "", "every chain joint to 0 (or its nearest limit, for a joint whose range excludes 0)"
+)
+@dataclass(frozen=True, slots=True)
+class Home:
+    """Move every chain joint to zero (or the nearest limit where zero is outside)."""
 
 
-def _marker(verb: str, words: list[str]) -> MarkerShape:
-    shape = _one_word(verb, words).lower()
-    if shape not in MARKER_SHAPES:
-        raise BadArguments(verb, f"unknown shape {shown(shape)}", USAGE[verb])
-    return MarkerShape(shape)
+@verb(
+    "radians",
+    "",
+    "angles of this connection, sent and received, in radians (the default)",
+    aliases=("radian",),
+    parse=lambda verb, words: Units.parse(verb, words, degrees=False),
+)
+@verb(
+    "degrees",
+    "",
+    "angles of this connection, sent and received, in degrees",
+    aliases=("degree",),
+    parse=lambda verb, words: Units.parse(verb, words, degrees=True),
+)
+@dataclass(frozen=True, slots=True)
+class Units:
+    """Switch this connection's angle unit (``degrees=True``) or back to radians."""
+
+    degrees: bool
+
+    @staticmethod
+    def parse(verb: str, words: list[str], degrees: bool) -> Units:
+        if words:
+            raise BadArguments(verb, "takes no arguments", usage(verb))
+        return _UNITS[degrees]
 
 
-def _sleep(verb: str, words: list[str]) -> Sleep:
-    (seconds,) = _count(verb, _numbers(verb, _one_word(verb, words)), 1)
-    if seconds < 0:
-        raise BadArguments(verb, f"seconds must be >= 0, got {seconds:g}", USAGE[verb])
-    return Sleep(seconds)
+_UNITS = (Units(degrees=False), Units(degrees=True))
 
 
-_PARSERS: dict[str, Callable[[str, list[str]], Command]] = {
-    "rand": _no_args(Rand()),
-    "home": _no_args(Home()),
-    "degrees": _no_args(Units(degrees=True)),
-    "degree": _no_args(Units(degrees=True)),
-    "radians": _no_args(Units(degrees=False)),
-    "radian": _no_args(Units(degrees=False)),
-    "joints": _joints,
-    "j": _joints,
-    "move": _move,
-    "clear": _no_args(Clear()),
-    "mark": _mark,
-    "color": lambda verb, words: _colour(verb, words, 1.0),
-    "rgb": lambda verb, words: _colour(verb, words, 255.0),
-    "marker": _marker,
-    "where": _no_args(Where()),
-    "pose": _no_args(Pose()),
-    "limits": _no_args(Limits()),
-    "names": _no_args(Names()),
-    "help": _no_args(Help()),
-    "sleep": _sleep,
-    "bye": _no_args(Bye()),
-    "quit": _no_args(Quit()),
-}
-_USAGE_KEY = {"degree": "degrees", "radian": "radians"}
+@verb("joints", "v0,...,vn-1", "set all n chain joints; exactly n values", aliases=("j",))
+@dataclass(frozen=True, slots=True)
+class Joints:
+    """Set all chain joints, in the client's units."""
+
+    values: tuple[float, ...]
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> Joints:
+        return Joints(numbers(verb, one_word(verb, words)))
+
+
+@verb(
+    "move",
+    "i[,j,...] vi[,vj,...]",
+    "set the listed joints; as many values as indices, each index once",
+)
+@dataclass(frozen=True, slots=True)
+class Move:
+    """Set the joints at ``indices`` to ``values`` (client's units)."""
+
+    indices: tuple[int, ...]
+    values: tuple[float, ...]
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> Move:
+        if len(words) != 2:
+            raise BadArguments(verb, f"takes 2 arguments, got {len(words)}", usage(verb))
+        chosen = indices(verb, words[0])
+        values = numbers(verb, words[1])
+        if len(chosen) != len(values):
+            raise BadArguments(verb, f"{len(chosen)} indices but {len(values)} values", usage(verb))
+        if len(set(chosen)) != len(chosen):
+            twice = next(i for i in chosen if chosen.count(i) > 1)
+            raise BadArguments(verb, f"joint {twice} is given twice", usage(verb))
+        return Move(chosen, values)
+
+
+@verb("clear", "", "home, and remove every marker")
+@dataclass(frozen=True, slots=True)
+class Clear:
+    """Home the robot and remove every marker."""
+
+
+@verb(
+    "mark",
+    "[x,y,z,roll,pitch,yaw]",
+    "drop a marker at that pose in the base frame (metres; angles in the connection's unit); "
+    "without a pose, at the end effector",
+)
+@dataclass(frozen=True, slots=True)
+class Mark:
+    """Drop a marker at ``pose`` (x, y, z [m], roll, pitch, yaw [client's units]).
+
+    ``pose`` is None for a marker at the current end-effector pose.
+    """
+
+    pose: tuple[float, float, float, float, float, float] | None
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> Mark:
+        if not words:
+            return Mark(None)
+        x, y, z, roll, pitch, yaw = numbers_arg(verb, words, 6)
+        return Mark((x, y, z, roll, pitch, yaw))
+
+
+@verb(
+    "rgb",
+    "r,g,b (0..255)",
+    "the same, each channel 0..255",
+    parse=lambda verb, words: Color.parse(verb, words, 255.0),
+)
+@verb(
+    "color",
+    "r,g,b (0..1)",
+    "colour of this connection's next markers, each channel 0..1",
+    parse=lambda verb, words: Color.parse(verb, words, 1.0),
+)
+@dataclass(frozen=True, slots=True)
+class Color:
+    """Colour of this connection's next markers, each channel 0..1."""
+
+    rgb: tuple[float, float, float]
+
+    @staticmethod
+    def parse(verb: str, words: list[str], top: float) -> Color:
+        r, g, b = numbers_arg(verb, words, 3)
+        for channel in (r, g, b):
+            if not 0.0 <= channel <= top:
+                raise BadArguments(verb, f"channel {channel:g} is outside 0..{top:g}", usage(verb))
+        return Color((r / top, g / top, b / top))
+
+
+@verb(
+    "marker",
+    "|".join(MARKER_SHAPES),
+    "shape of this connection's next markers (default a small red sphere)",
+)
+@dataclass(frozen=True, slots=True)
+class MarkerShape:
+    """Shape of this connection's next markers, one of ``MARKER_SHAPES``."""
+
+    shape: str
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> MarkerShape:
+        shape = one_word(verb, words).lower()
+        if shape not in MARKER_SHAPES:
+            raise BadArguments(verb, f"unknown shape {shown(shape)}", usage(verb))
+        return MarkerShape(shape)
+
+
+@verb("where", "", "reply the chain's joint values")
+@dataclass(frozen=True, slots=True)
+class Where:
+    """Ask for the chain's joint values."""
+
+
+@verb(
+    "pose",
+    "",
+    "reply the end-effector pose in the base frame: x,y,z (m), roll,pitch,yaw "
+    "(the connection's unit)",
+)
+@dataclass(frozen=True, slots=True)
+class Pose:
+    """Ask for the end-effector pose in the base frame."""
+
+
+@verb(
+    "limits",
+    "",
+    "reply each chain joint's limits and unit, in index order: `ok -109.4..109.4 deg,...`",
+)
+@dataclass(frozen=True, slots=True)
+class Limits:
+    """Ask for each chain joint's limits and unit."""
+
+
+@verb("names", "", "reply the robot name and the chain's joint names in index order")
+@dataclass(frozen=True, slots=True)
+class Names:
+    """Ask for the robot name and the chain's joint names."""
+
+
+@verb("help", "", "reply the list of commands")
+@dataclass(frozen=True, slots=True)
+class Help:
+    """Ask for the list of commands."""
+
+
+@verb(
+    "sleep",
+    "seconds",
+    "pause this connection for that long (others go on); the reply comes when it ends",
+)
+@dataclass(frozen=True, slots=True)
+class Sleep:
+    """Pause this connection for ``seconds`` [s]."""
+
+    seconds: float
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> Sleep:
+        (seconds,) = numbers_arg(verb, words, 1)
+        if seconds < 0:
+            raise BadArguments(verb, f"seconds must be >= 0, got {seconds:g}", usage(verb))
+        return Sleep(seconds)
+
+
+@verb("bye", "", "close this connection")
+@dataclass(frozen=True, slots=True)
+class Bye:
+    """Close this connection."""
+
+
+@verb("quit", "", "reply, then stop the whole program (command server and viewer), status 0")
+@dataclass(frozen=True, slots=True)
+class Quit:
+    """Stop the whole program."""
+
+
+Command = object
+"""Any command: an instance of a class registered with ``@verb``."""
+
+USAGE: dict[str, str] = {word: v.usage for word, v in LOOKUP.items()}
+"""Usage of every verb and alias (the REPL completes these)."""
 
 
 def _clean(line: str) -> str:
@@ -359,7 +395,7 @@ def _clean(line: str) -> str:
     return line  # pragma: no cover - the loop always finds the character
 
 
-def parse_line(line: str) -> Command | None:
+def parse_line(line: str) -> object | None:
     """Parse one line of the command language.
 
     Args:
@@ -380,13 +416,12 @@ def parse_line(line: str) -> Command | None:
     words = line.split()
     if not words:
         return None
-    verb = words[0].lower()
-    parser = _PARSERS.get(verb)
-    if parser is None:
+    entry = LOOKUP.get(words[0].lower())
+    if entry is None:
         if _HTTP_RE.fullmatch(line.strip()):
             raise ForeignProtocol()
         raise UnknownCommand(words[0])
     args = words[1:]
     if len(args) > 1 and "," in line:
         args = _AROUND_COMMA_RE.sub(",", " ".join(args)).split()
-    return parser(_USAGE_KEY.get(verb, verb), args)
+    return entry.parse(entry.name, args)

@@ -22,7 +22,7 @@ from .errors import ConfigError
 
 __all__ = [
     "INI_NAME",
-    "Limits",
+    "ServerLimits",
     "RobotEntry",
     "Settings",
     "find_ini",
@@ -35,7 +35,7 @@ PROJECT_DIR = Path(__file__).resolve().parent.parent
 
 
 @dataclass(frozen=True)
-class Limits:
+class ServerLimits:
     """What one client may cost the server (README: "Limits")."""
 
     max_line: int = 8192
@@ -80,12 +80,12 @@ class Settings:
     """``package://`` search folders (``DIR`` or ``NAME=DIR``), flags first."""
     xacro_args: tuple[str, ...] = ()
     """``name:=value`` for a ``.xacro`` robot, the robot section's then the flags'."""
-    limits: Limits = field(default_factory=Limits)
+    limits: ServerLimits = field(default_factory=ServerLimits)
     robots: Mapping[str, RobotEntry] = field(default_factory=dict)
     ini: Path | None = None
 
 
-# ini key -> (Settings or Limits field, type, lowest allowed, highest allowed)
+# ini key -> (Settings or ServerLimits field, type, lowest allowed, highest allowed)
 _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "port": ("port", int, 0, 65535),
     "hz": ("hz", float, 1, 1000),
@@ -98,7 +98,7 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
 }
 _TEXT_OPTIONS = ("host", "viewer_host", "robot")
 _ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args"]
-_LIMIT_FIELDS = {f for f in Limits.__dataclass_fields__}
+_LIMIT_FIELDS = {f for f in ServerLimits.__dataclass_fields__}
 
 
 def number(key: str, text: str, kind: type, low: float, high: float) -> Any:
@@ -194,7 +194,9 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
     for key in ("package_paths", "xacro_args"):
         values[key] = tuple(values.get(key, ()))
     limit_values = {k: values.pop(k) for k in list(values) if k in _LIMIT_FIELDS}
-    settings = replace(Settings(), **values, limits=Limits(**limit_values), robots=robots, ini=ini)
+    settings = replace(
+        Settings(), **values, limits=ServerLimits(**limit_values), robots=robots, ini=ini
+    )
     if settings.urdf is None:
         entry = find_robot(settings.robot, robots, ini)
         settings = replace(

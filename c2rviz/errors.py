@@ -20,6 +20,7 @@ __all__ = [
     "LineTooLong",
     "RobotError",
     "UnknownCommand",
+    "UnknownRobot",
     "shown",
 ]
 
@@ -118,3 +119,12 @@ class ConfigError(C2rvizError):
         if self.choices:
             message += " (choose from: " + ", ".join(self.choices) + ")"
         super().__init__(message)
+
+
+class UnknownRobot(C2rvizError):
+    """A robot name that is not in the world."""
+
+    def __init__(self, name: str, names: Sequence[str]) -> None:
+        self.name = name
+        self.names = tuple(names)
+        super().__init__(f"no robot {shown(name)} here; robots: {', '.join(self.names)}")

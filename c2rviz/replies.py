@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from .commands import USAGE
+from . import commands  # noqa: F401  (registers every verb)
+from .registry import help_text
 
 __all__ = [
     "BYE",
@@ -27,7 +28,7 @@ OK = "ok"
 BYE = "ok bye"
 SHUTTING_DOWN = "error: server is shutting down"
 NOT_UTF8 = "line is not valid UTF-8"
-HELP = "ok commands: " + "; ".join(USAGE.values())
+HELP = "ok commands: " + help_text()
 
 
 def ok(payload: str) -> str:

@@ -105,6 +105,10 @@ class Robot:
         self.upper = tuple(joint.upper for joint in self.joints)
         self.prismatic = tuple(joint.prismatic for joint in self.joints)
         self.neutral = self._neutral()
+        self.home = tuple(
+            0.0 if joint.nq == 2 else float(self.neutral[joint.idx_q]) for joint in self.joints
+        )
+        """Chain values of ``home``: 0, or the nearest limit where 0 is outside [rad or m]."""
         self._simple_q = all(joint.nq == 1 for joint in self.joints)
         self._idx_q = np.array([joint.idx_q for joint in self.joints], dtype=int)
         pin.framesForwardKinematics(model, self.data, self.neutral)
@@ -197,8 +201,8 @@ class Robot:
     def _neutral(self) -> np.ndarray:
         """Pinocchio's neutral configuration, kept within each joint's limits.
 
-        A 1-DoF joint whose limits exclude 0 sits at its nearest limit, as
-        ``home`` puts chain joints; off-chain joints stay there.
+        A 1-DoF joint whose limits exclude 0 sits at its nearest limit; this is
+        ``home`` for chain joints, and where off-chain joints stay.
         """
         model = self.model
         q = pin.neutral(model)

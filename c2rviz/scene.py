@@ -1,27 +1,35 @@
-"""What the command side hands to a view: the ``Scene`` protocol.
+"""What the world hands to views and other observers: its effects, in SI units.
 
-The world calls these methods on every accepted change, on the asyncio thread;
-they must return at once (a real view stores the latest state and renders it
-on its own schedule). ``RecordingScene`` is the stand-in for tests,
-``NullScene`` the one for running without a viewer (``--no-viewer``).
+The world calls an ``Observer``'s methods on every accepted change, on the
+asyncio thread; they must return at once (a real view stores the latest state
+and renders it on its own schedule). An observer overrides what it cares
+about; the rest are no-ops. A ``Scene`` is the observer that is a view: it also
+has a lifecycle (``start``, ``stop``) and may serve a page (``url``).
+``RecordingScene`` is the stand-in for tests, ``NullScene`` the one for running
+without a viewer (``--no-viewer``).
 """
 
 from __future__ import annotations
 
+import asyncio
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import TYPE_CHECKING
 
-__all__ = ["MAX_MARKERS", "Marker", "NullScene", "RecordingScene", "Scene"]
+if TYPE_CHECKING:
+    from .world import World
+
+__all__ = ["MAX_MARKERS", "Marker", "NullScene", "Observer", "RecordingScene", "Scene"]
 
 MAX_MARKERS = 1000
-"""Markers kept at once; beyond it the oldest goes first, so a flood of ``mark``
-costs neither the server's memory nor the page's frame rate."""
+"""Markers kept at once per robot; beyond it the oldest goes first, so a flood of
+``mark`` costs neither the server's memory nor the page's frame rate. Every holder
+of markers keeps them in a ``deque(maxlen=MAX_MARKERS)``."""
 
 
 @dataclass(frozen=True, slots=True)
 class Marker:
-    """A marker in the robot's root (world) frame.
+    """A marker in the world frame (the root of the robot's model).
 
     Attributes:
         position: x, y, z [m].
@@ -36,46 +44,44 @@ class Marker:
     shape: str
 
 
-class Scene(Protocol):
-    """The view's side of the contract. Every method is called on the asyncio thread."""
+class Observer:
+    """Receives the world's effects; every method is called on the asyncio thread."""
 
-    def show_joints(self, q: Sequence[float]) -> None:
-        """The chain is now at ``q`` [rad or m]; only the latest value matters."""
+    def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
+        """Robot ``robot``'s chain is now at ``q`` [rad or m], at clock time ``t`` [s]."""
 
-    def add_marker(self, marker: Marker) -> None:
-        """Show one more marker."""
+    def on_marker(self, robot: str, marker: Marker) -> None:
+        """One more marker (past ``MAX_MARKERS``, the oldest is gone)."""
 
-    def clear_markers(self) -> None:
-        """Remove every marker."""
+    def on_clear_markers(self, robot: str) -> None:
+        """Every marker of ``robot`` is gone."""
 
-    def set_client_count(self, count: int) -> None:
+    def on_clients(self, count: int) -> None:
         """``count`` TCP clients are connected."""
 
-    def note_command(self, line: str) -> None:
-        """A client sent ``line`` (for a 'last commands' readout)."""
+    def on_command(self, source: str, line: str, accepted: bool) -> None:
+        """``source`` sent ``line``; ``accepted`` False if it was refused."""
 
 
-class NullScene:
+class Scene(Observer):
+    """An observer that is a view: it starts with the world and stops with the program."""
+
+    url: str | None = None
+    """Where a person can look at it, if anywhere."""
+
+    def start(self, world: World, loop: asyncio.AbstractEventLoop) -> None:
+        """Begin showing ``world``; page input goes through ``loop`` (the asyncio thread's)."""
+
+    def stop(self) -> None:
+        """Stop and free what it holds (ports, threads); later calls do nothing."""
+
+
+class NullScene(Scene):
     """A scene that draws nothing (``--no-viewer``)."""
-
-    def show_joints(self, q: Sequence[float]) -> None:
-        pass
-
-    def add_marker(self, marker: Marker) -> None:
-        pass
-
-    def clear_markers(self) -> None:
-        pass
-
-    def set_client_count(self, count: int) -> None:
-        pass
-
-    def note_command(self, line: str) -> None:
-        pass
 
 
 @dataclass
-class RecordingScene:
+class RecordingScene(Scene):
     """A scene that remembers what it was told; no drawing."""
 
     joints: list[tuple[float, ...]] = field(default_factory=list)
@@ -83,19 +89,21 @@ class RecordingScene:
     clears: int = 0
     client_counts: list[int] = field(default_factory=list)
     commands: list[str] = field(default_factory=list)
+    refused: list[str] = field(default_factory=list)
 
-    def show_joints(self, q: Sequence[float]) -> None:
+    def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
         self.joints.append(tuple(q))
 
-    def add_marker(self, marker: Marker) -> None:
+    def on_marker(self, robot: str, marker: Marker) -> None:
         self.markers.append(marker)
+        del self.markers[:-MAX_MARKERS]
 
-    def clear_markers(self) -> None:
+    def on_clear_markers(self, robot: str) -> None:
         self.markers.clear()
         self.clears += 1
 
-    def set_client_count(self, count: int) -> None:
+    def on_clients(self, count: int) -> None:
         self.client_counts.append(count)
 
-    def note_command(self, line: str) -> None:
-        self.commands.append(line)
+    def on_command(self, source: str, line: str, accepted: bool) -> None:
+        (self.commands if accepted else self.refused).append(line)

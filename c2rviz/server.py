@@ -1,10 +1,10 @@
 """The TCP side: an asyncio line server in front of the shared world.
 
 Each connection is an ``asyncio.Protocol``: it splits what arrives into lines,
-runs every complete line through the parser and its ``Session``, and answers
+runs every complete line through its ``Session`` (the one way in), and answers
 all lines of one read (up to ``_BATCH_BYTES`` of them: a big read is run in
 batches, one loop turn each) with one write. Nothing here knows kinematics or
-drawing. The limits in ``config.Limits`` bound what one client can cost; a
+drawing. The limits in ``config.ServerLimits`` bound what one client can cost; a
 client that breaks one is told why and closed, and no other client notices.
 """
 
@@ -12,13 +12,13 @@ from __future__ import annotations
 
 import asyncio
 import logging
-from collections.abc import Callable
+from collections.abc import Awaitable, Callable
 from itertools import chain
 
 from . import replies
-from .commands import USAGE, Bye, ForeignProtocol, Quit, Sleep, parse_line
-from .config import Limits
-from .errors import BadArguments, C2rvizError, LineError, LineTooLong
+from .commands import ForeignProtocol, parse_line
+from .config import ServerLimits
+from .errors import C2rvizError, LineError, LineTooLong
 from .session import Session
 from .world import World
 
@@ -30,23 +30,33 @@ Line = str | C2rvizError  # a decoded line, or why it could not be one
 
 
 class Connection(asyncio.Protocol):
-    """One TCP client: its buffer, its session and its timers."""
+    """One TCP client: its buffer, its session and its timers.
+
+    Lines run in order. A reply that waits (an awaitable from the handler, such as
+    ``sleep``'s) stops reading: the lines read behind it wait in ``backlog`` and run
+    when it comes, while other connections go on.
+    """
 
     def __init__(self, server: CommandServer) -> None:
         self.server = server
         self.limits = server.limits
-        self.session = Session(server.world)
+        self.session = Session(server.world, limits=server.limits)
         self.transport: asyncio.Transport | None = None
         self.peer = "?"
         self.buffer = b""
-        self.backlog: list[Line] = []  # lines read but waiting behind a sleep
-        self.wake_timer: asyncio.Handle | None = None  # set while reading is paused
-        self.sleeping = False  # the pause is a `sleep`, which is answered when it ends
+        self.backlog: list[Line] = []  # lines read but waiting behind a reply
+        self.pending: asyncio.Future[str] | None = None  # the reply being waited for
+        self.yield_timer: asyncio.Handle | None = None  # set while yielding to other clients
         self.partial_timer: asyncio.TimerHandle | None = None
         self.linger_timer: asyncio.TimerHandle | None = None
         self.closing = False
         self.eof = False
         self.closed = asyncio.get_running_loop().create_future()
+
+    @property
+    def waiting(self) -> bool:
+        """Reading is paused: behind a reply, or yielding to the other clients."""
+        return self.pending is not None or self.yield_timer is not None
 
     # asyncio callbacks
 
@@ -55,6 +65,7 @@ class Connection(asyncio.Protocol):
         self.transport = transport
         peer = transport.get_extra_info("peername")
         self.peer = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
+        self.session.source = f"tcp {self.peer}"
         server = self.server
         server.open.add(self)
         if server.stopping:
@@ -70,6 +81,8 @@ class Connection(asyncio.Protocol):
     def connection_lost(self, exc: Exception | None) -> None:
         self._cancel_timers()
         self.closing = True
+        if self.pending is not None:
+            self.pending.cancel()
         server = self.server
         server.open.discard(self)
         if self in server.connections:
@@ -83,7 +96,7 @@ class Connection(asyncio.Protocol):
         if self.closing:
             return
         buffer = self.buffer + data if self.buffer else data
-        if self.wake_timer is not None:
+        if self.waiting:
             self.buffer = buffer  # reading is paused; the wake-up goes on from here
             return
         self._consume(buffer)
@@ -92,7 +105,7 @@ class Connection(asyncio.Protocol):
         self.eof = True
         if self.closing:
             return False  # done lingering: asyncio closes the transport
-        if self.wake_timer is None:
+        if not self.waiting:
             self._close()
         return True  # keep the write side open until the replies are out
 
@@ -111,10 +124,11 @@ class Connection(asyncio.Protocol):
             self._run(self._decode(buffer[:cut]))
         else:
             self.buffer = buffer
-        if self.closing or self.wake_timer is not None:
+        if self.closing or self.waiting:
             return  # while paused we do not read, so an unfinished line is not the client's fault
         if b"\n" in self.buffer:  # more complete lines: let the other clients in first
-            self._pause([], 0.0, sleeping=False)
+            self._pause_reading()
+            self.yield_timer = asyncio.get_running_loop().call_soon(self._yielded)
         elif len(self.buffer) > self.limits.max_line:
             self._close_with(replies.error(LineTooLong(self.limits.max_line)))
         elif self.buffer and self.partial_timer is None:
@@ -146,31 +160,27 @@ class Connection(asyncio.Protocol):
         return lines
 
     def _run(self, lines: list[Line]) -> None:
-        """Answer ``lines`` in order, stopping at a sleep, bye, quit or fatal line."""
+        """Answer ``lines`` in order, stopping at a reply that waits, bye, quit or a fatal line."""
         out: list[str] = []
         reply = out.append
-        execute = self.session.execute
-        note = self.server.world.note_command
+        run = self.session.run
+        session = self.session
         for i, line in enumerate(lines):
             try:
                 if line.__class__ is not str:
                     raise line  # type: ignore[misc]
-                command = parse_line(line)  # type: ignore[arg-type]
-                if command is None:
+                answer = run(line)  # type: ignore[arg-type]
+                if answer is None:
                     continue
-                note(line)  # type: ignore[arg-type]
-                if command.__class__ in _CONNECTION_COMMANDS:
-                    if isinstance(command, Sleep) and command.seconds > self.limits.max_sleep_s:
-                        raise BadArguments(
-                            "sleep",
-                            f"{command.seconds:g} s is over the limit of "
-                            f"{self.limits.max_sleep_s:g} s",
-                            USAGE["sleep"],
-                        )
+                if answer.__class__ is not str:  # a reply that waits
                     self._write(out)
-                    self._connection_command(command, lines[i + 1 :])
+                    self._wait(answer, lines[i + 1 :])  # type: ignore[arg-type]
                     return
-                reply(execute(command))
+                reply(answer)  # type: ignore[arg-type]
+                if session.hangup is not None:
+                    self._write(out)
+                    self._hang_up(lines[i + 1 :])
+                    return
             except (ForeignProtocol, LineTooLong) as exc:
                 out.append(replies.error(exc))
                 self._write(out)
@@ -183,49 +193,62 @@ class Connection(asyncio.Protocol):
                 reply(replies.error("internal error (see the server log)"))
         self._write(out)
 
-    def _connection_command(self, command: object, rest: list[Line]) -> None:
-        if isinstance(command, Sleep):
-            self._pause(rest, command.seconds, sleeping=True)
-        elif isinstance(command, Bye):
-            self._write([replies.BYE])
-            self._close()
-        elif isinstance(command, Quit):
-            self._write([replies.OK])
+    def _hang_up(self, rest: list[Line]) -> None:
+        """After ``bye`` or ``quit``: close (``quit`` also stops the program)."""
+        if self.session.hangup == "quit":
             self._write([replies.SHUTTING_DOWN] * self._unanswered(rest))
             self.server.request_quit()  # before the close: a client seeing EOF sees it done
-            self._close()
+        self._close()
 
-    def _pause(self, rest: list[Line], seconds: float, sleeping: bool) -> None:
-        """Stop reading; after ``seconds`` (0: the next loop turn) run ``rest`` and go on."""
+    def _wait(self, answer: Awaitable[str], rest: list[Line]) -> None:
+        """Stop reading until ``answer`` is ready; then reply and run ``rest``."""
         self.backlog = rest
-        self.sleeping = sleeping
-        assert self.transport is not None
-        self.transport.pause_reading()
-        loop = asyncio.get_running_loop()
-        if seconds > 0:
-            self.wake_timer = loop.call_later(seconds, self._wake)
-        else:
-            self.wake_timer = loop.call_soon(self._wake)
+        self._pause_reading()
+        pending = asyncio.ensure_future(answer)
+        self.pending = pending
+        pending.add_done_callback(self._answered)
 
-    def _wake(self) -> None:
-        self.wake_timer = None
+    def _answered(self, pending: asyncio.Future[str]) -> None:
+        if pending is not self.pending:
+            return
+        self.pending = None
         if self.closing:
             return
-        if self.sleeping:
-            self.sleeping = False
-            self._write([replies.OK])
+        if pending.cancelled():
+            text = replies.SHUTTING_DOWN
+        elif isinstance(pending.exception(), C2rvizError):
+            text = replies.error(pending.exception())
+        elif pending.exception() is not None:
+            log.error("internal error from %s", self.peer, exc_info=pending.exception())
+            text = replies.error("internal error (see the server log)")
+        else:
+            text = pending.result()
+        self._write([text])
+        self._go_on()
+
+    def _yielded(self) -> None:
+        self.yield_timer = None
+        if not self.closing:
+            self._go_on()
+
+    def _go_on(self) -> None:
+        """Run the lines that waited, then what is buffered; resume reading when done."""
         backlog, self.backlog = self.backlog, []
         self._run(backlog)
-        if self.closing or self.wake_timer is not None:
+        if self.closing or self.waiting:
             return
         buffer, self.buffer = self.buffer, b""
         self._consume(buffer)
-        if self.closing or self.wake_timer is not None:
+        if self.closing or self.waiting:
             return
         if self.eof:
             self._close()
         elif self.transport is not None:
             self.transport.resume_reading()
+
+    def _pause_reading(self) -> None:
+        assert self.transport is not None
+        self.transport.pause_reading()
 
     def _partial_timeout(self) -> None:
         self.partial_timer = None
@@ -270,17 +293,20 @@ class Connection(asyncio.Protocol):
         self.linger_timer = asyncio.get_running_loop().call_later(_LINGER_S, transport.abort)
 
     def _cancel_timers(self) -> None:
-        for timer in (self.wake_timer, self.partial_timer, self.linger_timer):
+        for timer in (self.yield_timer, self.partial_timer, self.linger_timer):
             if timer is not None:
                 timer.cancel()
-        self.wake_timer = self.partial_timer = self.linger_timer = None
+        self.yield_timer = self.partial_timer = self.linger_timer = None
 
     def shutdown(self) -> None:
         """The program is stopping: answer what was read, then close."""
         if self.closing:
             return
-        self._write([replies.SHUTTING_DOWN] * (self.sleeping + self._unanswered(self.backlog)))
+        waited = self.pending is not None
+        self._write([replies.SHUTTING_DOWN] * (waited + self._unanswered(self.backlog)))
         self.backlog = []
+        if self.pending is not None:
+            self.pending.cancel()
         self._close()
 
     def _unanswered(self, rest: list[Line]) -> int:
@@ -300,7 +326,6 @@ def _is_command(line: Line) -> bool:
         return True
 
 
-_CONNECTION_COMMANDS = frozenset({Sleep, Bye, Quit})
 _BATCH_BYTES = 8192  # complete lines run per client per loop turn: at most ~20 ms of work
 _LINGER_S = 2.0  # after the last reply, how long a closing client's input is read and dropped
 
@@ -311,7 +336,7 @@ class CommandServer:
     def __init__(
         self,
         world: World,
-        limits: Limits | None = None,
+        limits: ServerLimits | None = None,
         on_quit: Callable[[], None] | None = None,
     ) -> None:
         """Set up the server; ``start`` makes it listen.
@@ -322,7 +347,7 @@ class CommandServer:
             on_quit: Called once when a client sends ``quit``.
         """
         self.world = world
-        self.limits = limits if limits is not None else Limits()
+        self.limits = limits if limits is not None else ServerLimits()
         self.on_quit = on_quit
         self.connections: set[Connection] = set()  # the clients being served
         self.open: set[Connection] = set()  # those and the refused ones, until their socket closes

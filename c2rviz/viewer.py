@@ -34,8 +34,10 @@ import pinocchio as pin
 import viser
 from viser import _messages as viser_messages
 
+from .errors import C2rvizError
 from .robot import Robot
-from .scene import MAX_MARKERS, Marker
+from .scene import MAX_MARKERS, Marker, Scene
+from .session import Session
 from .visuals import Shape, load_link_geometry
 from .world import World
 
@@ -48,7 +50,7 @@ MARKER_SIZE_M = 0.03
 SHOWN_LINE_CHARS = 80
 
 
-class ViserScene:
+class ViserScene(Scene):
     """The viser implementation of ``scene.Scene``; see the module docstring.
 
     Attributes:
@@ -76,19 +78,18 @@ class ViserScene:
         self.robot = robot
         self.period_s = 1.0 / hz
         self._data = robot.model.createData()  # the world's robot.data is not ours
-        self._world: World | None = None
+        self._session: Session | None = None  # the page's way in, once started
         self._loop: asyncio.AbstractEventLoop | None = None
         self._timer: asyncio.Handle | None = None
         self._last_send_s = -math.inf
         self._stopped = False
-        home = tuple(min(max(0.0, j.lower), j.upper) for j in robot.joints)
-        self._q: tuple[float, ...] = home
+        self._q: tuple[float, ...] = robot.home
         self._q_dirty = True
-        self._new_markers: list[Marker] = []
+        self._new_markers: deque[Marker] = deque(maxlen=MAX_MARKERS)
         self._clear_markers = False
         self._marker_handles: deque[Any] = deque()
         self._marker_count = 0
-        self._commands: deque[str] = deque(maxlen=RECENT_COMMANDS)
+        self._commands: deque[str] = deque(maxlen=RECENT_COMMANDS)  # newest last
         self._client_count = 0
         self._panel_dirty = True
         # Per joint: serial of the latest slider value the page sent, and of
@@ -113,30 +114,29 @@ class ViserScene:
         self._build_panel()
         self._send()
 
-    # the Scene protocol (asyncio thread, returns at once)
+    # the Observer protocol (asyncio thread, returns at once)
 
-    def show_joints(self, q: Sequence[float]) -> None:
+    def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
         self._q = tuple(q)
         self._q_dirty = True
         self._schedule()
 
-    def add_marker(self, marker: Marker) -> None:
+    def on_marker(self, robot: str, marker: Marker) -> None:
         self._new_markers.append(marker)
-        del self._new_markers[:-MAX_MARKERS]
         self._schedule()
 
-    def clear_markers(self) -> None:
+    def on_clear_markers(self, robot: str) -> None:
         self._new_markers.clear()
         self._clear_markers = True
         self._schedule()
 
-    def set_client_count(self, count: int) -> None:
+    def on_clients(self, count: int) -> None:
         self._client_count = count
         self._panel_dirty = True
         self._schedule()
 
-    def note_command(self, line: str) -> None:
-        self._commands.append(line)
+    def on_command(self, source: str, line: str, accepted: bool) -> None:
+        self._commands.append(line if accepted else f"{line}  [refused]")
         self._panel_dirty = True
         self._schedule()
 
@@ -147,9 +147,10 @@ class ViserScene:
 
     # lifecycle
 
-    def bind(self, world: World, loop: asyncio.AbstractEventLoop) -> None:
-        """Let the panel act on ``world`` through ``loop`` (the asyncio thread's)."""
-        self._world = world
+    def start(self, world: World, loop: asyncio.AbstractEventLoop) -> None:
+        """Show ``world``; the page acts on it as the source ``page``, through ``loop``."""
+        self._session = Session(world, source="page")
+        self._session.set_degrees(True)
         self._loop = loop
         self._q = world.q
         self._q_dirty = True
@@ -246,7 +247,9 @@ class ViserScene:
                 continue
             shown = self._to_slider(i, value)
             state = slider._impl
-            if abs(state.value - shown) > 1e-9:
+            current = state.value
+            # A NaN or a non-number a page sent is replaced too.
+            if not (isinstance(current, (int, float)) and abs(current - shown) <= 1e-9):
                 state.gui_api._websock_interface.queue_message(
                     viser_messages.GuiUpdateMessage(state.uuid, {"value": shown})
                 )
@@ -383,10 +386,10 @@ class ViserScene:
                 )
                 slider.on_update(self._slider_callback(i))
                 self._sliders.append(slider)
-            home = gui.add_button("Home", hint="all joints to zero (world.home)")
+            home = gui.add_button("Home", hint="all joints to zero (home)")
             home.on_click(self._button_callback("home"))
             random = gui.add_button("Random", hint="every joint to a random value")
-            random.on_click(self._button_callback("randomize"))
+            random.on_click(self._button_callback("rand"))
         collision = gui.add_checkbox("Show collision geometry", False)
         collision.on_update(self._collision_callback)
         with gui.add_folder("State"):
@@ -407,33 +410,36 @@ class ViserScene:
         async def moved(event: viser.GuiEvent) -> None:
             if event.client is None or self._loop is None:
                 return  # our own update of the slider (or nothing to command yet)
-            value = float(event.target.value)
-            if not math.isfinite(value):
-                return
+            value = event.target.value
             self._page_serial[index] += 1
             serial = self._page_serial[index]
             self._loop.call_soon_threadsafe(self._slider_moved, index, value, serial)
 
         return moved
 
-    def _slider_moved(self, index: int, value: float, serial: int) -> None:
-        """A page moved slider ``index`` to ``value`` (slider units): command the world."""
+    def _slider_moved(self, index: int, value: object, serial: int) -> None:
+        """A page moved slider ``index`` to ``value`` (slider units): command the world
+        through the page's session, as ``move index value`` in degrees (metres for a
+        prismatic joint); a refused value sends the slider back to the true value."""
         self._applied_serial[index] = serial
-        world = self._world
-        if world is None or self._stopped:
-            return
-        joint = self.robot.joints[index]
-        si = value if joint.prismatic else math.radians(value)
-        if not joint.continuous:
-            si = min(max(si, joint.lower), joint.upper)
-        q = list(world.q)
-        q[index] = si
-        world.set_q(q)
+        text = repr(float(value)) if isinstance(value, (int, float)) else "?"  # NaN: 'nan'
+        self._page_line(f"move {index} {text}")
 
-    def _button_callback(self, action: str) -> Any:
+    def _page_line(self, line: str) -> None:
+        session = self._session
+        if session is None or self._stopped:
+            return
+        try:
+            session.run(line)
+        except C2rvizError as exc:
+            log.warning("refused from the page: %s: %s", line, exc)
+            self._q_dirty = True  # the sliders go back to the true values
+            self._schedule()
+
+    def _button_callback(self, line: str) -> Any:
         async def clicked(event: viser.GuiEvent) -> None:
-            if self._loop is not None and self._world is not None:
-                self._loop.call_soon_threadsafe(getattr(self._world, action))
+            if self._loop is not None:
+                self._loop.call_soon_threadsafe(self._page_line, line)
 
         return clicked
 

@@ -1,80 +1,166 @@
-"""The one shared state: where the chain is and which markers stand.
+"""The one shared state: the robots by name, their joints and markers, and a clock.
 
-Every TCP session and the viewer's sliders act on one ``World``; it hands each
-accepted change to the scene. Values are validated before they get here (by
-the session); the world only stores them, all in SI units.
+Every change arrives through a ``Session`` (TCP clients, the page, replays), is
+checked there, and is applied here; the world then hands the effect, in SI
+units, to every observer (the scene, and later recorders and watch streams)
+through one fan-out. Nothing else writes the state.
+
+Each robot has a commanded ``target`` and the ``q`` shown now; without motion
+they are equal at once. ``clock`` is the time base [s] of every effect.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import time
+from collections import deque
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 import pinocchio as pin
 
+from .errors import UnknownRobot
 from .robot import Robot
-from .scene import MAX_MARKERS, Marker, NullScene, Scene
+from .scene import MAX_MARKERS, Marker, Observer
 
-__all__ = ["World"]
+__all__ = ["RobotState", "World"]
+
+
+@dataclass(eq=False)
+class RobotState:
+    """One robot of the world.
+
+    Attributes:
+        name: The robot's name in this world (what ``robot NAME`` selects).
+        robot: Its model and chain.
+        q: The chain's values shown now [rad or m].
+        target: The values it was last commanded to [rad or m].
+        markers: Its markers, in the world frame, oldest first.
+    """
+
+    name: str
+    robot: Robot
+    q: tuple[float, ...] = ()
+    target: tuple[float, ...] = ()
+    markers: deque[Marker] = field(default_factory=lambda: deque(maxlen=MAX_MARKERS))
+
+    def __post_init__(self) -> None:
+        if not self.q:
+            self.q = self.target = self.robot.home
 
 
 class World:
     """Shared robot state. Used from the asyncio thread only."""
 
     def __init__(
-        self, robot: Robot, scene: Scene | None = None, rng: np.random.Generator | None = None
+        self,
+        robots: Robot | Mapping[str, Robot],
+        scene: Observer | None = None,
+        rng: np.random.Generator | None = None,
+        clock: Callable[[], float] = time.monotonic,
     ) -> None:
-        self.robot = robot
-        self.scene: Scene = scene if scene is not None else NullScene()
+        """Set up the world.
+
+        Args:
+            robots: One robot (named by its model), or robots by name; the first is
+                the default a new session drives.
+            scene: A first observer (usually the view).
+            rng: Random source for ``rand``.
+            clock: The time base [s].
+        """
+        named = {robots.name: robots} if isinstance(robots, Robot) else dict(robots)
+        self.robots = {name: RobotState(name, robot) for name, robot in named.items()}
+        self.default = next(iter(self.robots))
+        self.observers: list[Observer] = [scene] if scene is not None else []
         self.rng = rng if rng is not None else np.random.default_rng()
-        self.home_q = tuple(min(max(0.0, j.lower), j.upper) for j in robot.joints)
-        self.q: tuple[float, ...] = self.home_q
-        self.markers: list[Marker] = []
+        self.clock = clock
         self.client_count = 0
 
-    def set_q(self, q: Sequence[float]) -> None:
-        """Put the chain at ``q`` [rad or m], already checked against the limits."""
-        self.q = tuple(q)
-        self.scene.show_joints(self.q)
+    def state(self, name: str | None = None) -> RobotState:
+        """The robot called ``name`` (the default robot for None)."""
+        try:
+            return self.robots[self.default if name is None else name]
+        except KeyError:
+            raise UnknownRobot(str(name), list(self.robots)) from None
 
-    def home(self) -> None:
-        """All chain joints to zero (or the nearest limit where zero is outside)."""
-        self.set_q(self.home_q)
+    # The default robot, for a one-robot world.
 
-    def randomize(self) -> None:
+    @property
+    def robot(self) -> Robot:
+        return self.robots[self.default].robot
+
+    @property
+    def q(self) -> tuple[float, ...]:
+        return self.robots[self.default].q
+
+    @property
+    def markers(self) -> deque[Marker]:
+        return self.robots[self.default].markers
+
+    # Changes: each is checked before it gets here, then told to every observer.
+
+    def set_q(self, q: Sequence[float], robot: str | None = None) -> None:
+        """Put a chain at ``q`` [rad or m], already checked against the limits."""
+        state = self.robots[self.default if robot is None else robot]
+        state.q = state.target = tuple(q)
+        t = self.clock()
+        for observer in self.observers:
+            observer.on_joints(state.name, state.q, t)
+
+    def home(self, robot: str | None = None) -> None:
+        """Every chain joint to zero (or the nearest limit where zero is outside)."""
+        self.set_q(self.state(robot).robot.home, robot)
+
+    def randomize(self, robot: str | None = None) -> None:
         """Every chain joint to a random value within its limits."""
-        self.set_q(self.robot.random(self.rng))
+        self.set_q(self.state(robot).robot.random(self.rng), robot)
 
-    def ee_pose(self) -> pin.SE3:
-        """End-effector placement in the base frame."""
-        return self.robot.ee_pose(self.q)
+    def ee_pose(self, robot: str | None = None) -> pin.SE3:
+        """End-effector placement in the base frame, as the arm is now."""
+        state = self.state(robot)
+        return state.robot.ee_pose(state.q)
 
     def add_marker(
-        self, pose_in_base: pin.SE3 | None, rgb: tuple[float, float, float], shape: str
+        self,
+        pose_in_base: pin.SE3 | None,
+        rgb: tuple[float, float, float],
+        shape: str,
+        robot: str | None = None,
     ) -> Marker:
         """Drop a marker at ``pose_in_base``, or at the end effector when None."""
-        in_base = self.ee_pose() if pose_in_base is None else pose_in_base
-        placement = self.robot.base_placement * in_base
+        state = self.state(robot)
+        in_base = state.robot.ee_pose(state.q) if pose_in_base is None else pose_in_base
+        placement = state.robot.base_placement * in_base
         x, y, z, w = pin.Quaternion(placement.rotation).coeffs()
         px, py, pz = placement.translation
         marker = Marker(
             (float(px), float(py), float(pz)), (float(w), float(x), float(y), float(z)), rgb, shape
         )
-        self.markers.append(marker)
-        if len(self.markers) > MAX_MARKERS:
-            del self.markers[0]
-        self.scene.add_marker(marker)
+        state.markers.append(marker)
+        for observer in self.observers:
+            observer.on_marker(state.name, marker)
         return marker
 
-    def clear(self) -> None:
-        """Home the robot and remove every marker."""
-        self.markers.clear()
-        self.scene.clear_markers()
-        self.home()
+    def clear(self, robot: str | None = None) -> None:
+        """Remove every marker of the robot, and home it."""
+        state = self.state(robot)
+        state.markers.clear()
+        for observer in self.observers:
+            observer.on_clear_markers(state.name)
+        self.home(robot)
 
     def set_client_count(self, count: int) -> None:
         self.client_count = count
-        self.scene.set_client_count(count)
+        for observer in self.observers:
+            observer.on_clients(count)
 
-    def note_command(self, line: str) -> None:
-        self.scene.note_command(line)
+    def note(self, source: str, line: str, accepted: bool) -> None:
+        """``source`` sent ``line``; tell the observers (a 'last commands' readout)."""
+        for observer in self.observers:
+            observer.on_command(source, line, accepted)
+
+    def add_observers(self, observers: Iterable[Observer]) -> None:
+        self.observers.extend(observers)
+
+    def remove_observer(self, observer: Observer) -> None:
+        self.observers.remove(observer)

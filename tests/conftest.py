@@ -25,7 +25,7 @@ from typing import Any
 
 import pytest
 
-from c2rviz.config import Limits
+from c2rviz.config import ServerLimits
 from c2rviz.robot import Robot
 from c2rviz.scene import RecordingScene
 from c2rviz.server import CommandServer
@@ -51,7 +51,7 @@ class ServerThread:
     """A live server on its own loop and thread."""
 
     robot: Robot
-    limits: Limits
+    limits: ServerLimits
     scene: RecordingScene = field(default_factory=RecordingScene)
     quit: threading.Event = field(default_factory=threading.Event)
     host: str = "127.0.0.1"
@@ -101,7 +101,7 @@ def start_server() -> Iterator[Callable[..., ServerThread]]:
     started: list[ServerThread] = []
 
     def start(robot: str = "motoman_sia20d", **limits: Any) -> ServerThread:
-        server = ServerThread(load_robot(robot), Limits(**limits)).start()
+        server = ServerThread(load_robot(robot), ServerLimits(**limits)).start()
         started.append(server)
         return server
 

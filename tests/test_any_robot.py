@@ -20,7 +20,7 @@ from conftest import Client, ServerThread
 
 from c2rviz import cli
 from c2rviz.catalogue import EXAMPLE_ROBOTS, example_robot_data_dir, example_robots
-from c2rviz.config import Limits, find_ini, load_settings
+from c2rviz.config import ServerLimits, find_ini, load_settings
 from c2rviz.errors import ConfigError, RobotError
 from c2rviz.robot import Robot
 
@@ -213,7 +213,7 @@ def test_missing_mesh_folder_loads_with_a_warning(
 
 @pytest.fixture
 def tree_server(tree: Robot) -> Iterator[ServerThread]:
-    server = ServerThread(tree, Limits()).start()
+    server = ServerThread(tree, ServerLimits()).start()
     yield server
     server.stop()
 

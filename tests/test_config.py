@@ -6,7 +6,7 @@ import pytest
 from conftest import ROOT
 
 from c2rviz.cli import main
-from c2rviz.config import Limits, find_ini, load_settings
+from c2rviz.config import ServerLimits, find_ini, load_settings
 from c2rviz.errors import ConfigError
 
 INI = ROOT / "cmdinterpreter.ini"
@@ -19,7 +19,7 @@ def test_the_shipped_ini_names_the_seed_robots():
     assert set(settings.robots) == {"motoman_sia20d", "fanuc_lrmate200id", "kuka_lwr"}
     assert settings.urdf == ROOT / "robots/motoman_sia20d/robot.urdf"
     assert (settings.base, settings.eelink) == ("base_link", "link_t")
-    assert settings.limits == Limits()
+    assert settings.limits == ServerLimits()
 
 
 def test_flags_override_the_file():

@@ -445,7 +445,7 @@ def test_the_limits_table_matches_the_code():
     table = text.split("| Past the limit |")[1].split("\n\n")[0]
     rows = [[c.strip() for c in row.strip("|").split("|")] for row in table.splitlines()[2:]]
     flags = {a.option_strings[0]: a.dest for a in cli.build_parser()._actions if a.option_strings}
-    defaults = {f.name: f.default for f in dataclasses.fields(config.Limits)}
+    defaults = {f.name: f.default for f in dataclasses.fields(config.ServerLimits)}
     seen = set()
     for _limit, default, flag, key, allowed, _past in rows:
         field, kind, low, high = config._OPTIONS[key.strip("`")]

@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 
 from c2rviz import replies
 from c2rviz.commands import Bye, ForeignProtocol, Quit, Sleep, parse_line
-from c2rviz.config import Limits
+from c2rviz.config import ServerLimits
 from c2rviz.errors import C2rvizError, LineTooLong
 from c2rviz.session import Session
 from c2rviz.world import World
@@ -116,7 +116,7 @@ def test_the_parser_takes_any_decoded_bytes(data):
 # The live server against a reference model
 
 MAX_LINE = 256
-LIMITS = Limits(max_line=MAX_LINE, max_sleep_s=0.02)
+LIMITS = ServerLimits(max_line=MAX_LINE, max_sleep_s=0.02)
 
 
 @pytest.fixture(scope="module")
@@ -184,7 +184,8 @@ def test_the_server_does_what_the_model_predicts(live, lines, seed):
     # A shadow world in the server's state, with the same random stream for `rand`.
     shadow = World(world.robot)
     q, markers = server.call(lambda: (world.q, list(world.markers)))
-    shadow.q, shadow.markers = q, list(markers)
+    shadow.set_q(q)
+    shadow.markers.extend(markers)
     shadow.rng = np.random.default_rng(seed)
     server.call(lambda: setattr(world, "rng", np.random.default_rng(seed)))
     data = b"\n".join(line.replace(b"\n", b"") for line in lines) + b"\n"

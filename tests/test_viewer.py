@@ -42,7 +42,7 @@ class Harness:
         self.loop = asyncio.new_event_loop()
         self.scene = ViserScene(robot, "127.0.0.1", port, hz)
         self.world = World(robot, self.scene, np.random.default_rng(7))
-        self.scene.bind(self.world, self.loop)
+        self.scene.start(self.world, self.loop)
         self.run(0.0)
 
     def run(self, seconds: float) -> None:
@@ -175,7 +175,9 @@ def test_sliders_follow_the_world_without_commanding_it(
     h = harness()
     set_q_calls: list[tuple[float, ...]] = []
     original = h.world.set_q
-    monkeypatch.setattr(h.world, "set_q", lambda q: (set_q_calls.append(tuple(q)), original(q)))
+    monkeypatch.setattr(
+        h.world, "set_q", lambda q, robot=None: (set_q_calls.append(tuple(q)), original(q, robot))
+    )
     q = [0.5, -0.3, 1.0, 0.2, -1.5, 0.7, 2.0]
     h.call(lambda: h.world.set_q(q))
     h.run(0.1)  # viser runs the sliders' update callbacks on its own loop
@@ -185,26 +187,65 @@ def test_sliders_follow_the_world_without_commanding_it(
     assert set_q_calls == [tuple(q)]  # the programmatic slider updates did not re-command
 
 
-def test_a_slider_from_the_page_commands_the_world_within_limits(
+def test_a_slider_from_the_page_commands_the_world_through_the_session(
     harness: Callable[..., Harness],
 ) -> None:
     h = harness()
     h.call(lambda: h.scene._slider_moved(1, 30.0, 0))
     assert h.world.q[1] == pytest.approx(np.radians(30.0))
-    h.call(lambda: h.scene._slider_moved(1, 500.0, 0))  # beyond joint_l's 1.91 rad
-    assert h.world.q[1] == pytest.approx(h.robot.upper[1])
+    h.call(lambda: h.scene._slider_moved(1, 500.0, 0))  # beyond joint_l's 1.91 rad: refused
+    assert h.world.q[1] == pytest.approx(np.radians(30.0))
     assert h.world.q[0] == 0.0
+
+
+CAMERA = {
+    "type": "ViewerCameraMessage",
+    "wxyz": (1.0, 0.0, 0.0, 0.0),
+    "position": (3.0, 0.0, 1.0),
+    "fov": 1.0,
+    "near": 0.01,
+    "far": 100.0,
+    "image_height": 480,
+    "image_width": 640,
+    "look_at": (0.0, 0.0, 0.5),
+    "up_direction": (0.0, 0.0, 1.0),
+}
+
+
+@pytest.mark.parametrize("bad", [500.0, float("nan")], ids=["over", "nan"])
+def test_a_bad_slider_value_over_the_websocket_changes_nothing_and_snaps_back(
+    harness: Callable[..., Harness], bad: object
+) -> None:
+    """The page is a source like any other: its value goes through the session's checks;
+    a refused one leaves the world as it was and the slider shows the true value again."""
+    h = harness()
+    h.call(lambda: h.world.set_q([0.0, 0.5, 0, 0, 0, 0, 0]))
+    h.run(0.05)
+    before = h.world.q
+    slider = h.scene._sliders[1]
+    ws_url = h.scene.url.replace("http://", "ws://")
+    with connect(ws_url, subprotocols=[f"viser-v{viser.__version__}"]) as ws:  # type: ignore[list-item]
+        ws.send(msgspec.msgpack.encode(CAMERA))  # viser counts a tab in after its first camera
+        update = {"type": "GuiUpdateMessage", "uuid": slider._impl.uuid, "updates": {"value": bad}}
+        ws.send(msgspec.msgpack.encode(update))
+        deadline = time.monotonic() + 60  # a generous bound: we wait for the refusal itself
+        while not any("[refused]" in line for line in h.scene._commands):
+            assert time.monotonic() < deadline, "the page's value never reached the session"
+            h.run(0.02)
+    h.run(0.05)
+    assert h.world.q == before
+    assert slider.value == pytest.approx(np.degrees(0.5))
 
 
 def test_the_buttons_and_the_collision_checkbox(harness: Callable[..., Harness]) -> None:
     h = harness()
     click = SimpleNamespace(client=object(), target=SimpleNamespace(value=True))
-    asyncio.run(h.scene._button_callback("randomize")(click))  # as on viser's loop
+    asyncio.run(h.scene._button_callback("rand")(click))  # as on viser's loop
     h.run(0.01)
-    assert h.world.q != h.world.home_q
+    assert h.world.q != h.robot.home
     asyncio.run(h.scene._button_callback("home")(click))
     h.run(0.01)
-    assert h.world.q == h.world.home_q
+    assert h.world.q == h.robot.home
     collisions = [n for n in h.scene.server.scene._handle_from_node_name if "/collision_" in n]
     assert collisions and not any(
         h.scene.server.scene._handle_from_node_name[n].visible for n in collisions
@@ -240,7 +281,7 @@ def test_a_marker_flood_keeps_the_newest(harness: Callable[..., Harness]) -> Non
 
     def flood() -> None:
         for _ in range(cap + 500):
-            h.scene.add_marker(marker)
+            h.scene.on_marker(h.robot.name, marker)
 
     h.call(flood)
     h.run(0.05)
@@ -254,7 +295,7 @@ def test_the_panel_shows_clients_commands_and_the_pose(harness: Callable[..., Ha
     def talk() -> None:
         h.world.set_client_count(3)
         for line in lines:
-            h.world.note_command(line)
+            h.world.note("tcp", line, True)
 
     h.call(talk)
     h.run(0.05)

@@ -1,0 +1,176 @@
+"""What each verb of the seed's language does: one ``@handler`` per command class.
+
+A handler gets the ``Session`` (the source's robot, units and style) and the
+parsed command; it checks everything first, then changes the world, and
+returns the reply — a string now, or an awaitable for a reply that waits.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from operator import le, mul
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pinocchio as pin
+
+from . import replies
+from .commands import (
+    Bye,
+    Clear,
+    Color,
+    Help,
+    Home,
+    Joints,
+    Limits,
+    Mark,
+    MarkerShape,
+    Move,
+    Names,
+    Pose,
+    Quit,
+    Rand,
+    Sleep,
+    Units,
+    Where,
+)
+from .errors import BadArguments, JointCountError, JointIndexError
+from .registry import Reply, handler, usage
+
+if TYPE_CHECKING:
+    from .session import Session
+
+__all__: list[str] = []
+
+
+@handler(Rand)
+def rand(session: Session, command: Rand) -> str:
+    session.world.randomize(session.state.name)
+    return replies.OK
+
+
+@handler(Home)
+def home(session: Session, command: Home) -> str:
+    session.world.home(session.state.name)
+    return replies.OK
+
+
+@handler(Units)
+def units(session: Session, command: Units) -> str:
+    session.set_degrees(command.degrees)
+    return replies.OK
+
+
+@handler(Joints)
+def joints(session: Session, command: Joints) -> str:
+    values = command.values
+    n = session.n
+    if len(values) != n:
+        raise JointCountError(n, len(values))
+    table = session.table
+    # The hot path (a stream of `joints` lines): all within limits, checked in C.
+    q: Sequence[float]
+    if all(map(le, table.lower, values)) and all(map(le, values, table.upper)):
+        q = values if table.identity else tuple(map(mul, values, table.scale))
+    else:
+        q = session.to_si(range(n), values)
+    session.world.set_q(q, session.state.name)
+    return replies.OK
+
+
+@handler(Move)
+def move(session: Session, command: Move) -> str:
+    n = session.n
+    for index in command.indices:
+        if index >= n:
+            raise JointIndexError(index, session.robot.name, n)
+    q = list(session.state.target)
+    for index, value in zip(command.indices, session.to_si(command.indices, command.values)):
+        q[index] = value
+    session.world.set_q(q, session.state.name)
+    return replies.OK
+
+
+@handler(Clear)
+def clear(session: Session, command: Clear) -> str:
+    session.world.clear(session.state.name)
+    return replies.OK
+
+
+@handler(Mark)
+def mark(session: Session, command: Mark) -> str:
+    pose = None
+    if command.pose is not None:
+        x, y, z, roll, pitch, yaw = command.pose
+        angle = session.angle_scale
+        rotation = pin.rpy.rpyToMatrix(roll * angle, pitch * angle, yaw * angle)
+        pose = pin.SE3(rotation, np.array([x, y, z]))
+    session.world.add_marker(pose, session.rgb, session.shape, session.state.name)
+    return replies.OK
+
+
+@handler(Color)
+def color(session: Session, command: Color) -> str:
+    session.rgb = command.rgb
+    return replies.OK
+
+
+@handler(MarkerShape)
+def marker_shape(session: Session, command: MarkerShape) -> str:
+    session.shape = command.shape
+    return replies.OK
+
+
+@handler(Where)
+def where(session: Session, command: Where) -> str:
+    return replies.ok(replies.numbers(session.from_si(session.state.q)))
+
+
+@handler(Pose)
+def pose(session: Session, command: Pose) -> str:
+    placement = session.robot.ee_pose(session.state.q)
+    rpy = pin.rpy.matrixToRpy(placement.rotation) / session.angle_scale
+    return replies.ok(replies.numbers([*placement.translation, *rpy]))
+
+
+@handler(Limits)
+def limits(session: Session, command: Limits) -> str:
+    table = session.table
+    return replies.ok(
+        ",".join(
+            f"{replies.numbers([lo])}..{replies.numbers([hi])} {unit}"
+            for lo, hi, unit in zip(table.lower, table.upper, table.unit)
+        )
+    )
+
+
+@handler(Names)
+def names(session: Session, command: Names) -> str:
+    return replies.ok(f"{session.robot.name} {','.join(session.robot.joint_names)}")
+
+
+@handler(Help)
+def help_(session: Session, command: Help) -> str:
+    return replies.HELP
+
+
+@handler(Sleep)
+def sleep(session: Session, command: Sleep) -> Reply:
+    longest = session.limits.max_sleep_s
+    if command.seconds > longest:
+        raise BadArguments(
+            "sleep", f"{command.seconds:g} s is over the limit of {longest:g} s", usage("sleep")
+        )
+    return session.after(command.seconds, replies.OK)
+
+
+@handler(Bye)
+def bye(session: Session, command: Bye) -> str:
+    session.hangup = "bye"
+    return replies.BYE
+
+
+@handler(Quit)
+def quit_(session: Session, command: Quit) -> str:
+    session.hangup = "quit"
+    return replies.OK
