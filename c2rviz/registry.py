@@ -36,6 +36,7 @@ __all__ = [
     "Verb",
     "handler",
     "help_text",
+    "readme_table",
     "usage",
     "verb",
 ]
@@ -133,6 +134,16 @@ def help_text() -> str:
     return "; ".join(
         "|".join((v.name, *v.aliases)) + (f" {v.args}" if v.args else "") for v in VERBS.values()
     )
+
+
+def readme_table() -> str:
+    """The README's command table, one row per verb (a test keeps the README equal to it)."""
+    rows = ["| command | meaning |", "|---|---|"]
+    for v in VERBS.values():
+        spelled = " / ".join(f"`{word}`" for word in v.aliases)
+        usage = v.usage.replace("|", "\\|")
+        rows.append(f"| `{usage}`{' / ' + spelled if spelled else ''} | {v.summary} |")
+    return "\n".join(rows)
 
 
 def _no_args(cls: type) -> Callable[[str, list[str]], Any]:
