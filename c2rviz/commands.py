@@ -48,6 +48,7 @@ __all__ = [
     "Rand",
     "Sleep",
     "Units",
+    "Version",
     "Where",
     "parse_line",
 ]
@@ -335,6 +336,17 @@ class Limits:
 @dataclass(frozen=True, slots=True)
 class Names:
     """Ask for the robot name and the chain's joint names."""
+
+
+@verb(
+    "version",
+    "",
+    "reply the c2rviz version and the robot file's name and checksum: "
+    "`ok c2rviz 0.2.0 robot.urdf sha256:1f3a...`",
+)
+@dataclass(frozen=True, slots=True)
+class Version:
+    """Ask for the c2rviz version and which robot file the robot came from."""
 
 
 @verb("help", "", "reply the list of commands")

@@ -7,6 +7,7 @@ returns the reply — a string now, or an awaitable for a reply that waits.
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Sequence
 from operator import le, mul
 from typing import TYPE_CHECKING
@@ -14,7 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from . import replies
+from . import __version__, replies
 from .commands import (
     Bye,
     Clear,
@@ -32,6 +33,7 @@ from .commands import (
     Rand,
     Sleep,
     Units,
+    Version,
     Where,
 )
 from .errors import BadArguments, JointCountError, JointIndexError
@@ -147,6 +149,14 @@ def limits(session: Session, command: Limits) -> str:
 @handler(Names)
 def names(session: Session, command: Names) -> str:
     return replies.ok(f"{session.robot.name} {','.join(session.robot.joint_names)}")
+
+
+@handler(Version)
+def version(session: Session, command: Version) -> str:
+    source = session.robot.source
+    digest = hashlib.sha256(source.xml.encode()).hexdigest()[:12]
+    name = source.path.name if source.path is not None else "(urdf text)"
+    return replies.ok(f"c2rviz {__version__} {name} sha256:{digest}")
 
 
 @handler(Help)

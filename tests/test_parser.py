@@ -27,6 +27,7 @@ from c2rviz.commands import (
     Rand,
     Sleep,
     Units,
+    Version,
     Where,
     parse_line,
 )
@@ -68,6 +69,7 @@ GOOD = [
     ("names", Names(), "names"),
     ("LIMITS", Limits(), "limits"),
     ("help", Help(), "help"),
+    ("version", Version(), "version"),
     ("sleep 0", Sleep(0.0), "sleep-zero"),
     ("sleep 1e9", Sleep(1e9), "sleep-long-checked-by-server"),
     ("bye", Bye(), "bye"),

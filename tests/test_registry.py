@@ -37,7 +37,7 @@ def test_help_lists_every_verb_and_alias_once():
     assert [w.split("|")[0] for w in listed] == list(VERBS)
     words = [word for item in listed for word in item.split("|")]
     assert sorted(words) == sorted(LOOKUP)
-    assert replies.HELP == "ok commands: " + help_text()
+    assert "ok commands: " + help_text() == replies.HELP
 
 
 def test_the_readme_command_table_is_the_registry():

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import hashlib
 import math
 import socket
 import threading
@@ -10,6 +11,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
+import c2rviz
 from c2rviz import replies
 from c2rviz.scene import MAX_MARKERS
 
@@ -164,6 +166,8 @@ def test_names_help_and_unknown(server, connect):
         "ok motoman_sia20d joint_s,joint_l,joint_e,joint_u,joint_r,joint_b,joint_t"
     )
     assert client.ask("help") == replies.HELP
+    digest = hashlib.sha256(server.robot.source.xml.encode()).hexdigest()[:12]
+    assert client.ask("version") == f"ok c2rviz {c2rviz.__version__} robot.urdf sha256:{digest}"
     assert client.ask("fly") == "error: unknown command 'fly' (try 'help')"
     assert client.ask("where") == "ok 0,0,0,0,0,0,0"
 
