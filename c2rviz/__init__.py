@@ -30,7 +30,7 @@ __all__ = [
     "World",
     "parse_line",
 ]
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 _HOME = {
     "C2rvizError": "errors",
