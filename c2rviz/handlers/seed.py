@@ -15,8 +15,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from . import __version__, replies
-from .commands import (
+from .. import __version__, replies
+from ..commands import (
     Bye,
     Clear,
     Color,
@@ -36,11 +36,11 @@ from .commands import (
     Version,
     Where,
 )
-from .errors import BadArguments, JointCountError, JointIndexError
-from .registry import Reply, handler, usage
+from ..errors import BadArguments, JointCountError, JointIndexError
+from ..registry import Reply, handler, usage
 
 if TYPE_CHECKING:
-    from .session import Session
+    from ..session import Session
 
 __all__: list[str] = []
 
