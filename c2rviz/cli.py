@@ -78,6 +78,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add("--hz", type=float, help="most scene updates per second (default 100)")
     add(
+        "--motion",
+        choices=("off", "on", "follow"),
+        help="how new connections' moves are shown: off (at once, the default), on (travel, "
+        "reply on arrival) or follow (travel, reply at once)",
+    )
+    add("--speed", type=float, metavar="P", help="new connections' speed, %% of the limits (50)")
+    add(
         "--no-viewer",
         dest="viewer",
         action="store_const",
@@ -140,7 +147,7 @@ async def serve(settings: Settings, robot: Robot) -> int:
             file=sys.stderr,
         )
         return 2
-    world = World(robot, scene)
+    world = World(robot, scene, hz=settings.hz, defaults=settings.session)
     scene.start(world, loop)
     server = CommandServer(world, settings.limits, on_quit=stop.set)
     try:
@@ -177,6 +184,7 @@ async def serve(settings: Settings, robot: Robot) -> int:
         for sig in (signal.SIGINT, signal.SIGTERM):
             loop.remove_signal_handler(sig)
         await server.stop()
+        world.travels.stop_all()
         scene.stop()
     print("c2rviz: stopped", flush=True)
     return 0

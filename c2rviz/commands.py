@@ -324,12 +324,24 @@ class Pose:
 
 @verb(
     "limits",
-    "",
-    "reply each chain joint's limits and unit, in index order: `ok -109.4..109.4 deg,...`",
+    "[all]",
+    "reply each chain joint's limits and unit, in index order: `ok -109.4..109.4 deg,...`; "
+    "`limits all` adds each joint's velocity, acceleration and jerk limits: "
+    "`ok -109.4..109.4 deg v=130 a=260 j=1300,...` (per s, s^2, s^3)",
 )
 @dataclass(frozen=True, slots=True)
 class Limits:
-    """Ask for each chain joint's limits and unit."""
+    """Ask for each chain joint's limits and unit (``all``: and its motion limits)."""
+
+    all: bool = False
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> Limits:
+        if not words:
+            return Limits()
+        if one_word(verb, words).lower() != "all":
+            raise BadArguments(verb, f"unknown argument {shown(words[0])}", usage(verb))
+        return Limits(all=True)
 
 
 @verb("names", "", "reply the robot name and the chain's joint names in index order")
@@ -437,3 +449,7 @@ def parse_line(line: str) -> object | None:
     if len(args) > 1 and "," in line:
         args = _AROUND_COMMA_RE.sub(",", " ".join(args)).split()
     return entry.parse(entry.name, args)
+
+
+# The verbs beyond the seed's, one module per concern (they use the pieces above).
+from .lang import motion as _motion  # noqa: E402, F401

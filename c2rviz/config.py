@@ -23,6 +23,7 @@ from .errors import ConfigError
 __all__ = [
     "INI_NAME",
     "ServerLimits",
+    "SessionDefaults",
     "RobotEntry",
     "Settings",
     "find_ini",
@@ -48,6 +49,16 @@ class ServerLimits:
     """How long a started line may stay unfinished [s]."""
     max_sleep_s: float = 3600.0
     """Longest ``sleep`` [s]."""
+
+
+@dataclass(frozen=True)
+class SessionDefaults:
+    """How a new connection starts (each may change its own with a command)."""
+
+    motion: str = "off"
+    """``off`` (moves shown at once, the seed's way), ``on`` or ``follow``."""
+    speed: float = 50.0
+    """Moves at this % of each joint's velocity limit (1..100)."""
 
 
 @dataclass(frozen=True)
@@ -81,6 +92,7 @@ class Settings:
     xacro_args: tuple[str, ...] = ()
     """``name:=value`` for a ``.xacro`` robot, the robot section's then the flags'."""
     limits: ServerLimits = field(default_factory=ServerLimits)
+    session: SessionDefaults = field(default_factory=SessionDefaults)
     robots: Mapping[str, RobotEntry] = field(default_factory=dict)
     ini: Path | None = None
 
@@ -95,10 +107,13 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "max_unread": ("max_unread", int, 1024, 1 << 30),
     "partial_timeout": ("partial_timeout_s", float, 0.01, 86400),
     "max_sleep": ("max_sleep_s", float, 0, 1e6),
+    "speed": ("speed", float, 1, 100),
 }
-_TEXT_OPTIONS = ("host", "viewer_host", "robot")
+_TEXT_OPTIONS = ("host", "viewer_host", "robot", "motion")
+_CHOICES = {"motion": ("off", "on", "follow")}
 _ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args"]
 _LIMIT_FIELDS = {f for f in ServerLimits.__dataclass_fields__}
+_SESSION_FIELDS = {f for f in SessionDefaults.__dataclass_fields__}
 
 
 def number(key: str, text: str, kind: type, low: float, high: float) -> Any:
@@ -140,6 +155,8 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
                 name, kind, low, high = _OPTIONS[key]
                 values[name] = number(f"[options] {key}", text, kind, low, high)
             elif key in _TEXT_OPTIONS:
+                if text not in _CHOICES.get(key, (text,)):
+                    raise ConfigError(f"[options] {key} = {text!r} is not one", _CHOICES[key])
                 values[key] = text
             else:
                 raise ConfigError(
@@ -194,8 +211,14 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
     for key in ("package_paths", "xacro_args"):
         values[key] = tuple(values.get(key, ()))
     limit_values = {k: values.pop(k) for k in list(values) if k in _LIMIT_FIELDS}
+    session_values = {k: values.pop(k) for k in list(values) if k in _SESSION_FIELDS}
     settings = replace(
-        Settings(), **values, limits=ServerLimits(**limit_values), robots=robots, ini=ini
+        Settings(),
+        **values,
+        limits=ServerLimits(**limit_values),
+        session=SessionDefaults(**session_values),
+        robots=robots,
+        ini=ini,
     )
     if settings.urdf is None:
         entry = find_robot(settings.robot, robots, ini)

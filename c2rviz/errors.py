@@ -18,6 +18,7 @@ __all__ = [
     "JointLimitError",
     "LineError",
     "LineTooLong",
+    "MotionInterrupted",
     "RobotError",
     "UnknownCommand",
     "UnknownRobot",
@@ -128,3 +129,11 @@ class UnknownRobot(C2rvizError):
         self.name = name
         self.names = tuple(names)
         super().__init__(f"no robot {shown(name)} here; robots: {', '.join(self.names)}")
+
+
+class MotionInterrupted(C2rvizError):
+    """A move that a waiting client will not see arrive: preempted or stopped."""
+
+    def __init__(self, why: str) -> None:
+        self.why = why
+        super().__init__(why)

@@ -85,6 +85,8 @@ class RecordingScene(Scene):
     """A scene that remembers what it was told; no drawing."""
 
     joints: list[tuple[float, ...]] = field(default_factory=list)
+    times: list[float] = field(default_factory=list)
+    """The clock time [s] of each entry of ``joints``."""
     markers: list[Marker] = field(default_factory=list)
     clears: int = 0
     client_counts: list[int] = field(default_factory=list)
@@ -93,6 +95,7 @@ class RecordingScene(Scene):
 
     def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
         self.joints.append(tuple(q))
+        self.times.append(t)
 
     def on_marker(self, robot: str, marker: Marker) -> None:
         self.markers.append(marker)

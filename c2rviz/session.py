@@ -16,7 +16,10 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from . import handlers  # noqa: F401  (registers the handler of every verb)
+from . import (
+    handlers,  # noqa: F401  (registers the handler of every verb)
+    replies,
+)
 from .commands import parse_line
 from .config import ServerLimits
 from .errors import C2rvizError, JointLimitError
@@ -65,6 +68,8 @@ class Session:
 
     Attributes:
         source: Who speaks (``tcp 127.0.0.1:5123``, ``page``), for notes and errors.
+        motion: ``off``, ``on`` or ``follow`` (``lang.motion.MOTION_MODES``).
+        speed: Moves at this % of the joints' limits.
         hangup: Set by a handler to ``"bye"`` or ``"quit"``: the connection closes
             after this reply (and for ``quit`` stops the program).
     """
@@ -83,6 +88,8 @@ class Session:
         self.rgb: tuple[float, float, float] = (1.0, 0.0, 0.0)
         self.shape = "sphere"
         self.hangup: str | None = None
+        self.motion = world.defaults.motion
+        self.speed = world.defaults.speed
         self.select(robot)
 
     def select(self, name: str | None) -> None:
@@ -92,6 +99,22 @@ class Session:
         self.n = self.robot.n  # Robot.n is a property; this is read per command
         self._tables = (UnitTable.build(self.robot, False), UnitTable.build(self.robot, True))
         self.table = self._tables[self.degrees]
+
+    def go(self, q: Sequence[float]) -> Reply:
+        """Send this session's robot to ``q`` [rad or m, checked]: at once (``motion off``),
+        or travelling (``on``: the reply comes on arrival; ``follow``: ``ok`` now)."""
+        if self.motion == "off":
+            self.world.set_q(q, self.state.name, self.source)
+            return replies.OK
+        arrival = self.world.travels.go(
+            self.state, q, self.speed / 100.0, self.source, wait=self.motion == "on"
+        )
+        return replies.OK if arrival is None else arrival
+
+    def now(self) -> tuple[float, ...]:
+        """The robot's joints at this instant [rad or m] (mid-move too)."""
+        state = self.state
+        return self.world.travels.now(state) if state.travel.active else state.q
 
     def set_degrees(self, degrees: bool) -> None:
         self.degrees = degrees

@@ -19,9 +19,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from .config import SessionDefaults
 from .errors import UnknownRobot
+from .motion import MotionLimits, motion_limits
 from .robot import Robot
 from .scene import MAX_MARKERS, Marker, Observer
+from .travel import Travel, Travels
 
 __all__ = ["RobotState", "World"]
 
@@ -43,6 +46,8 @@ class RobotState:
     q: tuple[float, ...] = ()
     target: tuple[float, ...] = ()
     markers: deque[Marker] = field(default_factory=lambda: deque(maxlen=MAX_MARKERS))
+    travel: Travel = field(init=False, repr=False)
+    """Its motion (set by the world)."""
 
     def __post_init__(self) -> None:
         if not self.q:
@@ -58,6 +63,9 @@ class World:
         scene: Observer | None = None,
         rng: np.random.Generator | None = None,
         clock: Callable[[], float] = time.monotonic,
+        hz: float = 100.0,
+        limits: Mapping[str, MotionLimits] | None = None,
+        defaults: SessionDefaults | None = None,
     ) -> None:
         """Set up the world.
 
@@ -67,6 +75,9 @@ class World:
             scene: A first observer (usually the view).
             rng: Random source for ``rand``.
             clock: The time base [s].
+            hz: Samples per second of a moving arm [1/s].
+            limits: Motion limits by robot name (default: from each URDF).
+            defaults: How a new session starts (motion mode, speed).
         """
         named = {robots.name: robots} if isinstance(robots, Robot) else dict(robots)
         self.robots = {name: RobotState(name, robot) for name, robot in named.items()}
@@ -75,6 +86,11 @@ class World:
         self.rng = rng if rng is not None else np.random.default_rng()
         self.clock = clock
         self.client_count = 0
+        self.defaults = defaults if defaults is not None else SessionDefaults()
+        self.travels = Travels(self._show, clock, 1.0 / hz)
+        for name, state in self.robots.items():
+            chosen = (limits or {}).get(name) or motion_limits(state.robot)
+            state.travel = self.travels.add(state, chosen)
 
     def state(self, name: str | None = None) -> RobotState:
         """The robot called ``name`` (the default robot for None)."""
@@ -99,21 +115,24 @@ class World:
 
     # Changes: each is checked before it gets here, then told to every observer.
 
-    def set_q(self, q: Sequence[float], robot: str | None = None) -> None:
-        """Put a chain at ``q`` [rad or m], already checked against the limits."""
+    def set_q(self, q: Sequence[float], robot: str | None = None, source: str = "") -> None:
+        """Put a chain at ``q`` [rad or m] now, already checked against the limits.
+
+        A move running on that robot is preempted (its waiter is told by ``source``).
+        """
         state = self.robots[self.default if robot is None else robot]
-        state.q = state.target = tuple(q)
-        t = self.clock()
+        travel = state.travel
+        if travel.active:
+            self.travels.preempt(travel, source)
+        travel.synced = False
+        state.target = q = tuple(q)
+        self._show(state, q, self.clock())
+
+    def _show(self, state: RobotState, q: tuple[float, ...], t: float) -> None:
+        """The robot is seen at ``q`` at time ``t``: tell every observer."""
+        state.q = q
         for observer in self.observers:
-            observer.on_joints(state.name, state.q, t)
-
-    def home(self, robot: str | None = None) -> None:
-        """Every chain joint to zero (or the nearest limit where zero is outside)."""
-        self.set_q(self.state(robot).robot.home, robot)
-
-    def randomize(self, robot: str | None = None) -> None:
-        """Every chain joint to a random value within its limits."""
-        self.set_q(self.state(robot).robot.random(self.rng), robot)
+            observer.on_joints(state.name, q, t)
 
     def ee_pose(self, robot: str | None = None) -> pin.SE3:
         """End-effector placement in the base frame, as the arm is now."""
@@ -141,13 +160,17 @@ class World:
             observer.on_marker(state.name, marker)
         return marker
 
-    def clear(self, robot: str | None = None) -> None:
-        """Remove every marker of the robot, and home it."""
+    def clear_markers(self, robot: str | None = None) -> None:
+        """Remove every marker of the robot."""
         state = self.state(robot)
         state.markers.clear()
         for observer in self.observers:
             observer.on_clear_markers(state.name)
-        self.home(robot)
+
+    def clear(self, robot: str | None = None) -> None:
+        """Remove every marker of the robot, and home it at once."""
+        self.clear_markers(robot)
+        self.set_q(self.state(robot).robot.home, robot)
 
     def set_client_count(self, count: int) -> None:
         self.client_count = count

@@ -32,6 +32,7 @@ from c2rviz.commands import (
     parse_line,
 )
 from c2rviz.errors import BadArguments, C2rvizError, LineError, UnknownCommand
+from c2rviz.lang.motion import MotionMode, Speed, Status, Stop, Target, Wait
 
 GOOD = [
     ("home", Home(), "home"),
@@ -68,6 +69,19 @@ GOOD = [
     ("pose", Pose(), "pose"),
     ("names", Names(), "names"),
     ("LIMITS", Limits(), "limits"),
+    ("limits ALL", Limits(all=True), "limits-all"),
+    ("motion", MotionMode(None), "motion-ask"),
+    ("motion on", MotionMode("on"), "motion-on"),
+    ("MOTION Follow", MotionMode("follow"), "motion-follow"),
+    ("motion off", MotionMode("off"), "motion-off"),
+    ("speed", Speed(None), "speed-ask"),
+    ("speed 10", Speed(10.0), "speed"),
+    ("speed 1", Speed(1.0), "speed-lowest"),
+    ("speed 100", Speed(100.0), "speed-highest"),
+    ("stop", Stop(), "stop"),
+    ("wait", Wait(), "wait"),
+    ("target", Target(), "target"),
+    ("status", Status(), "status"),
     ("help", Help(), "help"),
     ("version", Version(), "version"),
     ("sleep 0", Sleep(0.0), "sleep-zero"),
@@ -139,6 +153,14 @@ BAD = [
     ("sleep nan", BadArguments, "bad number 'nan'", "sleep-nan"),
     ("sleep 1,2", BadArguments, "sleep: needs 1 values, got 2", "sleep-two"),
     ("home 1", BadArguments, "home: takes no arguments", "home-arg"),
+    ("limits some", BadArguments, "limits: unknown argument 'some'", "limits-other"),
+    ("motion fast", BadArguments, "unknown mode 'fast'; choose off, on or follow", "motion-fast"),
+    ("motion on off", BadArguments, "takes 1 argument, got 2", "motion-two"),
+    ("speed 0", BadArguments, "speed: 0 is outside 1..100", "speed-zero"),
+    ("speed 101", BadArguments, "101 is outside 1..100", "speed-over"),
+    ("speed nan", BadArguments, "bad number 'nan'", "speed-nan"),
+    ("speed -5", BadArguments, "-5 is outside 1..100", "speed-negative"),
+    ("stop now", BadArguments, "stop: takes no arguments", "stop-arg"),
     ("degree 1", BadArguments, "(usage: degrees)", "alias-usage"),
     ("jump 1", UnknownCommand, "unknown command 'jump' (try 'help')", "unknown-verb"),
     ("x" * 100, UnknownCommand, "'" + "x" * 40 + "...'", "unknown-long-verb-cut"),

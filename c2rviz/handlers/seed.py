@@ -46,15 +46,13 @@ __all__: list[str] = []
 
 
 @handler(Rand)
-def rand(session: Session, command: Rand) -> str:
-    session.world.randomize(session.state.name)
-    return replies.OK
+def rand(session: Session, command: Rand) -> Reply:
+    return session.go(session.robot.random(session.world.rng))
 
 
 @handler(Home)
-def home(session: Session, command: Home) -> str:
-    session.world.home(session.state.name)
-    return replies.OK
+def home(session: Session, command: Home) -> Reply:
+    return session.go(session.robot.home)
 
 
 @handler(Units)
@@ -64,7 +62,7 @@ def units(session: Session, command: Units) -> str:
 
 
 @handler(Joints)
-def joints(session: Session, command: Joints) -> str:
+def joints(session: Session, command: Joints) -> Reply:
     values = command.values
     n = session.n
     if len(values) != n:
@@ -76,12 +74,11 @@ def joints(session: Session, command: Joints) -> str:
         q = values if table.identity else tuple(map(mul, values, table.scale))
     else:
         q = session.to_si(range(n), values)
-    session.world.set_q(q, session.state.name)
-    return replies.OK
+    return session.go(q)
 
 
 @handler(Move)
-def move(session: Session, command: Move) -> str:
+def move(session: Session, command: Move) -> Reply:
     n = session.n
     for index in command.indices:
         if index >= n:
@@ -89,14 +86,13 @@ def move(session: Session, command: Move) -> str:
     q = list(session.state.target)
     for index, value in zip(command.indices, session.to_si(command.indices, command.values)):
         q[index] = value
-    session.world.set_q(q, session.state.name)
-    return replies.OK
+    return session.go(q)
 
 
 @handler(Clear)
-def clear(session: Session, command: Clear) -> str:
-    session.world.clear(session.state.name)
-    return replies.OK
+def clear(session: Session, command: Clear) -> Reply:
+    session.world.clear_markers(session.state.name)
+    return session.go(session.robot.home)
 
 
 @handler(Mark)
@@ -125,12 +121,12 @@ def marker_shape(session: Session, command: MarkerShape) -> str:
 
 @handler(Where)
 def where(session: Session, command: Where) -> str:
-    return replies.ok(replies.numbers(session.from_si(session.state.q)))
+    return replies.ok(replies.numbers(session.from_si(session.now())))
 
 
 @handler(Pose)
 def pose(session: Session, command: Pose) -> str:
-    placement = session.robot.ee_pose(session.state.q)
+    placement = session.robot.ee_pose(session.now())
     rpy = pin.rpy.matrixToRpy(placement.rotation) / session.angle_scale
     return replies.ok(replies.numbers([*placement.translation, *rpy]))
 
@@ -138,12 +134,20 @@ def pose(session: Session, command: Pose) -> str:
 @handler(Limits)
 def limits(session: Session, command: Limits) -> str:
     table = session.table
-    return replies.ok(
-        ",".join(
-            f"{replies.numbers([lo])}..{replies.numbers([hi])} {unit}"
-            for lo, hi, unit in zip(table.lower, table.upper, table.unit)
-        )
-    )
+    ranges = [
+        f"{replies.numbers([lo])}..{replies.numbers([hi])} {unit}"
+        for lo, hi, unit in zip(table.lower, table.upper, table.unit)
+    ]
+    if command.all:
+        motion = session.state.travel.motion.limits
+        ranges = [
+            f"{text} v={replies.numbers([v / s])} a={replies.numbers([a / s])} "
+            f"j={replies.numbers([j / s])}"
+            for text, v, a, j, s in zip(
+                ranges, motion.velocity, motion.acceleration, motion.jerk, table.scale
+            )
+        ]
+    return replies.ok(",".join(ranges))
 
 
 @handler(Names)
