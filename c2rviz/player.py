@@ -33,8 +33,8 @@ from .client import (
     ConnectionLost,
     ServerUnavailable,
     add_connection_args,
-    default_address,
     find_script,
+    server_address,
 )
 from .commands import Bye, Command, Joints, Move, Quit, Sleep, parse_line
 from .errors import C2rvizError, JointCountError, JointIndexError
@@ -278,10 +278,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         path = find_script(args.file)
         script = load_script(path, args.file)
-        host, port = (args.host, args.port)
-        if host is None or port is None:
-            ini_host, ini_port = default_address(args.config)
-            host, port = host or ini_host, ini_port if port is None else port
+        host, port = server_address(args.host, args.port, args.config)
     except (OSError, C2rvizError) as exc:
         print(f"c2rviz-play: {exc}", file=err)
         return 2

@@ -31,12 +31,13 @@ from .client import (
     ConnectionLost,
     ServerUnavailable,
     add_connection_args,
-    default_address,
     find_script,
+    server_address,
 )
 from .commands import USAGE, Joints, Sleep, parse_line
 from .errors import BadArguments, C2rvizError, JointCountError, JointLimitError
 from .player import Progress, check_robot, load_script, play
+from .tolerance import within_limit
 
 __all__ = ["LOCAL_USAGE", "Repl", "build_parser", "main"]
 
@@ -244,8 +245,7 @@ class Repl:
             raise BadArguments("goto", str(JointCountError(n, len(target))), usage)
         names = client.joint_names()
         for i, (value, (lower, upper, unit)) in enumerate(zip(target, client.limits())):
-            slack = 1e-9 * max(1.0, abs(value))  # the server's own slack at a limit
-            if not lower - slack <= value <= upper + slack:  # refuse before the first step
+            if not within_limit(value, lower, upper):  # refuse before the first step
                 raise BadArguments(
                     "goto", str(JointLimitError(names[i], i, value, lower, upper, unit)), usage
                 )
@@ -340,14 +340,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         if value is not None and not (value > 0 and math.isfinite(value)):
             print(f"c2rviz-cli: --{name} must be a number > 0", file=sys.stderr)
             return 2
-    host, port = args.host, args.port
-    if host is None or port is None:
-        try:
-            ini_host, ini_port = default_address(args.config)
-        except C2rvizError as exc:
-            print(f"c2rviz-cli: {exc}", file=sys.stderr)
-            return 2
-        host, port = host or ini_host, ini_port if port is None else port
+    try:
+        host, port = server_address(args.host, args.port, args.config)
+    except C2rvizError as exc:
+        print(f"c2rviz-cli: {exc}", file=sys.stderr)
+        return 2
     interactive = sys.stdin.isatty()
     info = sys.stdout if interactive else sys.stderr
 

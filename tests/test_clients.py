@@ -23,7 +23,8 @@ import pytest
 
 from c2rviz import client as client_module
 from c2rviz import player, repl
-from c2rviz.client import Client, ServerUnavailable, default_address
+from c2rviz.client import Client, ServerUnavailable, default_address, server_address
+from c2rviz.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parent.parent
 MOTOMAN = str(ROOT / "commands" / "motoman.txt")
@@ -77,6 +78,16 @@ def test_clients_do_not_import_pinocchio():
 def test_default_address_reads_the_ini(tmp_path):
     ini = write(tmp_path, "my.ini", "[options]\nhost = 0.0.0.0\nport = 31234\n")
     assert default_address(ini) == ("127.0.0.1", 31234)
+
+
+def test_flags_win_and_the_ini_fills_in_the_rest(tmp_path):
+    ini = write(tmp_path, "my.ini", "[options]\nhost = 10.1.2.3\nport = 31234\n")
+    assert server_address(None, None, ini) == ("10.1.2.3", 31234)
+    assert server_address("h", None, ini) == ("h", 31234)
+    assert server_address(None, 0, ini) == ("10.1.2.3", 0)  # 0 is a port, not "not given"
+    assert server_address("h", 5, tmp_path / "nonesuch.ini") == ("h", 5)  # ini not needed
+    with pytest.raises(ConfigError, match="does not exist"):
+        server_address("h", None, tmp_path / "nonesuch.ini")
 
 
 def test_client_tracks_units_and_restores_them_after_a_reconnect(server, connect):
