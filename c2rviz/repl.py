@@ -44,7 +44,7 @@ __all__ = ["LOCAL_USAGE", "Repl", "build_parser", "main"]
 LOCAL_USAGE = {
     "file": ("file NAME [speed=X]", "play a command file (here, else commands/); X divides sleeps"),
     "sleep": ("sleep S", "wait S seconds here"),
-    "where": ("where", "joint names and values"),
+    "where": ("where", "joint names and values, in this connection's units"),
     "goto": ("goto v0,...,vn-1 [step=S] [rate=HZ]", "move there smoothly in small joints steps"),
     "help": ("help", "this list"),
     "q": ("q", "leave (the server keeps running)"),
@@ -277,7 +277,10 @@ class Repl:
         reply = self.ask("help")
         self.show("server commands (sent as typed; # starts a comment):")
         for usage in reply.partition(": ")[2].split("; "):
-            self.show(f"  {usage}")
+            # A verb this client handles itself (where, sleep, help, quit) is listed once,
+            # above: typed here, it never reaches the server as the server's own verb.
+            if usage.split(" ", 1)[0].lower() not in LOCAL_USAGE:
+                self.show(f"  {usage}")
         return True
 
     def _quit(self, words: list[str]) -> bool:

@@ -308,6 +308,14 @@ def test_repl_goto_in_radians_and_its_errors(server, monkeypatch, capsys):
     assert server.q[:2] == pytest.approx((0.5, 1.91))
 
 
+def test_repl_help_lists_each_command_once(server, monkeypatch, capsys):
+    assert run_repl(monkeypatch, "help\n", "--port", str(server.port)) == 0
+    listed = [line.split()[0] for line in capsys.readouterr().out.splitlines()[1:]]
+    listed = [word for word in listed if word not in ("server", "local")]  # the two headings
+    assert "where" in listed and "goto" in listed and "pose" in listed
+    assert len(listed) == len(set(listed)), sorted(w for w in listed if listed.count(w) > 1)
+
+
 def test_repl_file_stops_at_the_first_error(server, tmp_path, monkeypatch, capsys):
     bad = write(tmp_path, "bad.txt", BAD_LINE_3)
     limit = write(tmp_path, "limit.txt", LIMIT_LINE_3)
