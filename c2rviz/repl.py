@@ -11,7 +11,8 @@ On a terminal there is a ``> `` prompt with line editing and history
 prompt, the replies go to stdout and the connection messages to stderr.
 
 Exit status: 0 left with ``q``, ``quit``, Ctrl-D or Ctrl-C at the prompt; 1 no
-server (after retrying ``--timeout`` seconds); 2 bad options or config.
+server (after retrying ``--timeout`` seconds), or, with piped input, a line got
+an ``error:`` (the rest still ran, as typed); 2 bad options or config.
 """
 
 from __future__ import annotations
@@ -104,6 +105,8 @@ class Repl:
         self.step = step
         self.rate_hz = rate_hz
         self.speed = speed
+        self.errors = 0
+        """Lines that got an ``error:`` (from the server or from this client)."""
         self._local: dict[str, Callable[[list[str]], bool]] = {
             "file": self._file,
             "sleep": self._sleep,
@@ -121,7 +124,12 @@ class Repl:
         print(message, file=self.out, flush=True)
 
     def run(self) -> int:
-        """Connect, then read and run lines until the user leaves; return the exit status."""
+        """Connect, then read and run lines until the user leaves; return the exit status.
+
+        With piped input the status is 1 when any line got an ``error:``, so a script
+        run as ``c2rviz-cli < script`` fails like ``c2rviz-play`` does; a person at
+        the prompt has seen each error, and leaving is not a failure.
+        """
         client = self.client
         self.say("Socket Created")
         try:
@@ -136,15 +144,16 @@ class Repl:
                 except (EOFError, KeyboardInterrupt):
                     if self.interactive:
                         self.show("")
-                    return 0
+                    return self._status()
                 try:
                     if not self.handle(line):
-                        return 0
+                        return self._status()
                 except KeyboardInterrupt:
                     self.show("interrupted")
                 except ServerUnavailable:
                     raise
                 except C2rvizError as exc:
+                    self.errors += 1
                     self.show(f"error: {exc}")
         except ServerUnavailable as exc:
             self.say(f"{exc}; giving up")
@@ -152,6 +161,9 @@ class Repl:
         except KeyboardInterrupt:  # while connecting
             self.say("interrupted")
             return 130
+
+    def _status(self) -> int:
+        return 1 if self.errors and not self.interactive else 0
 
     def _read(self) -> str:
         if self.interactive:
@@ -177,6 +189,8 @@ class Repl:
             return local(words[1:])
         reply = self.ask(line)
         self.show(reply)
+        if reply.startswith("error"):
+            self.errors += 1
         return verb != "bye" or not reply.startswith("ok")
 
     def ask(self, line: str) -> str:
@@ -203,13 +217,16 @@ class Repl:
         for problem in problems:
             self.show(problem)
         if problems:
+            self.errors += 1
             self.show(f"{script.name}: nothing was sent")
             return True
         show = Progress(self.out, self.out, in_place=False)
         try:
             errors = play(client, script, show, speed=options.get("speed", self.speed))
         except ConnectionLost:
+            self.errors += 1
             return True  # play has said where it stopped; the next command reconnects
+        self.errors += errors > 0
         if not errors:
             self.show(f"{script.name}: {len(script.lines)} commands, all ok")
         return True
@@ -264,6 +281,7 @@ class Repl:
             )
             reply = client.ask("joints " + ",".join(map(repr, values)))
             if not reply.startswith("ok"):
+                self.errors += 1
                 self.show(f"goto: stopped at step {k}/{steps}: {reply}")
                 return True
         self.show(f"ok (goto: {steps} steps in {time.monotonic() - start:.2f} s)")
@@ -284,7 +302,9 @@ class Repl:
         return True
 
     def _quit(self, words: list[str]) -> bool:
-        self.show(self.ask("quit"))
+        reply = self.ask("quit")
+        self.show(reply)
+        self.errors += not reply.startswith("ok")
         return False
 
 

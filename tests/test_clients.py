@@ -273,7 +273,7 @@ def test_repl_piped(server, connect, monkeypatch, capsys):
         "sleep 0.01\n"
         "q\n"
     )
-    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 0
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 1  # a line got an error
     captured = capsys.readouterr()
     assert "Socket Created" in captured.err and "Socket Connected" in captured.err
     assert not any(line.startswith(">") for line in captured.out.splitlines())  # no prompt
@@ -288,6 +288,23 @@ def test_repl_piped(server, connect, monkeypatch, capsys):
     assert where_degrees(server, connect) == "ok 10,20,0,0,0,0,0"
 
 
+def test_piped_repl_exits_1_when_a_line_got_an_error(server, connect):
+    """`c2rviz-cli < script` fails like the player, but still runs every line."""
+    args = [sys.executable, REPL_SCRIPT, "--port", str(server.port)]
+    clean = subprocess.run(
+        args, input="degrees\nmove 0 10\nwhere\n", capture_output=True, text=True, timeout=30
+    )
+    assert clean.returncode == 0, clean.stderr
+    script = "degrees\nmove 1 500\nmove 0 20\nwhere\n"
+    failed = subprocess.run(args, input=script, capture_output=True, text=True, timeout=30)
+    assert failed.returncode == 1, failed.stderr
+    assert "error: joint_l (index 1) = 500 deg is outside its limits" in failed.stdout
+    assert where_degrees(server, connect) == "ok 20,0,0,0,0,0,0"  # the lines after it ran
+    local = subprocess.run(args, input="goto 1\n", capture_output=True, text=True, timeout=30)
+    assert local.returncode == 1  # an error from a local command counts too
+    assert "error: goto: joints needs 7 values, got 1" in local.stdout
+
+
 def test_repl_goto_in_radians_and_its_errors(server, monkeypatch, capsys):
     text = (
         "goto 0.5,0,0,0,0,0,0 rate=1000\n"  # default step: 2 degrees = 0.0349 rad
@@ -297,7 +314,7 @@ def test_repl_goto_in_radians_and_its_errors(server, monkeypatch, capsys):
         "help\n"
         "goto 0.5,1.91,0,0,0,0,0 step=1 rate=1000\n"  # exactly at joint_l's limit
     )
-    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 0
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 1  # a line got an error
     out = capsys.readouterr().out
     assert "ok (goto: 15 steps" in out
     assert "error: goto: joints needs 7 values, got 2" in out
@@ -320,7 +337,7 @@ def test_repl_file_stops_at_the_first_error(server, tmp_path, monkeypatch, capsy
     bad = write(tmp_path, "bad.txt", BAD_LINE_3)
     limit = write(tmp_path, "limit.txt", LIMIT_LINE_3)
     text = f"file {bad}\nfile {limit}\nfile nonesuch.txt\nwhere\n"
-    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 0
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 1  # a line got an error
     out = capsys.readouterr().out
     assert f"{bad}:3: error: unknown command 'mvoe'" in out
     assert f"{limit}:3: error: joint_l (index 1) = 500 deg" in out
