@@ -37,7 +37,7 @@ from .client import (
 )
 from .commands import USAGE, Joints, Sleep, parse_line
 from .errors import BadArguments, C2rvizError, JointCountError, JointLimitError
-from .player import Progress, check_robot, load_script, play
+from .player import Progress, check_robot, load_script, play, robot_mismatch
 from .tolerance import within_limit
 
 __all__ = ["LOCAL_USAGE", "Repl", "build_parser", "main"]
@@ -213,6 +213,9 @@ class Repl:
             raise C2rvizError(f"file: {exc}") from None
         client = self.client
         names = client.joint_names()
+        mismatch = robot_mismatch(script, client.robot or "?", names)
+        if mismatch is not None:
+            self.say(f"warning: {mismatch}; playing it anyway")
         problems = script.problems or check_robot(script, client.robot or "?", names)
         for problem in problems:
             self.show(problem)

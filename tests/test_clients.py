@@ -165,6 +165,51 @@ def test_joint_counts_and_indices_are_checked_against_the_robot(server, tmp_path
     assert server.q == before
 
 
+def test_the_robot_header_is_read_from_the_opening_comments(tmp_path):
+    path = Path(write(tmp_path, "a.txt", "# a demo\n#Robot:  kuka_lwr  \nhome\n# robot: x\n"))
+    assert player.load_script(path).robot == "kuka_lwr"
+    late = Path(write(tmp_path, "b.txt", "home\n# robot: kuka_lwr\n"))
+    assert player.load_script(late).robot is None  # after the first command: a comment
+    prose = Path(write(tmp_path, "c.txt", "# robot: run it with c2rviz --robot x\nhome\n"))
+    assert player.load_script(prose).robot is None  # one word only
+    for path in sorted((ROOT / "commands").glob("*.txt")):
+        assert player.load_script(path).robot is not None, path.name
+
+
+KUKA = str(ROOT / "commands" / "kuka_lwr.txt")
+
+
+def test_a_file_for_another_robot_is_warned_about(server, capsys):
+    assert player.main([KUKA, "--port", str(server.port), "--speed", "1000"]) == 0
+    captured = capsys.readouterr()
+    assert (
+        f"warning: {KUKA} is written for robot kuka_lwr (its '# robot:' line), "
+        "but the server runs motoman_sia20d (7 joints); playing it anyway" in captured.err
+    )
+    assert "all ok" in captured.out
+    assert player.main([MOTOMAN, "--port", str(server.port), "--speed", "1000"]) == 0
+    assert "warning" not in capsys.readouterr().err  # motoman.txt says motoman_sia20d
+
+
+def test_strict_refuses_a_file_for_another_robot(server, connect, capsys):
+    other = connect(server)
+    assert other.ask("move 2 0.5") == "ok"
+    before = server.q
+    assert player.main([KUKA, "--port", str(server.port), "--strict"]) == 2
+    err = capsys.readouterr().err
+    assert "written for robot kuka_lwr" in err and "the server runs motoman_sia20d" in err
+    assert "nothing was sent" in err
+    assert server.q == before
+    assert player.main([MOTOMAN, "--port", str(server.port), "--speed", "1e4", "--strict"]) == 0
+
+
+def test_repl_file_warns_about_another_robot(server, monkeypatch, capsys):
+    assert run_repl(monkeypatch, "file kuka_lwr.txt speed=1000\n", "--port", str(server.port)) == 0
+    captured = capsys.readouterr()
+    assert "warning: kuka_lwr.txt is written for robot kuka_lwr" in captured.err
+    assert "commands, all ok" in captured.out
+
+
 LIMIT_LINE_3 = "degrees\nmove 0 10\nmove 1 500\nmove 2 20\n"
 
 
