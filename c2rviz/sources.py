@@ -33,7 +33,7 @@ from urllib.parse import unquote
 
 from .errors import ConfigError, RobotError
 
-__all__ = ["MissingMesh", "RobotSource", "load_source", "parse_xacro_args"]
+__all__ = ["MissingMesh", "RobotSource", "load_source", "parse_xacro_args", "split_package_path"]
 
 _NAME = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
 _MESH = re.compile(r"""<mesh\b[^>]*\bfilename\s*=\s*["']([^"']+)["']""")
@@ -193,6 +193,28 @@ class RobotSource:
         ]
 
 
+def split_package_path(
+    entry: str | Path, relative_to: Path | None = None
+) -> tuple[str | None, Path]:
+    """One package search entry, as (package name or None, absolute folder).
+
+    ``NAME=DIR`` says package NAME is the folder DIR; any other entry is a DIR to
+    search (so is a ``NAME=DIR`` text that exists as a folder itself). The same
+    forms serve ``--package-path`` and the ini's ``package_path``.
+
+    Args:
+        entry: ``DIR`` or ``NAME=DIR``; ``~`` is expanded.
+        relative_to: The folder a relative DIR is taken from (the ini file's
+            folder for the ini; default: the working directory).
+    """
+    base = Path.cwd() if relative_to is None else relative_to
+    text = str(entry)
+    name, sep, named = text.partition("=")
+    if sep and _PACKAGE_NAME.fullmatch(name) and not (base / Path(text).expanduser()).exists():
+        return name, (base / Path(named).expanduser()).resolve()
+    return None, (base / Path(text).expanduser()).resolve()
+
+
 def parse_xacro_args(args: Mapping[str, str] | Iterable[str]) -> dict[str, str]:
     """``name:=value`` strings (or a mapping) as a dict for xacro.
 
@@ -277,14 +299,14 @@ def load_source(
     folders: list[Path] = []
     mapped: list[tuple[str, Path]] = []
     for entry in package_paths:
-        name, sep, named = str(entry).partition("=")
-        if sep and _PACKAGE_NAME.fullmatch(name) and not Path(entry).exists():
-            mapped.append((name, Path(named).expanduser().resolve()))
-        else:
-            folders.append(Path(entry).expanduser().resolve())
-    for folder in [*folders, *(f for _, f in mapped)]:
+        name, folder = split_package_path(entry)
         if not folder.is_dir():
-            raise ConfigError(f"--package-path {str(folder)!r} is not a folder")
+            named = f" (for package {name})" if name is not None else ""
+            raise ConfigError(f"--package-path {str(folder)!r}{named} is not a folder")
+        if name is None:
+            folders.append(folder)
+        else:
+            mapped.append((name, folder))
     source = RobotSource(
         "",
         path.resolve(),

@@ -13,7 +13,7 @@ from xacro import substitution_args
 
 from c2rviz.errors import ConfigError, RobotError
 from c2rviz.robot import Robot
-from c2rviz.sources import RobotSource, load_source, parse_xacro_args
+from c2rviz.sources import RobotSource, load_source, parse_xacro_args, split_package_path
 
 DATA = Path(__file__).parent / "data"
 WS_SRC = DATA / "tiny_ws" / "src"
@@ -117,6 +117,24 @@ def test_relative_file_and_remote_uris(tmp_path: Path) -> None:
 def test_missing_package_path_is_a_config_error(tmp_path: Path) -> None:
     with pytest.raises(ConfigError, match="is not a folder"):
         load_source(TINY, [tmp_path / "nope"], environ=NO_ENV)
+
+
+def test_a_missing_name_dir_names_the_package(tmp_path: Path) -> None:
+    nope = tmp_path / "nope"
+    message = f"--package-path {str(nope)!r} (for package tiny_gripper) is not a folder"
+    with pytest.raises(ConfigError) as info:
+        load_source(TINY, [f"tiny_gripper={nope}"], environ=NO_ENV)
+    assert str(info.value) == message
+
+
+def test_split_package_path_forms(tmp_path: Path) -> None:
+    odd = tmp_path / "a=b"  # a folder whose own name holds '=' is a DIR
+    odd.mkdir()
+    assert split_package_path("a=b", tmp_path) == (None, odd)
+    assert split_package_path("pkg=x/y", tmp_path) == ("pkg", tmp_path / "x" / "y")
+    assert split_package_path("x/y", tmp_path) == (None, tmp_path / "x" / "y")
+    assert split_package_path(f"pkg={tmp_path}", Path("/elsewhere")) == ("pkg", tmp_path)
+    assert split_package_path("~/ws")[1] == Path.home() / "ws"
 
 
 def test_mesh_uris_survive_xml_that_elementtree_rejects() -> None:
