@@ -244,7 +244,9 @@ def _expand_xacro(path: Path, args: dict[str, str], source: RobotSource) -> str:
         folder = source.find_package(name)
         if folder is None:
             raise substitution_args.SubstitutionException(
-                f"package {name!r} not found (give the folder that holds it with --package-path)"
+                f"package {name!r} not found in --package-path, ROS_PACKAGE_PATH, "
+                f"AMENT_PREFIX_PATH or the folders above {path.parent} "
+                "(give the folder that holds it with --package-path DIR or NAME=DIR)"
             )
         return str(folder)
 
@@ -259,13 +261,29 @@ def _expand_xacro(path: Path, args: dict[str, str], source: RobotSource) -> str:
         try:
             return xacro.process_file(str(path), mappings=args).toprettyxml(indent="  ")
         except Exception as exc:  # xacro raises all sorts; each is a bad description
-            problem = " ".join(str(exc).split()) or type(exc).__name__
+            problem = _xacro_problem(exc)
             if "argument" in problem.lower():
                 problem += " (give it with --xacro-arg name:=value)"
             raise RobotError(f"cannot expand {path}: {problem}") from exc
         finally:
             if patch:
                 substitution_args._eval_find, substitution_args._eval_dict["find"] = saved
+
+
+def _xacro_problem(exc: Exception) -> str:
+    """What xacro raised, as one line without class names or repeats.
+
+    xacro wraps an error in a substitution such as ``$(find NAME)`` as
+    ``XacroException(f"{type(e)}: {e}", exc=e)``, whose text is then
+    ``<class '...'>: {e} {e}``; only ``{e}`` (and any suffix) is kept.
+    """
+    text = str(exc)
+    inner = getattr(exc, "exc", None)
+    if inner is not None:
+        wrapped = f"{type(inner)}: {inner}"
+        if text.startswith(wrapped):
+            text = text[len(wrapped) :]
+    return " ".join(text.split()) or type(exc).__name__
 
 
 def _split_env(value: str | None) -> tuple[Path, ...]:

@@ -161,15 +161,25 @@ def test_xacro_missing_argument_says_how_to_give_it() -> None:
         load_source(TINY_XACRO, environ=NO_ENV)
 
 
-def test_xacro_unknown_package(tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    "body",
+    [
+        '<link name="a"><visual><geometry><mesh filename="$(find no_such_pkg)/m.stl"/>'
+        "</geometry></visual></link>",
+        '<xacro:include filename="$(find no_such_pkg)/urdf/arm.xacro"/><link name="a"/>',
+    ],
+    ids=["in-an-attribute", "in-an-include"],
+)
+def test_xacro_unknown_package_is_one_sentence(tmp_path: Path, body: str) -> None:
     path = tmp_path / "r.xacro"
-    path.write_text(
-        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="a">'
-        '<visual><geometry><mesh filename="$(find no_such_pkg)/m.stl"/></geometry></visual>'
-        "</link></robot>"
-    )
-    with pytest.raises(RobotError, match="package 'no_such_pkg' not found"):
+    path.write_text(f'<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">{body}</robot>')
+    with pytest.raises(RobotError) as info:
         load_source(path, environ=NO_ENV)
+    assert str(info.value) == (
+        f"cannot expand {path}: package 'no_such_pkg' not found in --package-path, "
+        f"ROS_PACKAGE_PATH, AMENT_PREFIX_PATH or the folders above {tmp_path} "
+        "(give the folder that holds it with --package-path DIR or NAME=DIR)"
+    )
 
 
 @pytest.mark.parametrize("arg", ["length", ":=1", "length=1"])
