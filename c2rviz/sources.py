@@ -33,7 +33,14 @@ from urllib.parse import unquote
 
 from .errors import ConfigError, RobotError
 
-__all__ = ["MissingMesh", "RobotSource", "load_source", "parse_xacro_args", "split_package_path"]
+__all__ = [
+    "MissingMesh",
+    "RobotSource",
+    "check_urdf_root",
+    "load_source",
+    "parse_xacro_args",
+    "split_package_path",
+]
 
 _NAME = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
 _MESH = re.compile(r"""<mesh\b[^>]*\bfilename\s*=\s*["']([^"']+)["']""")
@@ -42,6 +49,10 @@ _SCAN_DEPTH = 4  # how far below a package-path entry package.xml files are look
 _SCAN_MAX_DIRS = 5000  # and how many folders at most, so a too-wide entry stays quick
 _IGNORE_MARKERS = ("CATKIN_IGNORE", "COLCON_IGNORE", "AMENT_IGNORE")
 _xacro_lock = threading.Lock()  # xacro keeps module-level state
+# The first element of an XML text, past a BOM, the declaration, comments and a doctype.
+_ROOT_TAG = re.compile(
+    r"\ufeff?\s*(?:(?:<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>]*>)\s*)*<([A-Za-z_][\w:.-]*)", re.DOTALL
+)
 
 
 def package_name(folder: Path) -> str | None:
@@ -286,6 +297,25 @@ def _xacro_problem(exc: Exception) -> str:
     return " ".join(text.split()) or type(exc).__name__
 
 
+def check_urdf_root(xml: str, where: Path) -> None:
+    """Raise RobotError unless ``xml``'s root element is ``<robot>``.
+
+    Checked before Pinocchio sees the text: urdfdom, under Pinocchio, prints
+    its own complaint about a missing ``robot`` element straight to stderr.
+
+    Args:
+        xml: The description text.
+        where: The file it came from, for the message.
+    """
+    match = _ROOT_TAG.match(xml)
+    if match is None:
+        raise RobotError(f"{where} is not a URDF: it is not XML (a URDF starts with <robot ...>)")
+    tag = match.group(1)
+    if tag != "robot":
+        what = " (an SDF file: c2rviz reads URDF and xacro)" if tag == "sdf" else ""
+        raise RobotError(f"{where} is not a URDF: its root element is <{tag}>, not <robot>{what}")
+
+
 def _split_env(value: str | None) -> tuple[Path, ...]:
     return tuple(Path(p) for p in (value or "").split(os.pathsep) if p)
 
@@ -307,7 +337,8 @@ def load_source(
             (default ``os.environ``).
 
     Raises:
-        RobotError: the file does not exist, cannot be read or does not expand.
+        RobotError: the file does not exist, cannot be read, does not expand or is
+            not a URDF (its root element is not ``<robot>``).
         ConfigError: a package path that is not a folder, or a bad xacro argument.
     """
     path = Path(path)
@@ -343,6 +374,7 @@ def load_source(
             xml = path.read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as exc:
             raise RobotError(f"cannot read {path}: {exc}") from exc
+    check_urdf_root(xml, path)
     scans = source._scans
     source = replace(source, xml=xml)
     source._scans.update(scans)  # keep the package.xml scans made while expanding

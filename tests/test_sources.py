@@ -11,6 +11,7 @@ import pytest
 import trimesh
 from xacro import substitution_args
 
+from c2rviz.cli import main
 from c2rviz.errors import ConfigError, RobotError
 from c2rviz.robot import Robot
 from c2rviz.sources import RobotSource, load_source, parse_xacro_args, split_package_path
@@ -191,3 +192,42 @@ def test_bad_xacro_argument(arg: str) -> None:
 def test_xacro_arguments_for_a_plain_urdf_are_refused() -> None:
     with pytest.raises(ConfigError, match="not a .xacro file"):
         load_source(TINY, (), ["length:=1"], environ=NO_ENV)
+
+
+SDF = """<?xml version="1.0"?>
+<!-- a model as Gazebo describes it -->
+<sdf version="1.7"><model name="arm"><link name="base"/></model></sdf>
+"""
+
+
+@pytest.mark.parametrize(
+    ("name", "text", "problem"),
+    [
+        ("arm.sdf", SDF, "its root element is <sdf>, not <robot> (an SDF file: c2rviz reads "
+         "URDF and xacro)"),
+        ("scene.xml", "<mujoco model='arm'/>", "its root element is <mujoco>, not <robot>"),
+        ("arm.urdf", "solid arm\nendsolid arm\n", "it is not XML (a URDF starts with <robot ...>)"),
+    ],
+    ids=["sdf", "mjcf", "not-xml"],
+)  # fmt: skip
+def test_a_file_that_is_not_a_urdf_gets_only_our_message(tmp_path, capfd, name, text, problem):
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(RobotError) as info:
+        Robot.from_urdf(path)
+    assert str(info.value) == f"{path} is not a URDF: {problem}"
+    assert main(["--urdf", str(path), "--no-viewer"]) == 2
+    out, err = capfd.readouterr()  # fd 1 and 2: what urdfdom would print goes there
+    assert (out, err) == ("", f"c2rviz: {path} is not a URDF: {problem}\n")
+
+
+def test_a_urdf_with_a_declaration_comments_and_a_doctype_is_a_urdf(tmp_path, capfd):
+    path = tmp_path / "r.urdf"
+    path.write_text(
+        '\ufeff<?xml version="1.0"?>\n<!-- a -- b -->\n<!DOCTYPE robot>\n'
+        '<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="revolute">'
+        '<parent link="a"/><child link="b"/><limit lower="-1" upper="1" effort="1" '
+        'velocity="1"/></joint></robot>',
+        encoding="utf-8",
+    )
+    assert Robot.from_urdf(path).joint_names == ("j",)
