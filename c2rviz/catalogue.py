@@ -67,7 +67,7 @@ class _IniRobot(Protocol):
     @property
     def eelink(self) -> str | None: ...
     @property
-    def package_paths(self) -> tuple[Path, ...]: ...
+    def package_paths(self) -> tuple[str | Path, ...]: ...
     @property
     def xacro_args(self) -> tuple[str, ...]: ...
 
@@ -81,7 +81,8 @@ class CatalogueEntry:
         urdf: The URDF or xacro file.
         base: First link of the chain (None: the root).
         eelink: End-effector link (None: the only leaf).
-        package_paths: Extra ``--package-path`` folders its meshes need.
+        package_paths: Extra ``--package-path`` entries its meshes need (``DIR`` or
+            ``NAME=DIR``).
         origin: Where it comes from, for ``--list-robots``.
         xacro_args: ``name:=value`` for a xacro file.
     """
@@ -90,7 +91,7 @@ class CatalogueEntry:
     urdf: Path
     base: str | None
     eelink: str | None
-    package_paths: tuple[Path, ...]
+    package_paths: tuple[str | Path, ...]
     origin: str
     xacro_args: tuple[str, ...] = ()
 

@@ -30,6 +30,7 @@ __all__ = [
     "add_connection_args",
     "default_address",
     "find_script",
+    "server_address",
 ]
 
 COMMANDS_DIR = Path(__file__).resolve().parent.parent / "commands"
@@ -97,6 +98,25 @@ def default_address(config: str | Path | None = None) -> tuple[str, int]:
     elif host == "::":
         host = "::1"
     return host, settings.port
+
+
+def server_address(
+    host: str | None, port: int | None, config: str | Path | None = None
+) -> tuple[str, int]:
+    """Where to connect: ``--host``/``--port`` where given, the rest from the ini.
+
+    Args:
+        host: The ``--host`` flag (None: not given).
+        port: The ``--port`` flag (None: not given; 0 is a port).
+        config: The ``--config`` flag (None: the usual ini search).
+
+    Raises:
+        ConfigError: the ini is needed and ``config`` does not exist or has a bad value.
+    """
+    if host is not None and port is not None:
+        return host, port
+    ini_host, ini_port = default_address(config)
+    return host or ini_host, ini_port if port is None else port
 
 
 def find_script(name: str | Path) -> Path:

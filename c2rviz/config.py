@@ -2,11 +2,12 @@
 
 The ini file has an ``[options]`` section and one section per robot (named as
 in the seed: ``[motoman_sia20d]`` ...) with ``base``, ``eelink`` and ``urdf``
-(relative to the ini file), and optionally ``package_path`` (folders for
-``package://``, relative to the ini file) and ``xacro_args`` (``name:=value``
-...), each a space-separated list. A robot name with no section is looked up in
-the catalogue (example-robot-data). Every bad value is a ``ConfigError`` naming
-the key and what it accepts.
+(relative to the ini file), and optionally ``package_path`` (where
+``package://`` packages are: each entry ``DIR`` or ``NAME=DIR``, as for
+``--package-path``, relative to the ini file) and ``xacro_args``
+(``name:=value`` ...), each a space-separated list. A robot name with no section
+is looked up in the catalogue (example-robot-data). Every bad value is a
+``ConfigError`` naming the key and what it accepts.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from typing import Any
 
 from .catalogue import catalogue, find_robot
 from .errors import ConfigError
+from .sources import split_package_path
 
 __all__ = [
     "INI_NAME",
@@ -69,8 +71,31 @@ class RobotEntry:
     urdf: Path
     base: str | None = None
     eelink: str | None = None
-    package_paths: tuple[Path, ...] = ()
+    package_paths: tuple[str | Path, ...] = ()
+    """``package_path`` entries made absolute: a folder ``Path``, or ``"NAME=/abs/DIR"``."""
     xacro_args: tuple[str, ...] = ()
+    ini: Path | None = None
+    """The file the section was read from."""
+
+    def check_package_paths(self) -> None:
+        """Raise ConfigError, naming ``[section] package_path``, for an entry that is no folder."""
+        for entry in self.package_paths:
+            name, folder = split_package_path(entry)
+            if not folder.is_dir():
+                named = f" (for package {name})" if name is not None else ""
+                raise ConfigError(
+                    f"[{self.name}] package_path in {self.ini}: {str(folder)!r}{named} "
+                    "is not a folder (entries are DIR or NAME=DIR, relative to the ini file)"
+                )
+
+
+def _package_paths(text: str, ini: Path) -> tuple[str | Path, ...]:
+    """The ``package_path`` entries of a section, each made absolute against the ini's folder."""
+    entries: list[str | Path] = []
+    for entry in text.split():
+        name, folder = split_package_path(entry, ini.parent)
+        entries.append(folder if name is None else f"{name}={folder}")
+    return tuple(entries)
 
 
 @dataclass(frozen=True)
@@ -181,8 +206,9 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
             (path.parent / urdf).resolve(),
             items.get("base"),
             items.get("eelink"),
-            tuple((path.parent / p).resolve() for p in items.get("package_path", "").split()),
+            _package_paths(items.get("package_path", ""), path),
             tuple(items.get("xacro_args", "").split()),
+            path,
         )
     return values, robots
 
@@ -222,6 +248,8 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
     )
     if settings.urdf is None:
         entry = find_robot(settings.robot, robots, ini)
+        if settings.robot in robots:
+            robots[settings.robot].check_package_paths()
         settings = replace(
             settings,
             urdf=entry.urdf,

@@ -4,7 +4,9 @@ The whole file is parsed with ``c2rviz.commands.parse_line`` before anything is
 sent, so a typo on line 40 is reported as ``file:40: error: ...`` while the
 robot is still where it was. Once connected, the joint counts of ``joints``
 lines and the indices of ``move`` lines are checked against the server's
-robot (``names``), again before the first line is sent. Then every command
+robot (``names``), again before the first line is sent; a file that declares
+its robot in its opening comments (a ``# robot: NAME`` line) and finds another
+one at the server is warned about, or refused with ``--strict``. Then every command
 line is sent and its reply shown; the first ``error:`` reply stops the play
 (unless ``--keep-going``).
 
@@ -20,6 +22,7 @@ could not be reached or went away; 2 the file or the options are wrong
 from __future__ import annotations
 
 import argparse
+import re
 import shutil
 import sys
 import time
@@ -33,13 +36,24 @@ from .client import (
     ConnectionLost,
     ServerUnavailable,
     add_connection_args,
-    default_address,
     find_script,
+    server_address,
 )
 from .commands import Bye, Command, Joints, Move, Quit, Sleep, parse_line
 from .errors import C2rvizError, JointCountError, JointIndexError
 
-__all__ = ["Progress", "Script", "ScriptLine", "build_parser", "load_script", "main", "play"]
+__all__ = [
+    "Progress",
+    "Script",
+    "ScriptLine",
+    "build_parser",
+    "load_script",
+    "main",
+    "play",
+    "robot_mismatch",
+]
+
+_ROBOT_HEADER = re.compile(r"#\s*robot:\s*([A-Za-z0-9_.-]+)\s*", re.IGNORECASE)
 
 
 @dataclass(frozen=True, slots=True)
@@ -63,6 +77,8 @@ class Script:
     lines: list[ScriptLine] = field(default_factory=list)
     problems: list[str] = field(default_factory=list)
     """``name:line: error: ...`` for each line the parser rejected."""
+    robot: str | None = None
+    """The robot the file is written for: its ``# robot: NAME`` line, if it has one."""
 
     def problem(self, number: int, message: object) -> str:
         return f"{self.name}:{number}: error: {message}"
@@ -70,6 +86,9 @@ class Script:
 
 def load_script(path: Path, name: str | None = None) -> Script:
     """Read and parse a command file (comments and blank lines are dropped).
+
+    The first ``# robot: NAME`` line among the comments that open the file (before
+    its first command) names the robot it is written for (``Script.robot``).
 
     Args:
         path: The file.
@@ -89,6 +108,9 @@ def load_script(path: Path, name: str | None = None) -> Script:
             script.problems.append(script.problem(number, exc))
             continue
         if command is None:
+            header = _ROBOT_HEADER.fullmatch(raw.strip())
+            if header and script.robot is None and not script.lines and not script.problems:
+                script.robot = header.group(1)
             continue
         if closed_at is not None:
             verb = closed_at.wire.split()[0]
@@ -119,6 +141,16 @@ def check_robot(script: Script, robot: str, joint_names: Sequence[str]) -> list[
             if bad:
                 problems.append(script.problem(line.number, JointIndexError(bad[0], robot, n)))
     return problems
+
+
+def robot_mismatch(script: Script, robot: str, joint_names: Sequence[str]) -> str | None:
+    """What to say when ``script`` declares another robot than the server's, else None."""
+    if script.robot is None or script.robot == robot:
+        return None
+    return (
+        f"{script.name} is written for robot {script.robot} (its '# robot:' line), "
+        f"but the server runs {robot} ({len(joint_names)} joints)"
+    )
 
 
 class Progress:
@@ -227,7 +259,8 @@ def build_parser() -> argparse.ArgumentParser:
         "each line is sent, its reply shown; the first error stops the play.",
         epilog="Exit status: 0 all lines ok; 1 a line got an error or no server; "
         "2 the file does not check (nothing was sent). FILE is looked for here, "
-        "then in the project's commands/.",
+        "then in the project's commands/. A '# robot: NAME' line in the file's "
+        "opening comments names the robot it is for.",
     )
     add = parser.add_argument
     add("file", metavar="FILE", help="command file, e.g. commands/motoman.txt")
@@ -242,6 +275,12 @@ def build_parser() -> argparse.ArgumentParser:
     add("--loop", type=int, default=1, metavar="N", help="play N times; 0: until Ctrl-C")
     add("--keep-going", action="store_true", help="go on after an error reply")
     add("--check", action="store_true", help="only parse the file; do not connect")
+    add(
+        "--strict",
+        action="store_true",
+        help="refuse (exit 2) when the file's '# robot: NAME' line names another robot "
+        "than the server's (default: warn and play)",
+    )
     add(
         "--window",
         type=int,
@@ -278,10 +317,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         path = find_script(args.file)
         script = load_script(path, args.file)
-        host, port = (args.host, args.port)
-        if host is None or port is None:
-            ini_host, ini_port = default_address(args.config)
-            host, port = host or ini_host, ini_port if port is None else port
+        host, port = server_address(args.host, args.port, args.config)
     except (OSError, C2rvizError) as exc:
         print(f"c2rviz-play: {exc}", file=err)
         return 2
@@ -309,6 +345,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     start = time.monotonic()
     try:
         names = client.joint_names()
+        mismatch = robot_mismatch(script, client.robot or "?", names)
+        if mismatch is not None and args.strict:
+            return _fail([f"{mismatch} (--strict)"], script.name, err)
+        if mismatch is not None:
+            notify(f"warning: {mismatch}; playing it anyway (--strict refuses)")
         problems = check_robot(script, client.robot or "?", names)
         if problems:
             return _fail(problems, f"{script.name} (robot {client.robot})", err)

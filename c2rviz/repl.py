@@ -11,7 +11,8 @@ On a terminal there is a ``> `` prompt with line editing and history
 prompt, the replies go to stdout and the connection messages to stderr.
 
 Exit status: 0 left with ``q``, ``quit``, Ctrl-D or Ctrl-C at the prompt; 1 no
-server (after retrying ``--timeout`` seconds); 2 bad options or config.
+server (after retrying ``--timeout`` seconds), or, with piped input, a line got
+an ``error:`` (the rest still ran, as typed); 2 bad options or config.
 """
 
 from __future__ import annotations
@@ -31,19 +32,20 @@ from .client import (
     ConnectionLost,
     ServerUnavailable,
     add_connection_args,
-    default_address,
     find_script,
+    server_address,
 )
 from .commands import USAGE, Joints, Sleep, parse_line
 from .errors import BadArguments, C2rvizError, JointCountError, JointLimitError
-from .player import Progress, check_robot, load_script, play
+from .player import Progress, check_robot, load_script, play, robot_mismatch
+from .tolerance import within_limit
 
 __all__ = ["LOCAL_USAGE", "Repl", "build_parser", "main"]
 
 LOCAL_USAGE = {
     "file": ("file NAME [speed=X]", "play a command file (here, else commands/); X divides sleeps"),
     "sleep": ("sleep S", "wait S seconds here"),
-    "where": ("where", "joint names and values"),
+    "where": ("where", "joint names and values, in this connection's units"),
     "goto": ("goto v0,...,vn-1 [step=S] [rate=HZ]", "move there smoothly in small joints steps"),
     "help": ("help", "this list"),
     "q": ("q", "leave (the server keeps running)"),
@@ -103,6 +105,8 @@ class Repl:
         self.step = step
         self.rate_hz = rate_hz
         self.speed = speed
+        self.errors = 0
+        """Lines that got an ``error:`` (from the server or from this client)."""
         self._local: dict[str, Callable[[list[str]], bool]] = {
             "file": self._file,
             "sleep": self._sleep,
@@ -120,7 +124,12 @@ class Repl:
         print(message, file=self.out, flush=True)
 
     def run(self) -> int:
-        """Connect, then read and run lines until the user leaves; return the exit status."""
+        """Connect, then read and run lines until the user leaves; return the exit status.
+
+        With piped input the status is 1 when any line got an ``error:``, so a script
+        run as ``c2rviz-cli < script`` fails like ``c2rviz-play`` does; a person at
+        the prompt has seen each error, and leaving is not a failure.
+        """
         client = self.client
         self.say("Socket Created")
         try:
@@ -135,15 +144,16 @@ class Repl:
                 except (EOFError, KeyboardInterrupt):
                     if self.interactive:
                         self.show("")
-                    return 0
+                    return self._status()
                 try:
                     if not self.handle(line):
-                        return 0
+                        return self._status()
                 except KeyboardInterrupt:
                     self.show("interrupted")
                 except ServerUnavailable:
                     raise
                 except C2rvizError as exc:
+                    self.errors += 1
                     self.show(f"error: {exc}")
         except ServerUnavailable as exc:
             self.say(f"{exc}; giving up")
@@ -151,6 +161,9 @@ class Repl:
         except KeyboardInterrupt:  # while connecting
             self.say("interrupted")
             return 130
+
+    def _status(self) -> int:
+        return 1 if self.errors and not self.interactive else 0
 
     def _read(self) -> str:
         if self.interactive:
@@ -176,6 +189,8 @@ class Repl:
             return local(words[1:])
         reply = self.ask(line)
         self.show(reply)
+        if reply.startswith("error"):
+            self.errors += 1
         return verb != "bye" or not reply.startswith("ok")
 
     def ask(self, line: str) -> str:
@@ -198,17 +213,23 @@ class Repl:
             raise C2rvizError(f"file: {exc}") from None
         client = self.client
         names = client.joint_names()
+        mismatch = robot_mismatch(script, client.robot or "?", names)
+        if mismatch is not None:
+            self.say(f"warning: {mismatch}; playing it anyway")
         problems = script.problems or check_robot(script, client.robot or "?", names)
         for problem in problems:
             self.show(problem)
         if problems:
+            self.errors += 1
             self.show(f"{script.name}: nothing was sent")
             return True
         show = Progress(self.out, self.out, in_place=False)
         try:
             errors = play(client, script, show, speed=options.get("speed", self.speed))
         except ConnectionLost:
+            self.errors += 1
             return True  # play has said where it stopped; the next command reconnects
+        self.errors += errors > 0
         if not errors:
             self.show(f"{script.name}: {len(script.lines)} commands, all ok")
         return True
@@ -244,8 +265,7 @@ class Repl:
             raise BadArguments("goto", str(JointCountError(n, len(target))), usage)
         names = client.joint_names()
         for i, (value, (lower, upper, unit)) in enumerate(zip(target, client.limits())):
-            slack = 1e-9 * max(1.0, abs(value))  # the server's own slack at a limit
-            if not lower - slack <= value <= upper + slack:  # refuse before the first step
+            if not within_limit(value, lower, upper):  # refuse before the first step
                 raise BadArguments(
                     "goto", str(JointLimitError(names[i], i, value, lower, upper, unit)), usage
                 )
@@ -264,6 +284,7 @@ class Repl:
             )
             reply = client.ask("joints " + ",".join(map(repr, values)))
             if not reply.startswith("ok"):
+                self.errors += 1
                 self.show(f"goto: stopped at step {k}/{steps}: {reply}")
                 return True
         self.show(f"ok (goto: {steps} steps in {time.monotonic() - start:.2f} s)")
@@ -277,11 +298,16 @@ class Repl:
         reply = self.ask("help")
         self.show("server commands (sent as typed; # starts a comment):")
         for usage in reply.partition(": ")[2].split("; "):
-            self.show(f"  {usage}")
+            # A verb this client handles itself (where, sleep, help, quit) is listed once,
+            # above: typed here, it never reaches the server as the server's own verb.
+            if usage.split(" ", 1)[0].lower() not in LOCAL_USAGE:
+                self.show(f"  {usage}")
         return True
 
     def _quit(self, words: list[str]) -> bool:
-        self.show(self.ask("quit"))
+        reply = self.ask("quit")
+        self.show(reply)
+        self.errors += not reply.startswith("ok")
         return False
 
 
@@ -340,14 +366,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         if value is not None and not (value > 0 and math.isfinite(value)):
             print(f"c2rviz-cli: --{name} must be a number > 0", file=sys.stderr)
             return 2
-    host, port = args.host, args.port
-    if host is None or port is None:
-        try:
-            ini_host, ini_port = default_address(args.config)
-        except C2rvizError as exc:
-            print(f"c2rviz-cli: {exc}", file=sys.stderr)
-            return 2
-        host, port = host or ini_host, ini_port if port is None else port
+    try:
+        host, port = server_address(args.host, args.port, args.config)
+    except C2rvizError as exc:
+        print(f"c2rviz-cli: {exc}", file=sys.stderr)
+        return 2
     interactive = sys.stdin.isatty()
     info = sys.stdout if interactive else sys.stderr
 

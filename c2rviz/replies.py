@@ -44,9 +44,14 @@ def error(problem: object) -> str:
 def numbers(values: Iterable[float]) -> str:
     """Comma-separated values, 10 significant digits, no trailing zeros.
 
-    Values within 1e-12 of zero print as 0 (no ``6.7e-17`` from rounding noise).
+    Values within 1e-9 of zero (in their own unit: [m], [rad] or [deg]) print as
+    ``0``, and so does ``-0.0``: forward kinematics leaves rounding noise such as
+    ``-5.4e-12`` m or ``-3.1e-10`` deg where the answer is 0, and a reply
+    of ``0`` says what is meant. 1e-9 is far below anything a robot resolves (a
+    nanometre, a nanoradian) and far above double-precision noise on values of
+    order 1 to 360.
     """
-    return ",".join([f"{value:.10g}" if abs(value) > 1e-12 else "0" for value in values])
+    return ",".join([f"{value:.10g}" if abs(value) > 1e-9 else "0" for value in values])
 
 
 def too_many_clients(limit: int) -> str:

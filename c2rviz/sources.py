@@ -33,7 +33,14 @@ from urllib.parse import unquote
 
 from .errors import ConfigError, RobotError
 
-__all__ = ["MissingMesh", "RobotSource", "load_source", "parse_xacro_args"]
+__all__ = [
+    "MissingMesh",
+    "RobotSource",
+    "check_urdf_root",
+    "load_source",
+    "parse_xacro_args",
+    "split_package_path",
+]
 
 _NAME = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
 _MESH = re.compile(r"""<mesh\b[^>]*\bfilename\s*=\s*["']([^"']+)["']""")
@@ -42,6 +49,10 @@ _SCAN_DEPTH = 4  # how far below a package-path entry package.xml files are look
 _SCAN_MAX_DIRS = 5000  # and how many folders at most, so a too-wide entry stays quick
 _IGNORE_MARKERS = ("CATKIN_IGNORE", "COLCON_IGNORE", "AMENT_IGNORE")
 _xacro_lock = threading.Lock()  # xacro keeps module-level state
+# The first element of an XML text, past a BOM, the declaration, comments and a doctype.
+_ROOT_TAG = re.compile(
+    r"\ufeff?\s*(?:(?:<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>]*>)\s*)*<([A-Za-z_][\w:.-]*)", re.DOTALL
+)
 
 
 def package_name(folder: Path) -> str | None:
@@ -193,6 +204,28 @@ class RobotSource:
         ]
 
 
+def split_package_path(
+    entry: str | Path, relative_to: Path | None = None
+) -> tuple[str | None, Path]:
+    """One package search entry, as (package name or None, absolute folder).
+
+    ``NAME=DIR`` says package NAME is the folder DIR; any other entry is a DIR to
+    search (so is a ``NAME=DIR`` text that exists as a folder itself). The same
+    forms serve ``--package-path`` and the ini's ``package_path``.
+
+    Args:
+        entry: ``DIR`` or ``NAME=DIR``; ``~`` is expanded.
+        relative_to: The folder a relative DIR is taken from (the ini file's
+            folder for the ini; default: the working directory).
+    """
+    base = Path.cwd() if relative_to is None else relative_to
+    text = str(entry)
+    name, sep, named = text.partition("=")
+    if sep and _PACKAGE_NAME.fullmatch(name) and not (base / Path(text).expanduser()).exists():
+        return name, (base / Path(named).expanduser()).resolve()
+    return None, (base / Path(text).expanduser()).resolve()
+
+
 def parse_xacro_args(args: Mapping[str, str] | Iterable[str]) -> dict[str, str]:
     """``name:=value`` strings (or a mapping) as a dict for xacro.
 
@@ -222,7 +255,9 @@ def _expand_xacro(path: Path, args: dict[str, str], source: RobotSource) -> str:
         folder = source.find_package(name)
         if folder is None:
             raise substitution_args.SubstitutionException(
-                f"package {name!r} not found (give the folder that holds it with --package-path)"
+                f"package {name!r} not found in --package-path, ROS_PACKAGE_PATH, "
+                f"AMENT_PREFIX_PATH or the folders above {path.parent} "
+                "(give the folder that holds it with --package-path DIR or NAME=DIR)"
             )
         return str(folder)
 
@@ -237,13 +272,48 @@ def _expand_xacro(path: Path, args: dict[str, str], source: RobotSource) -> str:
         try:
             return xacro.process_file(str(path), mappings=args).toprettyxml(indent="  ")
         except Exception as exc:  # xacro raises all sorts; each is a bad description
-            problem = " ".join(str(exc).split()) or type(exc).__name__
+            problem = _xacro_problem(exc)
             if "argument" in problem.lower():
                 problem += " (give it with --xacro-arg name:=value)"
             raise RobotError(f"cannot expand {path}: {problem}") from exc
         finally:
             if patch:
                 substitution_args._eval_find, substitution_args._eval_dict["find"] = saved
+
+
+def _xacro_problem(exc: Exception) -> str:
+    """What xacro raised, as one line without class names or repeats.
+
+    xacro wraps an error in a substitution such as ``$(find NAME)`` as
+    ``XacroException(f"{type(e)}: {e}", exc=e)``, whose text is then
+    ``<class '...'>: {e} {e}``; only ``{e}`` (and any suffix) is kept.
+    """
+    text = str(exc)
+    inner = getattr(exc, "exc", None)
+    if inner is not None:
+        wrapped = f"{type(inner)}: {inner}"
+        if text.startswith(wrapped):
+            text = text[len(wrapped) :]
+    return " ".join(text.split()) or type(exc).__name__
+
+
+def check_urdf_root(xml: str, where: Path) -> None:
+    """Raise RobotError unless ``xml``'s root element is ``<robot>``.
+
+    Checked before Pinocchio sees the text: urdfdom, under Pinocchio, prints
+    its own complaint about a missing ``robot`` element straight to stderr.
+
+    Args:
+        xml: The description text.
+        where: The file it came from, for the message.
+    """
+    match = _ROOT_TAG.match(xml)
+    if match is None:
+        raise RobotError(f"{where} is not a URDF: it is not XML (a URDF starts with <robot ...>)")
+    tag = match.group(1)
+    if tag != "robot":
+        what = " (an SDF file: c2rviz reads URDF and xacro)" if tag == "sdf" else ""
+        raise RobotError(f"{where} is not a URDF: its root element is <{tag}>, not <robot>{what}")
 
 
 def _split_env(value: str | None) -> tuple[Path, ...]:
@@ -267,7 +337,8 @@ def load_source(
             (default ``os.environ``).
 
     Raises:
-        RobotError: the file does not exist, cannot be read or does not expand.
+        RobotError: the file does not exist, cannot be read, does not expand or is
+            not a URDF (its root element is not ``<robot>``).
         ConfigError: a package path that is not a folder, or a bad xacro argument.
     """
     path = Path(path)
@@ -277,14 +348,14 @@ def load_source(
     folders: list[Path] = []
     mapped: list[tuple[str, Path]] = []
     for entry in package_paths:
-        name, sep, named = str(entry).partition("=")
-        if sep and _PACKAGE_NAME.fullmatch(name) and not Path(entry).exists():
-            mapped.append((name, Path(named).expanduser().resolve()))
-        else:
-            folders.append(Path(entry).expanduser().resolve())
-    for folder in [*folders, *(f for _, f in mapped)]:
+        name, folder = split_package_path(entry)
         if not folder.is_dir():
-            raise ConfigError(f"--package-path {str(folder)!r} is not a folder")
+            named = f" (for package {name})" if name is not None else ""
+            raise ConfigError(f"--package-path {str(folder)!r}{named} is not a folder")
+        if name is None:
+            folders.append(folder)
+        else:
+            mapped.append((name, folder))
     source = RobotSource(
         "",
         path.resolve(),
@@ -303,6 +374,7 @@ def load_source(
             xml = path.read_text(encoding="utf-8")
         except (OSError, UnicodeDecodeError) as exc:
             raise RobotError(f"cannot read {path}: {exc}") from exc
+    check_urdf_root(xml, path)
     scans = source._scans
     source = replace(source, xml=xml)
     source._scans.update(scans)  # keep the package.xml scans made while expanding

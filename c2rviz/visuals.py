@@ -42,8 +42,11 @@ class Shape:
     Attributes:
         kind: ``box``, ``cylinder``, ``sphere`` or ``mesh``.
         origin: 4x4 pose of the piece in its link's frame (the URDF ``<origin>``).
-        rgba: Colour, each channel 0..1; for a mesh, None keeps the file's own
-            colours and textures.
+        rgba: Colour, each channel 0..1. For a mesh: the URDF ``<material>``
+            colour when its ``<visual>`` gives one (it wins over the mesh
+            file's own colours and textures, such as an ``.obj``'s ``.mtl``);
+            else None when the file brings colours of its own (they are kept);
+            else the default grey.
         size: Box edge lengths (x, y, z) [m]; cylinder (radius, length) [m];
             sphere (radius,) [m]; empty for a mesh.
         mesh: The loaded mesh (kind ``mesh`` only), scale already applied.
@@ -154,10 +157,12 @@ def _shapes(
         return []
     shapes = []
     for mesh in meshes:
-        # A URDF colour paints meshes that bring no colour of their own (STL);
-        # RViz does the same, so coloured COLLADA/glTF files keep theirs.
+        # The URDF's colour is what the robot's author chose for this link, so it
+        # wins over the file's (exporters often leave a near-white .mtl behind:
+        # pybullet's kuka_iiwa). Without one, a file's own colours are kept.
         own = mesh.visual is not None and mesh.visual.defined
-        shapes.append(Shape("mesh", origin, None if own else rgba or DEFAULT_RGBA, (), mesh))
+        color = rgba if rgba is not None else None if own else DEFAULT_RGBA
+        shapes.append(Shape("mesh", origin, color, (), mesh))
     return shapes
 
 

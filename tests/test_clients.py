@@ -23,7 +23,8 @@ import pytest
 
 from c2rviz import client as client_module
 from c2rviz import player, repl
-from c2rviz.client import Client, ServerUnavailable, default_address
+from c2rviz.client import Client, ServerUnavailable, default_address, server_address
+from c2rviz.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parent.parent
 MOTOMAN = str(ROOT / "commands" / "motoman.txt")
@@ -77,6 +78,16 @@ def test_clients_do_not_import_pinocchio():
 def test_default_address_reads_the_ini(tmp_path):
     ini = write(tmp_path, "my.ini", "[options]\nhost = 0.0.0.0\nport = 31234\n")
     assert default_address(ini) == ("127.0.0.1", 31234)
+
+
+def test_flags_win_and_the_ini_fills_in_the_rest(tmp_path):
+    ini = write(tmp_path, "my.ini", "[options]\nhost = 10.1.2.3\nport = 31234\n")
+    assert server_address(None, None, ini) == ("10.1.2.3", 31234)
+    assert server_address("h", None, ini) == ("h", 31234)
+    assert server_address(None, 0, ini) == ("10.1.2.3", 0)  # 0 is a port, not "not given"
+    assert server_address("h", 5, tmp_path / "nonesuch.ini") == ("h", 5)  # ini not needed
+    with pytest.raises(ConfigError, match="does not exist"):
+        server_address("h", None, tmp_path / "nonesuch.ini")
 
 
 def test_client_tracks_units_and_restores_them_after_a_reconnect(server, connect):
@@ -152,6 +163,51 @@ def test_joint_counts_and_indices_are_checked_against_the_robot(server, tmp_path
     assert f"{path}:3: error: joints needs 7 values, got 3" in err
     assert f"{path}:4: error: joint index 9 out of range: motoman_sia20d has joints 0..6" in err
     assert server.q == before
+
+
+def test_the_robot_header_is_read_from_the_opening_comments(tmp_path):
+    path = Path(write(tmp_path, "a.txt", "# a demo\n#Robot:  kuka_lwr  \nhome\n# robot: x\n"))
+    assert player.load_script(path).robot == "kuka_lwr"
+    late = Path(write(tmp_path, "b.txt", "home\n# robot: kuka_lwr\n"))
+    assert player.load_script(late).robot is None  # after the first command: a comment
+    prose = Path(write(tmp_path, "c.txt", "# robot: run it with c2rviz --robot x\nhome\n"))
+    assert player.load_script(prose).robot is None  # one word only
+    for path in sorted((ROOT / "commands").glob("*.txt")):
+        assert player.load_script(path).robot is not None, path.name
+
+
+KUKA = str(ROOT / "commands" / "kuka_lwr.txt")
+
+
+def test_a_file_for_another_robot_is_warned_about(server, capsys):
+    assert player.main([KUKA, "--port", str(server.port), "--speed", "1000"]) == 0
+    captured = capsys.readouterr()
+    assert (
+        f"warning: {KUKA} is written for robot kuka_lwr (its '# robot:' line), "
+        "but the server runs motoman_sia20d (7 joints); playing it anyway" in captured.err
+    )
+    assert "all ok" in captured.out
+    assert player.main([MOTOMAN, "--port", str(server.port), "--speed", "1000"]) == 0
+    assert "warning" not in capsys.readouterr().err  # motoman.txt says motoman_sia20d
+
+
+def test_strict_refuses_a_file_for_another_robot(server, connect, capsys):
+    other = connect(server)
+    assert other.ask("move 2 0.5") == "ok"
+    before = server.q
+    assert player.main([KUKA, "--port", str(server.port), "--strict"]) == 2
+    err = capsys.readouterr().err
+    assert "written for robot kuka_lwr" in err and "the server runs motoman_sia20d" in err
+    assert "nothing was sent" in err
+    assert server.q == before
+    assert player.main([MOTOMAN, "--port", str(server.port), "--speed", "1e4", "--strict"]) == 0
+
+
+def test_repl_file_warns_about_another_robot(server, monkeypatch, capsys):
+    assert run_repl(monkeypatch, "file kuka_lwr.txt speed=1000\n", "--port", str(server.port)) == 0
+    captured = capsys.readouterr()
+    assert "warning: kuka_lwr.txt is written for robot kuka_lwr" in captured.err
+    assert "commands, all ok" in captured.out
 
 
 LIMIT_LINE_3 = "degrees\nmove 0 10\nmove 1 500\nmove 2 20\n"
@@ -262,7 +318,7 @@ def test_repl_piped(server, connect, monkeypatch, capsys):
         "sleep 0.01\n"
         "q\n"
     )
-    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 0
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 1  # a line got an error
     captured = capsys.readouterr()
     assert "Socket Created" in captured.err and "Socket Connected" in captured.err
     assert not any(line.startswith(">") for line in captured.out.splitlines())  # no prompt
@@ -277,6 +333,23 @@ def test_repl_piped(server, connect, monkeypatch, capsys):
     assert where_degrees(server, connect) == "ok 10,20,0,0,0,0,0"
 
 
+def test_piped_repl_exits_1_when_a_line_got_an_error(server, connect):
+    """`c2rviz-cli < script` fails like the player, but still runs every line."""
+    args = [sys.executable, REPL_SCRIPT, "--port", str(server.port)]
+    clean = subprocess.run(
+        args, input="degrees\nmove 0 10\nwhere\n", capture_output=True, text=True, timeout=30
+    )
+    assert clean.returncode == 0, clean.stderr
+    script = "degrees\nmove 1 500\nmove 0 20\nwhere\n"
+    failed = subprocess.run(args, input=script, capture_output=True, text=True, timeout=30)
+    assert failed.returncode == 1, failed.stderr
+    assert "error: joint_l (index 1) = 500 deg is outside its limits" in failed.stdout
+    assert where_degrees(server, connect) == "ok 20,0,0,0,0,0,0"  # the lines after it ran
+    local = subprocess.run(args, input="goto 1\n", capture_output=True, text=True, timeout=30)
+    assert local.returncode == 1  # an error from a local command counts too
+    assert "error: goto: joints needs 7 values, got 1" in local.stdout
+
+
 def test_repl_goto_in_radians_and_its_errors(server, monkeypatch, capsys):
     text = (
         "goto 0.5,0,0,0,0,0,0 rate=1000\n"  # default step: 2 degrees = 0.0349 rad
@@ -286,7 +359,7 @@ def test_repl_goto_in_radians_and_its_errors(server, monkeypatch, capsys):
         "help\n"
         "goto 0.5,1.91,0,0,0,0,0 step=1 rate=1000\n"  # exactly at joint_l's limit
     )
-    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 0
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 1  # a line got an error
     out = capsys.readouterr().out
     assert "ok (goto: 15 steps" in out
     assert "error: goto: joints needs 7 values, got 2" in out
@@ -297,11 +370,19 @@ def test_repl_goto_in_radians_and_its_errors(server, monkeypatch, capsys):
     assert server.q[:2] == pytest.approx((0.5, 1.91))
 
 
+def test_repl_help_lists_each_command_once(server, monkeypatch, capsys):
+    assert run_repl(monkeypatch, "help\n", "--port", str(server.port)) == 0
+    listed = [line.split()[0] for line in capsys.readouterr().out.splitlines()[1:]]
+    listed = [word for word in listed if word not in ("server", "local")]  # the two headings
+    assert "where" in listed and "goto" in listed and "pose" in listed
+    assert len(listed) == len(set(listed)), sorted(w for w in listed if listed.count(w) > 1)
+
+
 def test_repl_file_stops_at_the_first_error(server, tmp_path, monkeypatch, capsys):
     bad = write(tmp_path, "bad.txt", BAD_LINE_3)
     limit = write(tmp_path, "limit.txt", LIMIT_LINE_3)
     text = f"file {bad}\nfile {limit}\nfile nonesuch.txt\nwhere\n"
-    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 0
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 1  # a line got an error
     out = capsys.readouterr().out
     assert f"{bad}:3: error: unknown command 'mvoe'" in out
     assert f"{limit}:3: error: joint_l (index 1) = 500 deg" in out

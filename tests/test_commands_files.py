@@ -35,9 +35,13 @@ def header(path: Path) -> str:
 
 
 def robot_of(path: Path) -> str:
+    """The robot the file declares (``# robot: NAME``), the one it says to start."""
+    declared = player.load_script(path).robot
+    assert declared, f"{path.name} has no '# robot: NAME' line"
     match = re.search(r"c2rviz --robot (\w+)", header(path))
-    assert match, f"{path.name} does not say which robot (`c2rviz --robot NAME`)"
-    return match.group(1)
+    assert match, f"{path.name} does not say how to start its robot (`c2rviz --robot NAME`)"
+    assert match.group(1) == declared, path.name
+    return declared
 
 
 def command_lines(path: Path) -> list[str]:

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import shutil
+
 import pytest
 from conftest import ROOT
 
 from c2rviz.cli import main
 from c2rviz.config import ServerLimits, find_ini, load_settings
 from c2rviz.errors import ConfigError
+from c2rviz.sources import load_source
 
 INI = ROOT / "cmdinterpreter.ini"
 
@@ -105,3 +108,55 @@ def test_port_zero_prints_the_port_it_picked(c2rviz_process):
     proc = c2rviz_process("--no-viewer")
     assert proc.port > 0
     assert any(f"commands on 127.0.0.1:{proc.port}" in line for line in proc.output)
+
+
+TINY_WS = ROOT / "tests" / "data" / "tiny_ws"
+FINGER_URI = "package://tiny_gripper/meshes/finger.stl"
+
+
+@pytest.mark.parametrize(
+    "entry",
+    ["tiny_gripper=../ws/src/gripper-checkout", "../ws", "../ws/src/gripper-checkout"],
+    ids=["name=dir", "workspace", "the-package-itself"],
+)
+def test_ini_package_path_takes_the_flags_forms_relative_to_the_ini(tmp_path, monkeypatch, entry):
+    shutil.copytree(TINY_WS, tmp_path / "ws")
+    ini = tmp_path / "cfg" / "my.ini"
+    ini.parent.mkdir()
+    ini.write_text(
+        f"[tiny]\nurdf = ../ws/src/tiny_description/urdf/tiny.urdf\npackage_path = {entry}\n"
+    )
+    monkeypatch.chdir(tmp_path / "ws")  # relative to the ini, not to here
+    settings = load_settings(ini, {"robot": "tiny"})
+    assert settings.urdf is not None
+    source = load_source(settings.urdf, settings.package_paths, environ={})
+    assert source.resolve(FINGER_URI) == tmp_path / "ws/src/gripper-checkout/meshes/finger.stl"
+
+
+@pytest.mark.parametrize(
+    ("entry", "folder", "named"),
+    [
+        ("kuka_kr6_support=../nope", "nope", " (for package kuka_kr6_support)"),
+        ("nope", "cfg/nope", ""),
+    ],
+    ids=["name=dir", "dir"],
+)
+def test_a_missing_ini_package_path_names_the_ini_key(tmp_path, capsys, entry, folder, named):
+    ini = tmp_path / "cfg" / "my.ini"
+    ini.parent.mkdir()
+    urdf = INI.parent / "robots/kuka_lwr/robot.urdf"
+    ini.write_text(
+        f"[options]\nrobot = kr6\n[kr6]\nurdf = {urdf}\npackage_path = {entry}\n"
+        f"[lwr]\nurdf = {urdf}\n"
+    )
+    expected = (
+        f"[kr6] package_path in {ini}: {str(tmp_path / folder)!r}{named} is not a folder "
+        "(entries are DIR or NAME=DIR, relative to the ini file)"
+    )
+    with pytest.raises(ConfigError) as info:
+        load_settings(ini, {})
+    assert str(info.value) == expected
+    assert load_settings(ini, {"robot": "lwr"}).urdf == urdf  # only the chosen one counts
+    assert main(["--config", str(ini), "--no-viewer"]) == 2
+    err = capsys.readouterr().err
+    assert err == f"c2rviz: {expected}\n" and "--package-path" not in err

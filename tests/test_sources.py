@@ -11,9 +11,10 @@ import pytest
 import trimesh
 from xacro import substitution_args
 
+from c2rviz.cli import main
 from c2rviz.errors import ConfigError, RobotError
 from c2rviz.robot import Robot
-from c2rviz.sources import RobotSource, load_source, parse_xacro_args
+from c2rviz.sources import RobotSource, load_source, parse_xacro_args, split_package_path
 
 DATA = Path(__file__).parent / "data"
 WS_SRC = DATA / "tiny_ws" / "src"
@@ -119,6 +120,24 @@ def test_missing_package_path_is_a_config_error(tmp_path: Path) -> None:
         load_source(TINY, [tmp_path / "nope"], environ=NO_ENV)
 
 
+def test_a_missing_name_dir_names_the_package(tmp_path: Path) -> None:
+    nope = tmp_path / "nope"
+    message = f"--package-path {str(nope)!r} (for package tiny_gripper) is not a folder"
+    with pytest.raises(ConfigError) as info:
+        load_source(TINY, [f"tiny_gripper={nope}"], environ=NO_ENV)
+    assert str(info.value) == message
+
+
+def test_split_package_path_forms(tmp_path: Path) -> None:
+    odd = tmp_path / "a=b"  # a folder whose own name holds '=' is a DIR
+    odd.mkdir()
+    assert split_package_path("a=b", tmp_path) == (None, odd)
+    assert split_package_path("pkg=x/y", tmp_path) == ("pkg", tmp_path / "x" / "y")
+    assert split_package_path("x/y", tmp_path) == (None, tmp_path / "x" / "y")
+    assert split_package_path(f"pkg={tmp_path}", Path("/elsewhere")) == ("pkg", tmp_path)
+    assert split_package_path("~/ws")[1] == Path.home() / "ws"
+
+
 def test_mesh_uris_survive_xml_that_elementtree_rejects() -> None:
     source = RobotSource('<robot name="x"><!-- a -- b --><link name="l"><visual><geometry>'
                          '<mesh filename="m.stl"/></geometry></visual></link></robot>')  # fmt: skip
@@ -143,15 +162,25 @@ def test_xacro_missing_argument_says_how_to_give_it() -> None:
         load_source(TINY_XACRO, environ=NO_ENV)
 
 
-def test_xacro_unknown_package(tmp_path: Path) -> None:
+@pytest.mark.parametrize(
+    "body",
+    [
+        '<link name="a"><visual><geometry><mesh filename="$(find no_such_pkg)/m.stl"/>'
+        "</geometry></visual></link>",
+        '<xacro:include filename="$(find no_such_pkg)/urdf/arm.xacro"/><link name="a"/>',
+    ],
+    ids=["in-an-attribute", "in-an-include"],
+)
+def test_xacro_unknown_package_is_one_sentence(tmp_path: Path, body: str) -> None:
     path = tmp_path / "r.xacro"
-    path.write_text(
-        '<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="a">'
-        '<visual><geometry><mesh filename="$(find no_such_pkg)/m.stl"/></geometry></visual>'
-        "</link></robot>"
-    )
-    with pytest.raises(RobotError, match="package 'no_such_pkg' not found"):
+    path.write_text(f'<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">{body}</robot>')
+    with pytest.raises(RobotError) as info:
         load_source(path, environ=NO_ENV)
+    assert str(info.value) == (
+        f"cannot expand {path}: package 'no_such_pkg' not found in --package-path, "
+        f"ROS_PACKAGE_PATH, AMENT_PREFIX_PATH or the folders above {tmp_path} "
+        "(give the folder that holds it with --package-path DIR or NAME=DIR)"
+    )
 
 
 @pytest.mark.parametrize("arg", ["length", ":=1", "length=1"])
@@ -163,3 +192,42 @@ def test_bad_xacro_argument(arg: str) -> None:
 def test_xacro_arguments_for_a_plain_urdf_are_refused() -> None:
     with pytest.raises(ConfigError, match="not a .xacro file"):
         load_source(TINY, (), ["length:=1"], environ=NO_ENV)
+
+
+SDF = """<?xml version="1.0"?>
+<!-- a model as Gazebo describes it -->
+<sdf version="1.7"><model name="arm"><link name="base"/></model></sdf>
+"""
+
+
+@pytest.mark.parametrize(
+    ("name", "text", "problem"),
+    [
+        ("arm.sdf", SDF, "its root element is <sdf>, not <robot> (an SDF file: c2rviz reads "
+         "URDF and xacro)"),
+        ("scene.xml", "<mujoco model='arm'/>", "its root element is <mujoco>, not <robot>"),
+        ("arm.urdf", "solid arm\nendsolid arm\n", "it is not XML (a URDF starts with <robot ...>)"),
+    ],
+    ids=["sdf", "mjcf", "not-xml"],
+)  # fmt: skip
+def test_a_file_that_is_not_a_urdf_gets_only_our_message(tmp_path, capfd, name, text, problem):
+    path = tmp_path / name
+    path.write_text(text)
+    with pytest.raises(RobotError) as info:
+        Robot.from_urdf(path)
+    assert str(info.value) == f"{path} is not a URDF: {problem}"
+    assert main(["--urdf", str(path), "--no-viewer"]) == 2
+    out, err = capfd.readouterr()  # fd 1 and 2: what urdfdom would print goes there
+    assert (out, err) == ("", f"c2rviz: {path} is not a URDF: {problem}\n")
+
+
+def test_a_urdf_with_a_declaration_comments_and_a_doctype_is_a_urdf(tmp_path, capfd):
+    path = tmp_path / "r.urdf"
+    path.write_text(
+        '\ufeff<?xml version="1.0"?>\n<!-- a -- b -->\n<!DOCTYPE robot>\n'
+        '<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="revolute">'
+        '<parent link="a"/><child link="b"/><limit lower="-1" upper="1" effort="1" '
+        'velocity="1"/></joint></robot>',
+        encoding="utf-8",
+    )
+    assert Robot.from_urdf(path).joint_names == ("j",)

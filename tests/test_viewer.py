@@ -438,3 +438,23 @@ def test_missing_meshes_warn_and_fall_back(
     h.call(lambda: h.world.set_q([0.5, -0.5]))
     h.run(0.05)
     assert_frames_match(h, [0.5, -0.5])
+
+
+MTL_ROBOT = Path(__file__).parent / "data" / "mtl_robot" / "robot.urdf"
+
+
+def test_a_urdf_material_wins_over_the_mesh_files_own_colour(
+    harness: Callable[..., Harness],
+) -> None:
+    """pybullet's kuka_iiwa: OBJ meshes with a near-white .mtl, URDF colours per link."""
+    robot = Robot.from_urdf(MTL_ROBOT)
+    links = load_link_geometry(robot.source)
+    [base], [tip] = links["base"].visual, links["tip"].visual
+    assert base.mesh is not None and tip.mesh is not None
+    for shape in (base, tip):  # the .mtl was read: the file has a colour of its own
+        assert shape.mesh is not None and shape.mesh.visual.defined
+        assert list(shape.mesh.visual.material.main_color) == [230, 230, 230, 255]
+    assert base.rgba == pytest.approx((1.0, 0.423529411765, 0.0392156862745, 1.0))
+    assert tip.rgba is None  # no URDF material: the file's colour is kept
+    nodes = harness(robot).scene.server.scene._handle_from_node_name
+    assert tuple(nodes["/robot/base/visual_0"].color) == pytest.approx((255, 108, 10), abs=1)
