@@ -238,25 +238,32 @@ class Clear:
 
 @verb(
     "mark",
-    "[x,y,z,roll,pitch,yaw]",
-    "drop a marker at that pose in the base frame (metres; angles in the connection's unit); "
-    "without a pose, at the end effector",
+    "[world] [x,y,z,roll,pitch,yaw]",
+    "drop a marker at that pose in the base frame (metres; angles in the connection's unit), "
+    "or with `world` in the world (cell) frame; without a pose, at the end effector",
 )
 @dataclass(frozen=True, slots=True)
 class Mark:
     """Drop a marker at ``pose`` (x, y, z [m], roll, pitch, yaw [client's units]).
 
-    ``pose`` is None for a marker at the current end-effector pose.
+    ``pose`` is None for a marker at the current end-effector pose; ``in_world``
+    puts it in the world (cell) frame instead of the robot's base frame.
     """
 
     pose: tuple[float, float, float, float, float, float] | None
+    in_world: bool = False
 
     @staticmethod
     def parse(verb: str, words: list[str]) -> Mark:
+        in_world = bool(words) and words[0].lower() == "world"
+        if in_world:
+            words = words[1:]
+            if not words:
+                raise BadArguments(verb, "world needs a pose", usage(verb))
         if not words:
             return Mark(None)
         x, y, z, roll, pitch, yaw = numbers_arg(verb, words, 6)
-        return Mark((x, y, z, roll, pitch, yaw))
+        return Mark((x, y, z, roll, pitch, yaw), in_world)
 
 
 @verb(
@@ -452,4 +459,5 @@ def parse_line(line: str) -> object | None:
 
 
 # The verbs beyond the seed's, one module per concern (they use the pieces above).
+from .lang import cell as _cell  # noqa: E402, F401
 from .lang import motion as _motion  # noqa: E402, F401

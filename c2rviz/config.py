@@ -190,9 +190,11 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
                 )
     robots = {}
     for section in parser.sections():
-        if section == "options":
+        if section == "options" or section.startswith("cell:"):
             continue
         items = dict(parser.items(section))
+        if "robot" in items:  # a member of a cell (see cell.py), not a robot of its own
+            continue
         unknown = set(items) - set(_ROBOT_KEYS)
         if unknown:
             raise ConfigError(

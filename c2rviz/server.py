@@ -40,7 +40,7 @@ class Connection(asyncio.Protocol):
     def __init__(self, server: CommandServer) -> None:
         self.server = server
         self.limits = server.limits
-        self.session = Session(server.world, limits=server.limits)
+        self.session = Session(server.world, limits=server.limits, robot=server.robot)
         self.transport: asyncio.Transport | None = None
         self.peer = "?"
         self.buffer = b""
@@ -338,6 +338,7 @@ class CommandServer:
         world: World,
         limits: ServerLimits | None = None,
         on_quit: Callable[[], None] | None = None,
+        robot: str | None = None,
     ) -> None:
         """Set up the server; ``start`` makes it listen.
 
@@ -345,10 +346,13 @@ class CommandServer:
             world: The shared state every client acts on.
             limits: What one client may cost.
             on_quit: Called once when a client sends ``quit``.
+            robot: The robot its clients drive until they say ``robot NAME`` (None:
+                the world's default).
         """
         self.world = world
         self.limits = limits if limits is not None else ServerLimits()
         self.on_quit = on_quit
+        self.robot = robot
         self.connections: set[Connection] = set()  # the clients being served
         self.open: set[Connection] = set()  # those and the refused ones, until their socket closes
         self.stopping = False

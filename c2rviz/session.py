@@ -93,7 +93,11 @@ class Session:
         self.select(robot)
 
     def select(self, name: str | None) -> None:
-        """Drive robot ``name`` from now on (None: the world's default robot)."""
+        """Drive robot ``name`` from now on (None: the world's default robot).
+
+        Raises:
+            UnknownRobot: naming the robots there are; nothing changes.
+        """
         self.state: RobotState = self.world.state(name)
         self.robot = self.state.robot
         self.n = self.robot.n  # Robot.n is a property; this is read per command

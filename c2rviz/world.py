@@ -39,6 +39,8 @@ class RobotState:
         q: The chain's values shown now [rad or m].
         target: The values it was last commanded to [rad or m].
         markers: Its markers, in the world frame, oldest first.
+        origin: Where its model's root stands in the world (the cell) frame.
+        port: The command port that drives it by default (None: not known here).
     """
 
     name: str
@@ -46,6 +48,8 @@ class RobotState:
     q: tuple[float, ...] = ()
     target: tuple[float, ...] = ()
     markers: deque[Marker] = field(default_factory=lambda: deque(maxlen=MAX_MARKERS))
+    origin: pin.SE3 = field(default_factory=pin.SE3.Identity)
+    port: int | None = None
     travel: Travel = field(init=False, repr=False)
     """Its motion (set by the world)."""
 
@@ -66,6 +70,7 @@ class World:
         hz: float = 100.0,
         limits: Mapping[str, MotionLimits] | None = None,
         defaults: SessionDefaults | None = None,
+        origins: Mapping[str, pin.SE3] | None = None,
     ) -> None:
         """Set up the world.
 
@@ -78,9 +83,13 @@ class World:
             hz: Samples per second of a moving arm [1/s].
             limits: Motion limits by robot name (default: from each URDF).
             defaults: How a new session starts (motion mode, speed).
+            origins: Where each robot's root stands in the world frame (default: at
+                the world's origin).
         """
         named = {robots.name: robots} if isinstance(robots, Robot) else dict(robots)
         self.robots = {name: RobotState(name, robot) for name, robot in named.items()}
+        for name, origin in (origins or {}).items():
+            self.state(name).origin = origin
         self.default = next(iter(self.robots))
         self.observers: list[Observer] = [scene] if scene is not None else []
         self.rng = rng if rng is not None else np.random.default_rng()
@@ -141,15 +150,20 @@ class World:
 
     def add_marker(
         self,
-        pose_in_base: pin.SE3 | None,
+        pose: pin.SE3 | None,
         rgb: tuple[float, float, float],
         shape: str,
         robot: str | None = None,
+        in_world: bool = False,
     ) -> Marker:
-        """Drop a marker at ``pose_in_base``, or at the end effector when None."""
+        """Drop a marker at ``pose`` in the robot's base frame (``in_world``: in the world
+        frame), or at the end effector when None."""
         state = self.state(robot)
-        in_base = state.robot.ee_pose(state.q) if pose_in_base is None else pose_in_base
-        placement = state.robot.base_placement * in_base
+        if in_world and pose is not None:
+            placement = pose
+        else:
+            in_base = state.robot.ee_pose(state.q) if pose is None else pose
+            placement = state.origin * state.robot.base_placement * in_base
         x, y, z, w = pin.Quaternion(placement.rotation).coeffs()
         px, py, pz = placement.translation
         marker = Marker(

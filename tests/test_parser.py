@@ -32,6 +32,7 @@ from c2rviz.commands import (
     parse_line,
 )
 from c2rviz.errors import BadArguments, C2rvizError, LineError, UnknownCommand
+from c2rviz.lang.cell import RobotChoice, RobotsList
 from c2rviz.lang.motion import MotionMode, Speed, Status, Stop, Target, Wait
 
 GOOD = [
@@ -62,6 +63,10 @@ GOOD = [
     ("clear", Clear(), "clear"),
     ("mark", Mark(None), "mark-here"),
     ("mark 1,2,3,0,0,90", Mark((1.0, 2.0, 3.0, 0.0, 0.0, 90.0)), "mark-pose"),
+    ("mark WORLD 1,2,3,0,0,90", Mark((1.0, 2.0, 3.0, 0.0, 0.0, 90.0), True), "mark-world"),
+    ("robot", RobotChoice(None), "robot-ask"),
+    ("robot right_arm", RobotChoice("right_arm"), "robot-choose"),
+    ("robots", RobotsList(), "robots"),
     ("color 0,0.5,1", Color((0.0, 0.5, 1.0)), "color"),
     ("rgb 0,255,51", Color((0.0, 1.0, 0.2)), "rgb"),
     ("marker CUBE", MarkerShape("cube"), "marker"),
@@ -140,6 +145,9 @@ BAD = [
     ("mark 1,2,3", BadArguments, "mark: needs 6 values, got 3", "mark-three"),
     ("mark 1,2,3,4,5,6,7", BadArguments, "needs 6 values, got 7", "mark-seven"),
     ("mark 1,2,3,0,0,inf", BadArguments, "bad number 'inf'", "mark-inf"),
+    ("mark world", BadArguments, "mark: world needs a pose", "mark-world-nothing"),
+    ("robot a/b", BadArguments, "robot: bad robot name 'a/b'", "robot-slash"),
+    ("robot a b", BadArguments, "robot: takes 1 argument, got 2", "robot-two"),
     ("color 1,1", BadArguments, "color: needs 3 values, got 2", "color-two"),
     ("color 1,1,1,1", BadArguments, "needs 3 values, got 4", "color-four"),
     ("color 0,0,1.5", BadArguments, "channel 1.5 is outside 0..1", "color-over"),

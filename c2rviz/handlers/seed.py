@@ -103,7 +103,9 @@ def mark(session: Session, command: Mark) -> str:
         angle = session.angle_scale
         rotation = pin.rpy.rpyToMatrix(roll * angle, pitch * angle, yaw * angle)
         pose = pin.SE3(rotation, np.array([x, y, z]))
-    session.world.add_marker(pose, session.rgb, session.shape, session.state.name)
+    session.world.add_marker(
+        pose, session.rgb, session.shape, session.state.name, in_world=command.in_world
+    )
     return replies.OK
 
 

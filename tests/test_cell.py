@@ -1,0 +1,231 @@
+"""Several robots in one cell: one world, a command server per robot, robots by name."""
+
+from __future__ import annotations
+
+import asyncio
+import math
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest import ROOT, Client, load_robot
+
+from c2rviz.cell import load_cell
+from c2rviz.config import ServerLimits
+from c2rviz.errors import ConfigError
+from c2rviz.scene import RecordingScene
+from c2rviz.server import CommandServer
+from c2rviz.world import World
+
+LEFT = "0,0,0,0,0,0"
+RIGHT = "1.2,0,0,0,0,180"
+
+
+def se3(x: float, y: float, z: float, roll: float, pitch: float, yaw: float) -> pin.SE3:
+    return pin.SE3(pin.rpy.rpyToMatrix(roll, pitch, yaw), np.array([x, y, z]))
+
+
+class CellThread:
+    """A world of several robots and a real command server for each, on one loop."""
+
+    def __init__(self, robots: dict[str, str], origins: dict[str, pin.SE3]) -> None:
+        self.loop = asyncio.new_event_loop()
+        self.scene = RecordingScene()
+        self.world = World(
+            {name: load_robot(model) for name, model in robots.items()},
+            self.scene,
+            origins=origins,
+        )
+        self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
+        self.thread.start()
+        self.servers: dict[str, CommandServer] = {}
+        self.ports: dict[str, int] = {}
+        for name in robots:
+            server = CommandServer(self.world, ServerLimits(), robot=name)
+            _, port = self.run(server.start("127.0.0.1", 0))
+            self.world.state(name).port = port
+            self.servers[name], self.ports[name] = server, port
+
+    def run(self, coro):  # type: ignore[no-untyped-def]
+        return asyncio.run_coroutine_threadsafe(coro, self.loop).result(timeout=10)
+
+    def call(self, fn):  # type: ignore[no-untyped-def]
+        async def on_loop():  # type: ignore[no-untyped-def]
+            return fn()
+
+        return self.run(on_loop())
+
+    def client(self, name: str) -> Client:
+        return Client("127.0.0.1", self.ports[name])
+
+    def stop(self) -> None:
+        for server in self.servers.values():
+            self.run(server.stop())
+        self.loop.call_soon_threadsafe(self.loop.stop)
+        self.thread.join(timeout=10)
+        self.loop.close()
+
+
+@pytest.fixture
+def cell() -> Iterator[CellThread]:
+    made = CellThread(
+        {"left": "motoman_sia20d", "right": "fanuc_lrmate200id"},
+        {"left": se3(0, 0, 0, 0, 0, 0), "right": se3(1.2, 0, 0, 0, 0, math.pi)},
+    )
+    clients: list[Client] = []
+    made.client = lambda name, client=made.client: clients.append(client(name)) or clients[-1]  # type: ignore[method-assign]
+    yield made
+    for client in clients:
+        client.close()
+    made.stop()
+
+
+def test_each_port_drives_its_own_robot(cell: CellThread):
+    left, right = cell.client("left"), cell.client("right")
+    assert left.ask("names").startswith("ok motoman_sia20d joint_s,")
+    assert right.ask("names").startswith("ok fanuc_lrmate200id joint_1,")
+    assert left.ask("robot") == "ok left" and right.ask("robot") == "ok right"
+    left.ask("degrees")
+    right.ask("degrees")
+    left.send("j 10,0,0,0,0,0,0\n" * 50)
+    right.send("j 0,20,0,0,0,0\n" * 50)
+    assert [left.read_line() for _ in range(50)] == ["ok"] * 50
+    assert [right.read_line() for _ in range(50)] == ["ok"] * 50
+    assert left.ask("where") == "ok 10,0,0,0,0,0,0"
+    assert right.ask("where") == "ok 0,20,0,0,0,0"
+    assert cell.ports["left"] != cell.ports["right"]
+    assert left.ask("robots") == f"ok left:{cell.ports['left']},right:{cell.ports['right']}"
+
+
+def test_robot_switches_a_connection_and_an_unknown_name_changes_nothing(cell: CellThread):
+    client = cell.client("left")
+    client.ask("degrees")
+    assert client.ask("robot nobody") == "error: no robot 'nobody' here; robots: left, right"
+    assert client.ask("robot") == "ok left"
+    assert client.ask("robot right") == "ok"
+    assert client.ask("j 0,30,0,0,0,0") == "ok"  # 6 joints now: the Fanuc
+    assert client.ask("where") == "ok 0,30,0,0,0,0"
+    assert client.ask("robot left") == "ok"
+    assert client.ask("where") == "ok 0,0,0,0,0,0,0"  # units stayed degrees
+    assert cell.client("right").ask("where").startswith("ok 0,0.5235987756,")
+
+
+def test_markers_in_the_base_frame_and_in_the_world_frame(cell: CellThread):
+    client = cell.client("right")
+    assert client.ask("mark 0.5,0,0.2,0,0,0") == "ok"
+    assert client.ask("mark world 0.5,0,0.2,0,0,0") == "ok"
+    base, world = cell.call(lambda: list(cell.world.state("right").markers))
+    robot = load_robot("fanuc_lrmate200id")
+    expected = se3(1.2, 0, 0, 0, 0, math.pi) * robot.base_placement
+    np.testing.assert_allclose(base.position, expected * np.array([0.5, 0.0, 0.2]), atol=1e-12)
+    np.testing.assert_allclose(world.position, [0.5, 0.0, 0.2], atol=1e-12)
+
+
+def test_the_same_model_twice_with_different_origins() -> None:
+    cell = CellThread(
+        {"a": "motoman_sia20d", "b": "motoman_sia20d"},
+        {"a": se3(0, -0.8, 0, 0, 0, 0), "b": se3(0, 0.8, 0, 0, 0, 0)},
+    )
+    try:
+        a, b = cell.client("a"), cell.client("b")
+        a.ask("rand")
+        assert b.ask("where") == "ok 0,0,0,0,0,0,0"
+        assert a.ask("mark") == b.ask("mark") == "ok"
+        ma, mb = cell.call(
+            lambda: (cell.world.state("a").markers[0], cell.world.state("b").markers[0])
+        )
+        assert mb.position[1] == pytest.approx(
+            0.8 + load_robot().ee_pose(load_robot().home).translation[1]
+        )
+        assert ma.position != mb.position
+        a.close()
+        b.close()
+    finally:
+        cell.stop()
+
+
+CELL_INI = """
+[options]
+robot = motoman_sia20d
+
+[motoman_sia20d]
+base = base_link
+eelink = link_t
+urdf = {root}/robots/motoman_sia20d/robot.urdf
+
+[fanuc_lrmate200id]
+base = base_link
+eelink = link_6
+urdf = {root}/robots/fanuc_lrmate200id/robot.urdf
+
+[cell:twoarms]
+robots = left right
+
+[left]
+robot = motoman_sia20d
+origin = 0,0,0,0,0,0
+port = 31000
+
+[right]
+robot = fanuc_lrmate200id
+origin = 1.2,0,0,0,0,180
+port = 31001
+"""
+
+
+def write_ini(tmp_path: Path, text: str) -> Path:
+    path = tmp_path / "cell.ini"
+    path.write_text(text.format(root=ROOT))
+    return path
+
+
+def test_a_cell_from_the_ini(tmp_path: Path):
+    ini = write_ini(tmp_path, CELL_INI)
+    for spec, where in (("twoarms", ini), (str(ini), None)):
+        cell = load_cell(spec, where)
+        assert cell.name == "twoarms"
+        assert [(m.name, m.entry.name, m.port) for m in cell.members] == [
+            ("left", "motoman_sia20d", 31000),
+            ("right", "fanuc_lrmate200id", 31001),
+        ]
+        assert cell.members[1].origin == pytest.approx((1.2, 0, 0, 0, 0, math.pi))
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (("port = 31001", "port = 31000"), "uses port 31000 twice (left and right)"),
+        (("robot = fanuc_lrmate200id", "robot = nosuch"), "unknown robot 'nosuch'"),
+        (("origin = 1.2,0,0,0,0,180", "origin = 1.2,0,0,0,0"), "origin = '1.2,0,0,0,0' must be 6"),
+        (("origin = 1.2,0,0,0,0,180", "origin = a,0,0,0,0,0"), "must be 6 numbers"),
+        (("robots = left right", "robots = left left"), "uses name left twice"),
+        (("robots = left right", "robots = left middle"), "names robot 'middle', which has no"),
+        (("port = 31001", "port = 70000"), "[right] port = 70000 is outside 0..65535"),
+        (("port = 31001", "colour = red"), "unknown key 'colour' in [right]"),
+    ],
+    ids=[
+        "duplicate-port",
+        "unknown-robot",
+        "five-numbers",
+        "bad-number",
+        "name-twice",
+        "no-section",
+        "port-range",
+        "unknown-key",
+    ],
+)
+def test_bad_cells_name_what_is_wrong(tmp_path: Path, change: tuple[str, str], message: str):
+    ini = write_ini(tmp_path, CELL_INI.replace(*change))
+    with pytest.raises(ConfigError) as caught:
+        load_cell("twoarms", ini)
+    assert message in str(caught.value)
+    assert "\n" not in str(caught.value)
+
+
+def test_an_unknown_cell_lists_the_cells(tmp_path: Path):
+    ini = write_ini(tmp_path, CELL_INI)
+    with pytest.raises(ConfigError, match=r"no \[cell:three\] in .* \(choose from: twoarms\)"):
+        load_cell("three", ini)
