@@ -146,6 +146,21 @@ def test_a_pair_touching_in_nearly_every_sample_is_not_checked() -> None:
     assert unsampled.colliding([0.0, 0.0]) == []
 
 
+@pytest.mark.parametrize("name", ["slot", "fanuc_lrmate200id"])
+def test_sampling_stops_early_with_the_answer_of_every_draw(name: str) -> None:
+    """Dropping pairs that missed too often changes nothing: count every draw here."""
+    robot = Robot.from_urdf(SLOT) if name == "slot" else load_robot(name)
+    every = CollisionModel(robot, samples=0)  # checks every pair not touching at home
+    rng = np.random.default_rng(4)
+    counts: dict[tuple[str, str], int] = {}
+    for _ in range(400):
+        for pair in every.colliding(robot.random(rng)):
+            counts[pair] = counts.get(pair, 0) + 1
+    expected = {pair for pair, n in counts.items() if n >= 380}
+    assert CollisionModel(robot, samples=400, seed=4).self_pairs.always == expected
+    assert (expected == {("link1", "rod")}) == (name == "slot")
+
+
 def test_the_chosen_pairs_follow_the_seed() -> None:
     robot = Robot.from_urdf(SLOT)
     first = CollisionModel(robot, samples=300, seed=7).self_pairs
