@@ -262,14 +262,15 @@ def test_the_token_is_required_when_set(served: Callable[..., Served]) -> None:
     assert refused_status(lambda: s.connect(path="/?token=")) == 403
     with s.connect(f"http://localhost:{s.port}", path="/?token=s3cret") as ws:
         ws.recv(timeout=10)
-    page = f"http://127.0.0.1:{s.port}/"
-    with pytest.raises(urllib.error.HTTPError) as no_token:
-        urllib.request.urlopen(page, timeout=10)
-    assert no_token.value.code == 403
-    no_token.value.close()
-    with urllib.request.urlopen(page + "?token=s3cret", timeout=10) as ok:
+    page = f"http://127.0.0.1:{s.port}"
+    for spelling in ("/", "/index.html", "/%69ndex.html", "/./index.html", "//"):
+        with pytest.raises(urllib.error.HTTPError) as no_token:
+            urllib.request.urlopen(page + spelling, timeout=10)
+        assert no_token.value.code == 403, spelling
+        no_token.value.close()
+    with urllib.request.urlopen(page + "/?token=s3cret", timeout=10) as ok:
         assert b"<html" in ok.read().lower()
-    assert s.door.refused == {"token": 4}
+    assert s.door.refused == {"token": 8}
 
 
 def test_the_page_url_carries_the_token_to_the_websocket(served: Callable[..., Served]) -> None:
@@ -369,6 +370,23 @@ def test_a_bad_message_changes_nothing_and_reaches_no_other_tab(
     assert s.own_callbacks == []
     assert s.server._share_tunnel is None
     assert sum(s.door.refused.values()) == 1
+
+
+def test_share_links_and_uploads_are_refused_by_name(
+    served: Callable[..., Served], caplog: pytest.LogCaptureFixture
+) -> None:
+    s = served()
+    frames = bad_messages(s.slider._impl.uuid, s.checkbox._impl.uuid)
+    with caplog.at_level(logging.WARNING, logger="c2rviz.view"), s.connect() as page:
+        for name in ("share-request", "share-disconnect", "upload-start", "upload-part"):
+            page.send(frames[name])
+        page.send(gui_update(s.button._impl.uuid, {"value": True}))
+        s.wait(lambda: len(s.calls) == 1, "the button")
+    assert s.door.refused == {"share": 2, "upload": 2}
+    assert [r.getMessage() for r in caplog.records] == [
+        "dropped a share-link request (the public tunnel is disabled) from a viewer page",
+        "dropped a file upload (the viewer takes none) from a viewer page",
+    ]
 
 
 def test_good_values_go_to_the_callback_only(served: Callable[..., Served]) -> None:

@@ -31,7 +31,7 @@ from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from http import HTTPStatus
 from typing import Any
-from urllib.parse import urlsplit
+from urllib.parse import unquote, urlsplit
 
 import msgspec
 from websockets.asyncio.server import ServerConnection
@@ -77,10 +77,24 @@ class _Camera(msgspec.Struct, forbid_unknown_fields=True):
     up_direction: tuple[float, float, float]
 
 
+# Messages a page of this viser version sends but the viewer refuses: (kind, what).
+_REFUSED = {
+    "ShareUrlRequest": ("share", "a share-link request (the public tunnel is disabled)"),
+    "ShareUrlDisconnect": ("share", "a share-link request (the public tunnel is disabled)"),
+    "FileTransferStartUpload": ("upload", "a file upload (the viewer takes none)"),
+    "FileTransferPart": ("upload", "a file upload (the viewer takes none)"),
+}
 CAMERA_FIELDS = tuple(f for f in _Camera.__struct_fields__ if f != "type")
 _ENVELOPE = msgspec.msgpack.Decoder(_Envelope)
 _GUI_UPDATE = msgspec.msgpack.Decoder(_GuiUpdate)
 _CAMERA = msgspec.msgpack.Decoder(_Camera)
+
+
+def _is_page(path: str) -> bool:
+    """Whether viser answers the request target ``path`` with the page (index.html)."""
+    text = unquote(urlsplit(path).path).replace("\\", "/")
+    segments = [s for s in text.split("/") if s and s != "."]
+    return "/".join(segments) in ("", "index.html")
 
 
 def _camera_ok(frame: bytes) -> bool:
@@ -106,8 +120,9 @@ class Door:
         host: The host the viewer serves (one of its origins, unless a wildcard).
         subprotocol: The websocket subprotocol of the page served
             (``viser-v<version>``); a page of another viser version is refused.
-        refused: Refusals so far, by kind (``origin``, ``token``, ``version``,
-            ``full``, ``frame``, ``message``, ``input``, ``oversize``, ...).
+        refused: Refusals so far, by kind: ``origin``, ``token``, ``version``,
+            ``full`` (handshakes); ``frame``, ``message``, ``share``, ``upload``,
+            ``input``, ``oversize`` (frames); ``handler``, ``lagging``.
         connections: Every websocket being handled, admitted or being refused.
         clients: The admitted websockets, each with the door's own number.
         identify: Maps an admitted websocket to the client id handed to input
@@ -153,8 +168,8 @@ class Door:
     def process_request(self, connection: ServerConnection, request: Request) -> Response | None:
         """Refuse a websocket from a foreign origin or without the token; None lets it on."""
         if request.headers.get("Upgrade", "").lower() != "websocket":
-            if self.policy.token_ok(request.path) or urlsplit(request.path).path not in ("/", ""):
-                return None  # the page's other files are viser's public client build
+            if self.policy.token_ok(request.path) or not _is_page(request.path):
+                return None  # no other file of viser's client build holds anything of ours
             self.refuse("token", "page", "refused the viewer page without its token")
             return connection.respond(HTTPStatus.FORBIDDEN, "open the URL c2rviz printed\n")
         origin = request.headers.get("Origin")
@@ -232,6 +247,8 @@ class Door:
             return None
         if kind == "GuiUpdateMessage":
             self._input(connection, frame)
+        elif kind in _REFUSED:
+            self._drop(*_REFUSED[kind])
         elif kind != "ViewerCameraMessage":
             self._drop("message", f"a {shown(kind)} message (the viewer does not take it)")
         elif _camera_ok(frame):
