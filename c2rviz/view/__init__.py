@@ -1,0 +1,1 @@
+"""The browser view: viser, reached through one adapter, behind one door."""

@@ -1,0 +1,312 @@
+"""The viewer's websocket door: who may connect, and what a page may say.
+
+viser serves the page and its websocket on one port and trusts both: any web
+page the user visits may open that websocket (browsers do not hold websockets
+to the same-origin rule), and viser applies whatever fields a page sends. The
+adapter (``view.adapter``) puts a ``Door`` in front of viser's websocket server:
+
+* the opening handshake (``process_request``): a websocket only from one of
+  the viewer's origins (``policy.DoorPolicy.origins``); a request without
+  ``Origin`` is not from a browser and is let on. With a token set, the
+  websocket and the page both need ``?token=...``. Refused: HTTP 403.
+* the connection (``handle``): the page's viser version, and at most
+  ``max_clients`` tabs (one more is closed with code 1013 and a reason).
+* each frame (``screen``), already bounded in size by the server
+  (``max_frame_bytes``): a camera update goes on to viser; ``{"value": v}`` for
+  an input the viewer registered goes to the viewer's callback and never to
+  viser (which would apply and re-broadcast it); everything else is dropped.
+
+Every refusal is counted in ``refused`` and logged on one line, at most once a
+minute per kind (per origin for origins). This module uses websockets' public
+API and viser's wire format, nothing private.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from collections import Counter
+from collections.abc import Awaitable, Callable
+from dataclasses import dataclass
+from http import HTTPStatus
+from typing import Any
+from urllib.parse import unquote, urlsplit
+
+import msgspec
+from websockets.asyncio.server import ServerConnection
+from websockets.exceptions import ConnectionClosed
+from websockets.frames import CloseCode
+from websockets.http11 import Request, Response
+
+from ..errors import shown
+from .policy import DoorPolicy
+from .ratelog import RateLimitedLog
+
+__all__ = ["CAMERA_FIELDS", "Door", "GuardedConnection", "InputCallback"]
+
+log = logging.getLogger("c2rviz.view")
+
+InputCallback = Callable[[int, "bool | float"], None]
+
+
+class _Envelope(msgspec.Struct):
+    type: str
+
+
+class _Value(msgspec.Struct, forbid_unknown_fields=True):
+    value: bool | float
+
+
+class _GuiUpdate(msgspec.Struct, forbid_unknown_fields=True):
+    type: str
+    uuid: str
+    updates: _Value
+
+
+class _Camera(msgspec.Struct, forbid_unknown_fields=True):
+    type: str
+    wxyz: tuple[float, float, float, float]
+    position: tuple[float, float, float]
+    fov: float
+    near: float
+    far: float
+    image_height: int
+    image_width: int
+    look_at: tuple[float, float, float]
+    up_direction: tuple[float, float, float]
+
+
+# Messages a page of this viser version sends but the viewer refuses: (kind, what).
+_REFUSED = {
+    "ShareUrlRequest": ("share", "a share-link request (the public tunnel is disabled)"),
+    "ShareUrlDisconnect": ("share", "a share-link request (the public tunnel is disabled)"),
+    "FileTransferStartUpload": ("upload", "a file upload (the viewer takes none)"),
+    "FileTransferPart": ("upload", "a file upload (the viewer takes none)"),
+}
+CAMERA_FIELDS = tuple(f for f in _Camera.__struct_fields__ if f != "type")
+_ENVELOPE = msgspec.msgpack.Decoder(_Envelope)
+_GUI_UPDATE = msgspec.msgpack.Decoder(_GuiUpdate)
+_CAMERA = msgspec.msgpack.Decoder(_Camera)
+
+
+def _is_page(path: str) -> bool:
+    """Whether viser answers the request target ``path`` with the page (index.html)."""
+    text = unquote(urlsplit(path).path).replace("\\", "/")
+    segments = [s for s in text.split("/") if s and s != "."]
+    return "/".join(segments) in ("", "index.html")
+
+
+def _camera_ok(frame: bytes) -> bool:
+    try:
+        c = _CAMERA.decode(frame)
+    except msgspec.MsgspecError:
+        return False
+    numbers = (*c.wxyz, *c.position, c.fov, c.near, c.far, *c.look_at, *c.up_direction)
+    return all(map(math.isfinite, numbers))
+
+
+@dataclass(frozen=True)
+class _Input:
+    kind: type
+    callback: InputCallback
+
+
+class Door:
+    """The checks in front of one viser websocket server; see the module docstring.
+
+    Attributes:
+        policy: The limits and the allowed origins.
+        host: The host the viewer serves (one of its origins, unless a wildcard).
+        subprotocol: The websocket subprotocol of the page served
+            (``viser-v<version>``); a page of another viser version is refused.
+        refused: Refusals so far, by kind: ``origin``, ``token``, ``version``,
+            ``full`` (handshakes); ``frame``, ``message``, ``share``, ``upload``,
+            ``input``, ``oversize`` (frames); ``handler``, ``lagging``.
+        connections: Every websocket being handled, admitted or being refused.
+        clients: The admitted websockets, each with the door's own number.
+        identify: Maps an admitted websocket to the client id handed to input
+            callbacks; the adapter sets it to viser's client id.
+    """
+
+    def __init__(
+        self,
+        policy: DoorPolicy,
+        host: str,
+        subprotocol: str,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.policy = policy
+        self.subprotocol = subprotocol
+        self.refused: Counter[str] = Counter()
+        self.connections: set[ServerConnection] = set()
+        self.clients: dict[ServerConnection, int] = {}
+        self.identify: Callable[[ServerConnection], int] = lambda c: self.clients.get(c, -1)
+        self._serial = 0
+        self._inputs: dict[str, _Input] = {}
+        self.host = host
+        self._log = RateLimitedLog(log, policy.log_interval_s, clock)
+
+    # what the viewer registers
+
+    def accept_input(self, uuid: str, kind: type, callback: InputCallback) -> None:
+        """Hand ``{"value": v}`` for ``uuid`` to ``callback(client_id, v)``.
+
+        ``kind`` is ``bool`` (a checkbox or button: only true/false) or
+        ``float`` (a slider or number: any finite number, as a float). The
+        callback runs on viser's thread and must return at once.
+        """
+        if kind not in (bool, float):
+            raise TypeError(f"an input's kind is bool or float, not {kind!r}")
+        self._inputs[uuid] = _Input(kind, callback)
+
+    def forget_input(self, uuid: str) -> None:
+        self._inputs.pop(uuid, None)
+
+    # the opening handshake (viser's event loop)
+
+    def process_request(self, connection: ServerConnection, request: Request) -> Response | None:
+        """Refuse a websocket from a foreign origin or without the token; None lets it on."""
+        if request.headers.get("Upgrade", "").lower() != "websocket":
+            if self.policy.token_ok(request.path) or not _is_page(request.path):
+                return None  # no other file of viser's client build holds anything of ours
+            self.refuse("token", "page", "refused the viewer page without its token")
+            return connection.respond(HTTPStatus.FORBIDDEN, "open the URL c2rviz printed\n")
+        origin = request.headers.get("Origin")
+        port = int(connection.local_address[1])
+        if origin is not None and not self.policy.origin_ok(origin, self.host, port):
+            self.refuse(
+                "origin",
+                f"origin {origin}",
+                f"refused a viewer websocket from origin {shown(origin, 80)}: allowed are "
+                f"{', '.join(self.policy.origins(self.host, port))}",
+            )
+            return connection.respond(HTTPStatus.FORBIDDEN, "origin not allowed\n")
+        if not self.policy.token_ok(request.path):
+            self.refuse("token", "websocket", "refused a viewer websocket without the token")
+            return connection.respond(HTTPStatus.FORBIDDEN, "token required\n")
+        return None
+
+    # the connection (viser's event loop)
+
+    async def handle(
+        self,
+        connection: ServerConnection,
+        inner: Callable[[ServerConnection], Awaitable[None]],
+    ) -> None:
+        """Check the version and the client count, then run viser's handler ``inner``."""
+        self.connections.add(connection)
+        try:
+            if connection.subprotocol != self.subprotocol:
+                got = connection.subprotocol or "no viser version"
+                self.refuse(
+                    "version",
+                    "version",
+                    f"refused a viewer page speaking {shown(got)}: this viewer speaks "
+                    f"{self.subprotocol} (reload the page)",
+                )
+                version = self.subprotocol.removeprefix("viser-v")
+                await connection.close(
+                    CloseCode.PROTOCOL_ERROR,
+                    f"Version mismatch. Client: {got.removeprefix('viser-v')[:20]}, "
+                    f"Server: {version}",
+                )
+                return
+            if len(self.clients) >= self.policy.max_clients:
+                limit = self.policy.max_clients
+                self.refuse("full", "full", f"refused a viewer tab: {limit} are connected")
+                await connection.close(
+                    CloseCode.TRY_AGAIN_LATER, f"viewer full: {limit} tabs open; close one"
+                )
+                return
+            self._serial += 1
+            self.clients[connection] = number = self._serial
+            try:
+                await inner(connection)
+            except Exception as error:  # one line, not websockets' traceback per frame
+                self.refuse(
+                    "handler", "handler", f"viewer client {number}: {shown(repr(error), 80)}"
+                )
+                log.debug("viewer client %d", number, exc_info=True)
+            finally:
+                del self.clients[connection]
+        finally:
+            self.connections.discard(connection)
+
+    # each frame (viser's event loop)
+
+    def screen(self, connection: ServerConnection, frame: str | bytes) -> bytes | None:
+        """Return a frame viser may read, or None after handling or dropping it."""
+        if isinstance(frame, str):
+            self._drop("frame", "a text frame")
+            return None
+        try:
+            kind = _ENVELOPE.decode(frame).type
+        except msgspec.MsgspecError:
+            self._drop("frame", "a frame that is not a viser message")
+            return None
+        if kind == "GuiUpdateMessage":
+            self._input(connection, frame)
+        elif kind in _REFUSED:
+            self._drop(*_REFUSED[kind])
+        elif kind != "ViewerCameraMessage":
+            self._drop("message", f"a {shown(kind)} message (the viewer does not take it)")
+        elif _camera_ok(frame):
+            return frame
+        else:
+            self._drop("message", "a camera update that is malformed or not finite")
+        return None
+
+    def _input(self, connection: ServerConnection, frame: bytes) -> None:
+        try:
+            update = _GUI_UPDATE.decode(frame)
+        except msgspec.MsgspecError:
+            self._drop("input", "an input update other than {'value': a number or true/false}")
+            return
+        target = self._inputs.get(update.uuid)
+        value = update.updates.value
+        if target is None:
+            self._drop("input", f"a value for {shown(update.uuid)}, not one of the page's inputs")
+            return
+        if target.kind is bool and not isinstance(value, bool):
+            self._drop("input", "a number for a checkbox or button")
+            return
+        if target.kind is float and (isinstance(value, bool) or not math.isfinite(value)):
+            self._drop("input", f"{value!r} for a slider (a finite number is needed)")
+            return
+        try:
+            target.callback(self.identify(connection), value)
+        except Exception as error:
+            self._log.warning("callback", f"viewer input callback failed: {error!r}")
+            log.debug("viewer input callback", exc_info=True)
+
+    def _drop(self, kind: str, what: str) -> None:
+        self.refuse(kind, kind, f"dropped {what} from a viewer page")
+
+    def refuse(self, kind: str, key: str, message: str) -> None:
+        """Count a refusal of ``kind`` and log ``message`` unless ``key`` was logged lately."""
+        self.refused[kind] += 1
+        self._log.warning(key, message)
+
+
+class GuardedConnection(ServerConnection):
+    """A viser websocket whose ``recv`` returns only frames its door let through."""
+
+    def __init__(self, door: Door, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.door = door
+
+    async def recv(self, decode: bool | None = None) -> Any:
+        while True:
+            try:
+                frame = await super().recv(decode)
+            except ConnectionClosed as closed:
+                if closed.sent is not None and closed.sent.code == CloseCode.MESSAGE_TOO_BIG:
+                    limit = self.door.policy.max_frame_bytes
+                    self.door.refuse(
+                        "oversize", "oversize", f"closed a viewer page: a frame over {limit} bytes"
+                    )
+                raise
+            passed = self.door.screen(self, frame)
+            if passed is not None:
+                return passed
