@@ -12,6 +12,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from .catalogue import catalogue, listing
+from .collision_geometry import read_srdf
 from .config import Settings, find_ini, load_settings, read_robots
 from .errors import C2rvizError
 from .robot import Robot
@@ -85,6 +86,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add("--speed", type=float, metavar="P", help="new connections' speed, %% of the limits (50)")
     add(
+        "--guard",
+        choices=("off", "on"),
+        help="new connections refuse colliding targets and paths (default off)",
+    )
+    add("--srdf", metavar="FILE", type=Path, help="SRDF whose disable_collisions are honoured")
+    add(
         "--no-viewer",
         dest="viewer",
         action="store_const",
@@ -147,7 +154,8 @@ async def serve(settings: Settings, robot: Robot) -> int:
             file=sys.stderr,
         )
         return 2
-    world = World(robot, scene, hz=settings.hz, defaults=settings.session)
+    disabled = {robot.name: read_srdf(settings.srdf)} if settings.srdf is not None else None
+    world = World(robot, scene, hz=settings.hz, defaults=settings.session, disabled_pairs=disabled)
     scene.start(world, loop)
     server = CommandServer(world, settings.limits, on_quit=stop.set)
     try:

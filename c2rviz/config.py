@@ -61,6 +61,8 @@ class SessionDefaults:
     """``off`` (moves shown at once, the seed's way), ``on`` or ``follow``."""
     speed: float = 50.0
     """Moves at this % of each joint's velocity limit (1..100)."""
+    guard: bool = False
+    """Refuse commands whose target or path collides."""
 
 
 @dataclass(frozen=True)
@@ -120,6 +122,8 @@ class Settings:
     session: SessionDefaults = field(default_factory=SessionDefaults)
     robots: Mapping[str, RobotEntry] = field(default_factory=dict)
     ini: Path | None = None
+    srdf: Path | None = None
+    """An SRDF whose ``disable_collisions`` pairs are never checked."""
 
 
 # ini key -> (Settings or ServerLimits field, type, lowest allowed, highest allowed)
@@ -134,8 +138,8 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "max_sleep": ("max_sleep_s", float, 0, 1e6),
     "speed": ("speed", float, 1, 100),
 }
-_TEXT_OPTIONS = ("host", "viewer_host", "robot", "motion")
-_CHOICES = {"motion": ("off", "on", "follow")}
+_TEXT_OPTIONS = ("host", "viewer_host", "robot", "motion", "guard")
+_CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on")}
 _ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args"]
 _LIMIT_FIELDS = {f for f in ServerLimits.__dataclass_fields__}
 _SESSION_FIELDS = {f for f in SessionDefaults.__dataclass_fields__}
@@ -182,7 +186,7 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
             elif key in _TEXT_OPTIONS:
                 if text not in _CHOICES.get(key, (text,)):
                     raise ConfigError(f"[options] {key} = {text!r} is not one", _CHOICES[key])
-                values[key] = text
+                values[key] = (text == "on") if key == "guard" else text
             else:
                 raise ConfigError(
                     f"unknown key {key!r} in [options] of {path}",
@@ -235,6 +239,8 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
         if name in given and not low <= given[name] <= high:
             flag = "--" + key.replace("_", "-").replace("viewer", "viser")
             raise ConfigError(f"{flag} {given[name]:g} is outside {low:g}..{high:g}")
+    if "guard" in given:
+        given["guard"] = given["guard"] == "on"
     values.update(given)
     for key in ("package_paths", "xacro_args"):
         values[key] = tuple(values.get(key, ()))

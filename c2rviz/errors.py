@@ -19,6 +19,7 @@ __all__ = [
     "LineError",
     "LineTooLong",
     "MotionInterrupted",
+    "PathCollides",
     "RobotError",
     "UnknownCommand",
     "UnknownRobot",
@@ -137,3 +138,13 @@ class MotionInterrupted(C2rvizError):
     def __init__(self, why: str) -> None:
         self.why = why
         super().__init__(why)
+
+
+class PathCollides(C2rvizError):
+    """A guarded command whose target, or a point of its way there, collides."""
+
+    def __init__(self, first: str, second: str, fraction: float, at_target: bool) -> None:
+        self.pair = (first, second)
+        self.fraction = fraction
+        where = "at the target" if at_target else f"at {fraction * 100:.0f}% of the move"
+        super().__init__(f"{first} would hit {second} {where}")

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from .workcell import WorkcellObject
     from .world import World
 
 __all__ = ["MAX_MARKERS", "Marker", "NullScene", "Observer", "RecordingScene", "Scene"]
@@ -62,6 +63,12 @@ class Observer:
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         """``source`` sent ``line``; ``accepted`` False if it was refused."""
 
+    def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
+        """``robot``'s workcell objects are now ``objects`` (placements in its base frame)."""
+
+    def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
+        """``robot``'s colliding pairs are now ``pairs`` (link or object names)."""
+
 
 class Scene(Observer):
     """An observer that is a view: it starts with the world and stops with the program."""
@@ -92,6 +99,8 @@ class RecordingScene(Scene):
     client_counts: list[int] = field(default_factory=list)
     commands: list[str] = field(default_factory=list)
     refused: list[str] = field(default_factory=list)
+    objects: dict[str, list[str]] = field(default_factory=dict)
+    collisions: list[tuple[str, list[tuple[str, str]]]] = field(default_factory=list)
 
     def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
         self.joints.append(tuple(q))
@@ -110,3 +119,9 @@ class RecordingScene(Scene):
 
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         (self.commands if accepted else self.refused).append(line)
+
+    def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
+        self.objects[robot] = [obj.name for obj in objects]
+
+    def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
+        self.collisions.append((robot, list(pairs)))

@@ -22,7 +22,7 @@ from . import (
 )
 from .commands import parse_line
 from .config import ServerLimits
-from .errors import C2rvizError, JointLimitError
+from .errors import C2rvizError, JointLimitError, PathCollides
 from .registry import HANDLERS, Reply
 from .robot import Robot
 from .world import RobotState, World
@@ -70,6 +70,7 @@ class Session:
         source: Who speaks (``tcp 127.0.0.1:5123``, ``page``), for notes and errors.
         motion: ``off``, ``on`` or ``follow`` (``lang.motion.MOTION_MODES``).
         speed: Moves at this % of the joints' limits.
+        guard: Refuse commands whose target or path collides.
         hangup: Set by a handler to ``"bye"`` or ``"quit"``: the connection closes
             after this reply (and for ``quit`` stops the program).
     """
@@ -90,6 +91,7 @@ class Session:
         self.hangup: str | None = None
         self.motion = world.defaults.motion
         self.speed = world.defaults.speed
+        self.guard = world.defaults.guard
         self.select(robot)
 
     def select(self, name: str | None) -> None:
@@ -107,6 +109,8 @@ class Session:
     def go(self, q: Sequence[float]) -> Reply:
         """Send this session's robot to ``q`` [rad or m, checked]: at once (``motion off``),
         or travelling (``on``: the reply comes on arrival; ``follow``: ``ok`` now)."""
+        if self.guard:
+            self.check_path(q)
         if self.motion == "off":
             self.world.set_q(q, self.state.name, self.source)
             return replies.OK
@@ -114,6 +118,24 @@ class Session:
             self.state, q, self.speed / 100.0, self.source, wait=self.motion == "on"
         )
         return replies.OK if arrival is None else arrival
+
+    def check_path(self, q: Sequence[float], path: Sequence[Sequence[float]] = ()) -> None:
+        """Refuse ``q`` if it collides, or if any point of the way there does (``path``,
+        else the straight joint-space segment from where the arm is now).
+
+        Raises:
+            PathCollides: naming the pair and how far along the move.
+        """
+        model = self.world.collision_model(self.state.name)
+        if self.motion == "off" and not path:
+            hit = None if model.is_free(q) else (1.0, model.colliding(q)[0])
+        elif path:
+            found = model.first_collision(path)
+            hit = None if found is None else (found[0] / max(len(path) - 1, 1), found[1])
+        else:
+            hit = model.first_collision_on_segment(self.now(), q)
+        if hit is not None:
+            raise PathCollides(*hit[1], hit[0], self.motion == "off" and not path)
 
     def now(self) -> tuple[float, ...]:
         """The robot's joints at this instant [rad or m] (mid-move too)."""

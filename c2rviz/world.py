@@ -19,7 +19,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pinocchio as pin
 
+from .collision import CollisionModel, Pair
 from .config import SessionDefaults
+from .contacts import Contacts
 from .errors import UnknownRobot
 from .motion import MotionLimits, motion_limits
 from .robot import Robot
@@ -71,6 +73,7 @@ class World:
         limits: Mapping[str, MotionLimits] | None = None,
         defaults: SessionDefaults | None = None,
         origins: Mapping[str, pin.SE3] | None = None,
+        disabled_pairs: Mapping[str, Sequence[Pair]] | None = None,
     ) -> None:
         """Set up the world.
 
@@ -85,13 +88,19 @@ class World:
             defaults: How a new session starts (motion mode, speed).
             origins: Where each robot's root stands in the world frame (default: at
                 the world's origin).
+            disabled_pairs: Link pairs never checked for collision, by robot (an SRDF's).
         """
         named = {robots.name: robots} if isinstance(robots, Robot) else dict(robots)
         self.robots = {name: RobotState(name, robot) for name, robot in named.items()}
         for name, origin in (origins or {}).items():
             self.state(name).origin = origin
         self.default = next(iter(self.robots))
-        self.observers: list[Observer] = [scene] if scene is not None else []
+        self.contacts = Contacts(
+            self.robots, self._tell_collisions, 1.0 / hz, dict(disabled_pairs or {})
+        )
+        self.observers: list[Observer] = [self.contacts]
+        if scene is not None:
+            self.observers.append(scene)
         self.rng = rng if rng is not None else np.random.default_rng()
         self.clock = clock
         self.client_count = 0
@@ -185,6 +194,26 @@ class World:
         """Remove every marker of the robot, and home it at once."""
         self.clear_markers(robot)
         self.set_q(self.state(robot).robot.home, robot)
+
+    # The workcell and collisions.
+
+    def collision_model(self, robot: str | None = None) -> CollisionModel:
+        """The robot's collision model (built on first use)."""
+        return self.contacts.model(self.state(robot).name)
+
+    def edit_objects(self, robot: str, edit: Callable[[CollisionModel], object]) -> None:
+        """Change ``robot``'s workcell with ``edit(model)`` (which checks its input and may
+        raise, changing nothing); then tell the observers and re-check collisions."""
+        model = self.collision_model(robot)
+        edit(model)
+        objects = model.object_list()
+        for observer in self.observers:
+            observer.on_objects(robot, objects)
+        self.contacts.changed(robot)
+
+    def _tell_collisions(self, robot: str, pairs: list[Pair]) -> None:
+        for observer in self.observers:
+            observer.on_collisions(robot, pairs)
 
     def set_client_count(self, count: int) -> None:
         self.client_count = count

@@ -34,6 +34,7 @@ from c2rviz.commands import (
 from c2rviz.errors import BadArguments, C2rvizError, LineError, UnknownCommand
 from c2rviz.lang.cell import RobotChoice, RobotsList
 from c2rviz.lang.motion import MotionMode, Speed, Status, Stop, Target, Wait
+from c2rviz.lang.workcell import Collisions, Guard, ObjectEdit, Objects
 
 GOOD = [
     ("home", Home(), "home"),
@@ -67,6 +68,17 @@ GOOD = [
     ("robot", RobotChoice(None), "robot-ask"),
     ("robot right_arm", RobotChoice("right_arm"), "robot-choose"),
     ("robots", RobotsList(), "robots"),
+    (
+        "object table box 1,0.6,0.05 0.6,0,-0.03,0,0,90",
+        ObjectEdit("table", "box", (1.0, 0.6, 0.05), (0.6, 0.0, -0.03, 0.0, 0.0, 90.0)),
+        "object-box",
+    ),
+    ("object b SPHERE .1 1,2,3", ObjectEdit("b", "sphere", (0.1,), (1, 2, 3, 0, 0, 0)), "sphere"),
+    ("object t remove", ObjectEdit("t", "remove"), "object-remove"),
+    ("objects", Objects(), "objects"),
+    ("collisions", Collisions(), "collisions"),
+    ("guard", Guard(None), "guard-ask"),
+    ("guard ON", Guard(True), "guard-on"),
     ("color 0,0.5,1", Color((0.0, 0.5, 1.0)), "color"),
     ("rgb 0,255,51", Color((0.0, 1.0, 0.2)), "rgb"),
     ("marker CUBE", MarkerShape("cube"), "marker"),

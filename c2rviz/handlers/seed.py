@@ -47,7 +47,10 @@ __all__: list[str] = []
 
 @handler(Rand)
 def rand(session: Session, command: Rand) -> Reply:
-    return session.go(session.robot.random(session.world.rng))
+    rng = session.world.rng
+    if session.guard:  # a configuration that collides with nothing
+        return session.go(session.world.collision_model(session.state.name).random_free(rng))
+    return session.go(session.robot.random(rng))
 
 
 @handler(Home)
