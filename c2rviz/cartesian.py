@@ -29,13 +29,31 @@ class LineBlocked(C2rvizError):
 
     Attributes:
         fraction: How far along the line the last good waypoint is (0..1).
-        joint: The joint that reaches its limit, or None for a singularity.
+        q: Chain values at that waypoint [rad or m].
+        joint: The joint that reaches its limit there, if that is the cause.
+        joint_count: For an arm of fewer than 6 joints that cannot hold the
+            line's poses, its joint count; None otherwise.
+
+    With neither ``joint`` nor ``joint_count``, the arm passes a singularity.
     """
 
-    def __init__(self, fraction: float, joint: str | None) -> None:
+    def __init__(
+        self,
+        fraction: float,
+        q: Sequence[float],
+        joint: str | None = None,
+        joint_count: int | None = None,
+    ) -> None:
         self.fraction = fraction
+        self.q = tuple(q)
         self.joint = joint
-        reason = f"{joint} reaches its limit" if joint is not None else "passes a singularity"
+        self.joint_count = joint_count
+        if joint is not None:
+            reason = f"{joint} reaches its limit"
+        elif joint_count is not None:
+            reason = f"the tool leaves the poses {joint_count} joints can reach"
+        else:
+            reason = "passes a singularity"
         percent = math.floor(fraction * 100)
         super().__init__(f"straight line blocked at {percent}% of the way: {reason}")
 
@@ -152,9 +170,11 @@ def plan_line(
         The line, its waypoints from ``s = 0`` (``q0``) to ``s = 1``.
 
     Raises:
-        LineBlocked: a joint reaches its limit, or the arm passes a singularity.
+        LineBlocked: a joint reaches its limit, the arm passes a singularity,
+            or (under 6 joints) the line leaves the poses the arm can reach.
         Unreachable: the goal itself cannot be reached.
     """
+    ik.solve(goal, q0, tool)  # an unreachable goal is reported as such, not as a block
     start = ik.tool_pose(q0, tool)
     length = float(np.linalg.norm(goal.translation - start.translation))
     angle = float(np.linalg.norm(pin.log3(start.rotation.T @ goal.rotation)))
@@ -165,7 +185,7 @@ def plan_line(
     waypoints = [LineWaypoint(0.0, q)]
     s, ds = 0.0, nominal
     while s < 1.0:
-        s_next = min(1.0, s + ds)
+        s_next = s + ds if s + ds < 1.0 - 1e-9 else 1.0
         attempt = ik.follow(interpolate(start, goal, s_next), q, tool)
         jump = float(np.abs(np.subtract(attempt.q, q)).max())
         if attempt.ok and jump <= max_joint_step:
@@ -176,10 +196,12 @@ def plan_line(
         if ds > smallest:
             ds /= 2
             continue
-        joint = None if attempt.ok else _joint_at_limit(ik, attempt.q)
-        if joint is None:
-            ik.solve(goal, q, tool)  # raises Unreachable when the goal is out of reach
-        raise LineBlocked(s, joint)
+        if attempt.ok:  # there, but only by a jump: the arm turns over a singularity
+            raise LineBlocked(s, q)
+        joint = _joint_at_limit(ik, attempt.q)
+        # An arm of under 6 joints reaches a thin set of poses; a line leaves it.
+        few = ik.robot.n if joint is None and ik.robot.n < 6 else None
+        raise LineBlocked(s, q, joint, few)
     return StraightLine(start, goal, tuple(waypoints))
 
 
