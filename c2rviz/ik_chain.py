@@ -17,6 +17,7 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
+from .errors import JointCountError
 from .robot import Robot
 
 __all__ = ["TOOL_FRAME", "IkChain", "chain_model"]
@@ -112,8 +113,13 @@ class IkChain:
 
         A revolute joint outside its limits is first turned by whole turns
         towards them (the same pose), then clipped.
+
+        Raises:
+            JointCountError: ``q`` does not have one value per chain joint.
         """
         joints = self.robot.joints
+        if len(q) != len(joints):
+            raise JointCountError(len(joints), len(q))
         out = pin.neutral(self.model)
         for i, (idx, value) in enumerate(zip(self._idx_q, q)):
             if self._continuous[i]:

@@ -22,8 +22,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from c2rviz.cartesian import LineBlocked, interpolate, plan_line
-from c2rviz.catalogue import example_robot_data_dir, example_robots
-from c2rviz.errors import C2rvizError
+from c2rviz.catalogue import EXAMPLE_ROBOTS, example_robot_data_dir, example_robots
+from c2rviz.errors import C2rvizError, JointCountError
 from c2rviz.ik import IkSolver, Unreachable
 from c2rviz.robot import Robot
 
@@ -31,7 +31,7 @@ TREE = Path(__file__).parent / "data" / "tree_robot" / "tree.urdf"
 POSITION_TOL_M = 1e-4  # the promise: 0.1 mm ...
 ANGLE_TOL_RAD = math.radians(0.1)  # ... and 0.1 deg
 BUNDLED = sorted(ROBOTS)
-EXAMPLE_ARMS = ["panda", "ur5"]
+EXAMPLE_ARMS = sorted(EXAMPLE_ROBOTS)  # every serial arm the catalogue names
 
 
 def erd_robot(name: str) -> Robot:
@@ -122,6 +122,12 @@ def test_a_near_target_keeps_the_arm_near_its_seed(name: str) -> None:
         nudged = np.clip(seed + rng.uniform(-0.02, 0.02, robot.n), robot.lower, robot.upper)
         q = ik.solve(robot.ee_pose(nudged), seed.tolist())
         assert np.abs(np.subtract(q, seed)).max() < 0.2
+
+
+def test_a_seed_of_the_wrong_length_is_refused() -> None:
+    ik = solver("kuka_lwr")
+    with pytest.raises(JointCountError, match="joints needs 7 values, got 6"):
+        ik.solve(ik.robot.ee_pose([0.0] * 7), [0.0] * 6)
 
 
 def test_the_answer_is_repeatable() -> None:
