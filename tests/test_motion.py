@@ -11,6 +11,9 @@ between samples by more than the step hides.
 from __future__ import annotations
 
 import math
+import re
+import subprocess
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -548,3 +551,15 @@ def test_planner_plans_from_the_state_ruckig_fails_on() -> None:
     p, v, a = trajectory.at_time(trajectory.duration)
     assert v == pytest.approx([0.0] * 6, abs=1e-12) and a == pytest.approx([0.0] * 6, abs=1e-12)
     assert trajectory.at_time(0.0) == tuple(ON_THE_LIMIT.values())  # from the state itself
+
+
+def test_benchmark_script_runs() -> None:
+    """``benchmarks/motion_bench.py --quick`` prints every row (no timing is checked)."""
+    script = Path(__file__).resolve().parent.parent / "benchmarks" / "motion_bench.py"
+    done = subprocess.run(
+        [sys.executable, str(script), "--quick"], capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 0, done.stdout + done.stderr
+    for row in ("ruckig calculate", "move_to from rest", "move_to preempting", "follow",
+                "stop mid-move", "sample mid-move", "sample at rest"):  # fmt: skip
+        assert re.search(rf"\| {re.escape(row)}[^|]* \| [0-9.]+ \| [0-9.]+ \|", done.stdout), row
