@@ -13,6 +13,8 @@ import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from .errors import C2rvizError
 from .robot import Robot
 
@@ -105,9 +107,8 @@ def _override(
 ) -> tuple[float, ...]:
     if value is None:
         return tuple(default)
-    if isinstance(value, Sequence):
-        return _positive(key, list(value), n)
-    return _positive(key, [float(value)] * n, n)
+    values = list(value) if isinstance(value, (Sequence, np.ndarray)) else [value] * n
+    return _positive(key, values, n)
 
 
 def motion_limits(
