@@ -192,7 +192,7 @@ async def serve(settings: Settings, robot: Robot) -> int:
         for sig in (signal.SIGINT, signal.SIGTERM):
             loop.remove_signal_handler(sig)
         await server.stop()
-        world.travels.stop_all()
+        world.close()
         scene.stop()
     print("c2rviz: stopped", flush=True)
     return 0

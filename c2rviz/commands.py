@@ -459,6 +459,7 @@ def parse_line(line: str) -> object | None:
 
 
 # The verbs beyond the seed's, one module per concern (they use the pieces above).
+from .lang import cartesian as _cartesian  # noqa: E402, F401
 from .lang import cell as _cell  # noqa: E402, F401
 from .lang import motion as _motion  # noqa: E402, F401
 from .lang import workcell as _workcell  # noqa: E402, F401

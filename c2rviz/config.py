@@ -63,6 +63,8 @@ class SessionDefaults:
     """Moves at this % of each joint's velocity limit (1..100)."""
     guard: bool = False
     """Refuse commands whose target or path collides."""
+    lspeed: float = 0.25
+    """``movel``'s tool speed [m/s] (as UR's movel)."""
 
 
 @dataclass(frozen=True)
@@ -137,6 +139,7 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "partial_timeout": ("partial_timeout_s", float, 0.01, 86400),
     "max_sleep": ("max_sleep_s", float, 0, 1e6),
     "speed": ("speed", float, 1, 100),
+    "lspeed": ("lspeed", float, 0.001, 5),
 }
 _TEXT_OPTIONS = ("host", "viewer_host", "robot", "motion", "guard")
 _CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on")}

@@ -10,6 +10,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 __all__ = [
+    "ArmMoved",
     "BadArguments",
     "C2rvizError",
     "ConfigError",
@@ -22,6 +23,7 @@ __all__ = [
     "PathCollides",
     "RobotError",
     "UnknownCommand",
+    "UnknownMarker",
     "UnknownRobot",
     "shown",
 ]
@@ -148,3 +150,17 @@ class PathCollides(C2rvizError):
         self.fraction = fraction
         where = "at the target" if at_target else f"at {fraction * 100:.0f}% of the move"
         super().__init__(f"{first} would hit {second} {where}")
+
+
+class ArmMoved(C2rvizError):
+    """A command that needs the arm where it was planned from, or at rest."""
+
+
+class UnknownMarker(C2rvizError):
+    """A marker number that is not among the robot's markers."""
+
+    def __init__(self, index: int, count: int) -> None:
+        self.index = index
+        self.count = count
+        have = f"markers 1..{count}" if count else "no markers"
+        super().__init__(f"no marker {index}: this robot has {have} (1 is the oldest)")

@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    import pinocchio as pin
+
     from .workcell import WorkcellObject
     from .world import World
 
@@ -62,6 +64,9 @@ class Observer:
 
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         """``source`` sent ``line``; ``accepted`` False if it was refused."""
+
+    def on_tool(self, robot: str, tool: pin.SE3) -> None:
+        """``robot``'s tool point is now ``tool`` (relative to its end-effector link)."""
 
     def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
         """``robot``'s workcell objects are now ``objects`` (placements in its base frame)."""

@@ -71,6 +71,7 @@ class Session:
         motion: ``off``, ``on`` or ``follow`` (``lang.motion.MOTION_MODES``).
         speed: Moves at this % of the joints' limits.
         guard: Refuse commands whose target or path collides.
+        lspeed: ``movel``'s tool speed [m/s].
         hangup: Set by a handler to ``"bye"`` or ``"quit"``: the connection closes
             after this reply (and for ``quit`` stops the program).
     """
@@ -92,6 +93,7 @@ class Session:
         self.motion = world.defaults.motion
         self.speed = world.defaults.speed
         self.guard = world.defaults.guard
+        self.lspeed = world.defaults.lspeed
         self.select(robot)
 
     def select(self, name: str | None) -> None:

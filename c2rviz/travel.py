@@ -16,6 +16,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from . import replies
 from .errors import MotionInterrupted
 from .motion import Motion, MotionLimits
@@ -24,6 +26,35 @@ if TYPE_CHECKING:
     from .world import RobotState
 
 __all__ = ["Travel", "Travels"]
+
+
+@dataclass(eq=False)
+class LinePlay:
+    """A joint path played at given times (a straight tool line, from ``cartesian``).
+
+    Between two waypoints the joints move at constant speed (linear interpolation).
+
+    Attributes:
+        times: When the arm passes each waypoint, on the world's clock [s], increasing.
+        qs: The waypoints' chain values [rad or m], one row each.
+    """
+
+    times: np.ndarray
+    qs: np.ndarray
+
+    def sample(self, t: float) -> tuple[float, ...]:
+        k = int(np.searchsorted(self.times, t, side="right"))
+        if k >= len(self.times):
+            return tuple(self.qs[-1].tolist())
+        if k == 0:
+            return tuple(self.qs[0].tolist())
+        t0, t1 = self.times[k - 1], self.times[k]
+        f = (t - t0) / (t1 - t0) if t1 > t0 else 1.0
+        return tuple((self.qs[k - 1] + f * (self.qs[k] - self.qs[k - 1])).tolist())
+
+    @property
+    def arrival(self) -> float:
+        return float(self.times[-1])
 
 
 @dataclass(eq=False)
@@ -38,12 +69,14 @@ class Travel:
             by the hundred thousand, only clear this; the next move re-syncs).
         arrivals: Replies waiting for the arm to reach the running move's target.
         rests: Replies waiting for the arm to come to rest (``wait``, ``stop``).
+        line: A straight-line path being played instead of ``motion``, if any.
     """
 
     state: RobotState
     motion: Motion
     active: bool = False
     synced: bool = True
+    line: LinePlay | None = None
     arrivals: list[asyncio.Future[str]] = field(default_factory=list)
     rests: list[asyncio.Future[str]] = field(default_factory=list)
 
@@ -81,6 +114,7 @@ class Travels:
         self._interrupt(travel, f"preempted by {source}")
         travel.active = False
         travel.synced = False
+        travel.line = None
         _settle(travel.rests, replies.OK)
 
     def go(
@@ -95,9 +129,12 @@ class Travels:
         travel = self.by_robot[state.name]
         self._interrupt(travel, f"preempted by {source}")
         t = self.clock()
-        if not travel.synced:
+        if travel.line is not None:  # leaving a line: from where it is, at rest (see README)
+            travel.motion.jump(travel.line.sample(t), t)
+            travel.line = None
+        elif not travel.synced:
             travel.motion.jump(state.q, t)
-            travel.synced = True
+        travel.synced = True
         if wait:
             travel.motion.move_to(q, t, speed)
         else:
@@ -112,12 +149,44 @@ class Travels:
             _settle(travel.arrivals, replies.OK)
         return arrival
 
+    def play_line(
+        self, state: RobotState, qs: np.ndarray, times: Sequence[float], source: str, wait: bool
+    ) -> asyncio.Future[str] | None:
+        """Play the joint path ``qs`` (from where the arm is) at ``times`` [s from now].
+
+        Returns:
+            As ``go``: with ``wait`` a reply on arrival, else None.
+        """
+        travel = self.by_robot[state.name]
+        self._interrupt(travel, f"preempted by {source}")
+        travel.line = LinePlay(self.clock() + np.asarray(times, dtype=float), qs)
+        travel.synced = False
+        state.target = tuple(qs[-1].tolist())
+        travel.active = True
+        self._run(travel)
+        if not wait:
+            return None
+        arrival: asyncio.Future[str] = asyncio.get_running_loop().create_future()
+        travel.arrivals.append(arrival)
+        return arrival
+
     def stop(self, state: RobotState, source: str) -> asyncio.Future[str] | None:
         """Decelerate to rest; return the reply that comes at rest (None: at rest now)."""
         travel = self.by_robot[state.name]
         if not travel.active:
             return None
         self._interrupt(travel, f"motion stopped by {source}")
+        if travel.line is not None:  # a line stops where it is (see README)
+            t = self.clock()
+            q = travel.line.sample(t)
+            travel.line = None
+            travel.motion.jump(q, t)
+            travel.synced = True
+            state.target = q
+            travel.active = False
+            self.publish(state, q, t)
+            _settle(travel.rests, replies.OK)
+            return None
         travel.motion.stop(self.clock())
         state.target = travel.motion.target
         return self.rest(state)
@@ -134,12 +203,19 @@ class Travels:
     def seconds_left(self, state: RobotState) -> float:
         """Time until the arm is at rest [s]; 0 when it is."""
         travel = self.by_robot[state.name]
-        return max(travel.motion.arrival() - self.clock(), 0.0) if travel.active else 0.0
+        if not travel.active:
+            return 0.0
+        end = travel.line.arrival if travel.line is not None else travel.motion.arrival()
+        return max(end - self.clock(), 0.0)
 
     def now(self, state: RobotState) -> tuple[float, ...]:
         """Where the arm is at this instant (between two frames, too)."""
         travel = self.by_robot[state.name]
-        return travel.motion.sample(self.clock())[0] if travel.active else state.q
+        if not travel.active:
+            return state.q
+        if travel.line is not None:
+            return travel.line.sample(self.clock())
+        return travel.motion.sample(self.clock())[0]
 
     def stop_all(self) -> None:
         """The program stops: no more frames."""
@@ -150,7 +226,7 @@ class Travels:
     # The frame timer.
 
     def _run(self, travel: Travel) -> None:
-        travel.active = travel.motion.moving(self.clock())
+        travel.active = travel.line is not None or travel.motion.moving(self.clock())
         if travel.active and self._timer is None:
             self._timer = asyncio.get_running_loop().call_soon(self._tick)
 
@@ -162,12 +238,20 @@ class Travels:
         for travel in self.by_robot.values():
             if not travel.active:
                 continue
-            q = travel.motion.sample(t)[0]
-            if not travel.motion.moving(t):
-                travel.active = False
+            line = travel.line
+            if line is not None:
+                q = line.sample(t)
+                end = line.arrival
+                if t >= end:
+                    travel.active, travel.line = False, None
+            else:
+                q = travel.motion.sample(t)[0]
+                end = travel.motion.arrival()
+                if not travel.motion.moving(t):
+                    travel.active = False
             self.publish(travel.state, q, t)
             if travel.active:
-                due = min(due, t + self.frame_s, travel.motion.arrival())
+                due = min(due, t + self.frame_s, end)
             else:
                 _settle(travel.arrivals, replies.OK)
                 _settle(travel.rests, replies.OK)

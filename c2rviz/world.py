@@ -11,10 +11,13 @@ they are equal at once. ``clock`` is the time base [s] of every effect.
 
 from __future__ import annotations
 
+import asyncio
 import time
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from typing import TypeVar
 
 import numpy as np
 import pinocchio as pin
@@ -23,12 +26,15 @@ from .collision import CollisionModel, Pair
 from .config import SessionDefaults
 from .contacts import Contacts
 from .errors import UnknownRobot
+from .ik import IkSolver
 from .motion import MotionLimits, motion_limits
 from .robot import Robot
 from .scene import MAX_MARKERS, Marker, Observer
 from .travel import Travel, Travels
 
 __all__ = ["RobotState", "World"]
+
+T = TypeVar("T")
 
 
 @dataclass(eq=False)
@@ -43,6 +49,7 @@ class RobotState:
         markers: Its markers, in the world frame, oldest first.
         origin: Where its model's root stands in the world (the cell) frame.
         port: The command port that drives it by default (None: not known here).
+        tool: The tool point (TCP) relative to the end-effector link.
     """
 
     name: str
@@ -52,6 +59,7 @@ class RobotState:
     markers: deque[Marker] = field(default_factory=lambda: deque(maxlen=MAX_MARKERS))
     origin: pin.SE3 = field(default_factory=pin.SE3.Identity)
     port: int | None = None
+    tool: pin.SE3 = field(default_factory=pin.SE3.Identity)
     travel: Travel = field(init=False, repr=False)
     """Its motion (set by the world)."""
 
@@ -106,6 +114,8 @@ class World:
         self.client_count = 0
         self.defaults = defaults if defaults is not None else SessionDefaults()
         self.travels = Travels(self._show, clock, 1.0 / hz)
+        self._solvers: dict[str, IkSolver] = {}
+        self._solver_thread = ThreadPoolExecutor(1, thread_name_prefix="c2rviz-ik")
         for name, state in self.robots.items():
             chosen = (limits or {}).get(name) or motion_limits(state.robot)
             state.travel = self.travels.add(state, chosen)
@@ -171,7 +181,7 @@ class World:
         if in_world and pose is not None:
             placement = pose
         else:
-            in_base = state.robot.ee_pose(state.q) if pose is None else pose
+            in_base = state.robot.ee_pose(state.q) * state.tool if pose is None else pose
             placement = state.origin * state.robot.base_placement * in_base
         x, y, z, w = pin.Quaternion(placement.rotation).coeffs()
         px, py, pz = placement.translation
@@ -194,6 +204,33 @@ class World:
         """Remove every marker of the robot, and home it at once."""
         self.clear_markers(robot)
         self.set_q(self.state(robot).robot.home, robot)
+
+    def set_tool(self, robot: str, tool: pin.SE3) -> None:
+        """The robot's tool point is now ``tool`` (relative to its end-effector link)."""
+        state = self.state(robot)
+        state.tool = tool
+        for observer in self.observers:
+            observer.on_tool(state.name, tool)
+
+    # Inverse kinematics, solved off the event loop.
+
+    def ik_solver(self, robot: str) -> IkSolver:
+        """The robot's IK solver (built on first use; used on the solver thread only)."""
+        solver = self._solvers.get(robot)
+        if solver is None:
+            solver = self._solvers[robot] = IkSolver(self.state(robot).robot)
+        return solver
+
+    def solve(self, fn: Callable[[], T]) -> asyncio.Future[T]:
+        """Run ``fn`` (an IK solve or a line plan) on the one solver thread: the event loop
+        goes on serving other clients meanwhile, and solves never overlap."""
+        return asyncio.get_running_loop().run_in_executor(self._solver_thread, fn)
+
+    def close(self) -> None:
+        """The program stops: no more frames, checks or solves."""
+        self.travels.stop_all()
+        self.contacts.stop()
+        self._solver_thread.shutdown(wait=False, cancel_futures=True)
 
     # The workcell and collisions.
 

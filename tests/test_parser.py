@@ -32,6 +32,7 @@ from c2rviz.commands import (
     parse_line,
 )
 from c2rviz.errors import BadArguments, C2rvizError, LineError, UnknownCommand
+from c2rviz.lang.cartesian import Ik, LinearSpeed, MoveL, MoveTo, Tool
 from c2rviz.lang.cell import RobotChoice, RobotsList
 from c2rviz.lang.motion import MotionMode, Speed, Status, Stop, Target, Wait
 from c2rviz.lang.workcell import Collisions, Guard, ObjectEdit, Objects
@@ -68,6 +69,14 @@ GOOD = [
     ("robot", RobotChoice(None), "robot-ask"),
     ("robot right_arm", RobotChoice("right_arm"), "robot-choose"),
     ("robots", RobotsList(), "robots"),
+    ("tool", Tool(None), "tool-ask"),
+    ("tool 0,0,0.1,0,0,0", Tool((0, 0, 0.1, 0, 0, 0)), "tool"),
+    ("ik 0.5,0,0.8,0,90,0", Ik((0.5, 0, 0.8, 0, 90, 0)), "ik"),
+    ("moveto 0.5,0,0.8,0,90,0", MoveTo((0.5, 0, 0.8, 0, 90, 0)), "moveto"),
+    ("moveto MARKER 3", MoveTo(None, 3), "moveto-marker"),
+    ("movel 0.5,0,0.8,0,90,0", MoveL((0.5, 0, 0.8, 0, 90, 0)), "movel"),
+    ("lspeed", LinearSpeed(None), "lspeed-ask"),
+    ("lspeed 0.1", LinearSpeed(0.1), "lspeed"),
     (
         "object table box 1,0.6,0.05 0.6,0,-0.03,0,0,90",
         ObjectEdit("table", "box", (1.0, 0.6, 0.05), (0.6, 0.0, -0.03, 0.0, 0.0, 90.0)),

@@ -131,7 +131,7 @@ def where(session: Session, command: Where) -> str:
 
 @handler(Pose)
 def pose(session: Session, command: Pose) -> str:
-    placement = session.robot.ee_pose(session.now())
+    placement = session.robot.ee_pose(session.now()) * session.state.tool
     rpy = pin.rpy.matrixToRpy(placement.rotation) / session.angle_scale
     return replies.ok(replies.numbers([*placement.translation, *rpy]))
 
