@@ -10,6 +10,7 @@ from __future__ import annotations
 import io
 import math
 import os
+import re
 import select
 import signal
 import socket
@@ -348,6 +349,28 @@ def test_piped_repl_exits_1_when_a_line_got_an_error(server, connect):
     local = subprocess.run(args, input="goto 1\n", capture_output=True, text=True, timeout=30)
     assert local.returncode == 1  # an error from a local command counts too
     assert "error: goto: joints needs 7 values, got 1" in local.stdout
+
+
+def test_the_readmes_quick_start_runs_as_shown(server):
+    """README's first example needs nothing but the installed client, and prints what it shows."""
+    readme = (ROOT / "README.md").read_text()
+    quick = readme.split("## Quick start")[1].split("\n## ")[0]
+    command, shown = re.search(r"```sh\n(printf .*)\n```\n\n```\n(.*?)```", quick, re.S).groups()
+    script, client = re.fullmatch(r"printf '(.*)' \| \.venv/bin/(c2rviz-cli)", command).groups()
+    assert client == "c2rviz-cli" and "nc " not in command
+    done = subprocess.run(
+        [sys.executable, REPL_SCRIPT, "--port", str(server.port)],
+        input=script.replace("\\n", "\n"),
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env(),
+    )
+    said = shown.replace(":31000:", f":{server.port}:").splitlines()
+    assert done.stderr.splitlines() == said[:2]  # the connection messages
+    assert done.stdout.splitlines() == said[2:]  # the replies
+    assert done.returncode == 1  # as the README says: a line got an error
+    assert "sudo apt-get install netcat-openbsd" in quick
 
 
 def test_repl_goto_in_radians_and_its_errors(server, monkeypatch, capsys):
