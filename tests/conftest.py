@@ -77,10 +77,10 @@ class ServerThread:
                 done.set_exception(exc)
 
         self.loop.call_soon_threadsafe(run)
-        return done.result(timeout=10)
+        return done.result(timeout=60)
 
     def call_async(self, coro: Any) -> Any:
-        return asyncio.run_coroutine_threadsafe(coro, self.loop).result(timeout=10)
+        return asyncio.run_coroutine_threadsafe(coro, self.loop).result(timeout=60)
 
     @property
     def q(self) -> tuple[float, ...]:
@@ -91,7 +91,7 @@ class ServerThread:
         if self.loop.is_running():
             self.call_async(self.server.stop())
             self.loop.call_soon_threadsafe(self.loop.stop)
-        self.thread.join(timeout=10)
+        self.thread.join(timeout=60)
         self.loop.close()
 
 
@@ -119,7 +119,7 @@ def server(start_server: Callable[..., ServerThread]) -> ServerThread:
 class Client:
     """A controller's view of the server: a blocking TCP socket, one line at a time."""
 
-    def __init__(self, host: str, port: int, timeout: float = 10.0) -> None:
+    def __init__(self, host: str, port: int, timeout: float = 60.0) -> None:
         self.sock = socket.create_connection((host, port), timeout=timeout)
         self.file = self.sock.makefile("rb")
 
@@ -171,7 +171,7 @@ class Process:
     output: list[str]
     viewer_url: str | None = None
 
-    def wait(self, timeout: float = 10.0) -> int:
+    def wait(self, timeout: float = 60.0) -> int:
         return self.popen.wait(timeout=timeout)
 
 
@@ -180,7 +180,7 @@ def c2rviz_process() -> Iterator[Callable[..., Process]]:
     """Factory: start ``python -m c2rviz --port 0 ARGS``; waits until it listens."""
     procs: list[Process] = []
 
-    def start(*args: str, timeout: float = 30.0) -> Process:
+    def start(*args: str, timeout: float = 120.0) -> Process:
         popen = subprocess.Popen(
             [sys.executable, "-m", "c2rviz", "--port", "0", *args],
             cwd=ROOT,

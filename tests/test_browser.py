@@ -4,6 +4,12 @@ One test walks through what a user sees: the robot drawn, TCP commands moving
 it, a slider on the page commanding the world (read back with ``where``), a
 late second tab showing the same state, markers appearing and ``clear``
 taking the page back to how it started. Screenshots go to test-artifacts/.
+
+Every wait is on a signal with a generous deadline, never on a short timer: the
+page's own state (viser's end-to-end hooks: the scene tree, node poses, the
+message queue and three.js's frame counter) says when a change has arrived and
+been drawn, and only then are pixels compared. Software WebGL on a busy 2-core
+CI machine is slow, not wrong; a timeout says what it last saw.
 """
 
 from __future__ import annotations
@@ -36,6 +42,29 @@ VIEWPORT = {"width": 1000, "height": 700}
 # Where the robot is drawn: right of viser's 'software WebGL' notice, left of the panel.
 SCENE = (slice(160, 700), slice(320, 660))
 JOINTS = ("joint_s", "joint_l", "joint_e", "joint_u", "joint_r", "joint_b", "joint_t")
+DEADLINE_S = 180.0  # for any one wait; a healthy run takes a second or two per step
+
+# viser's end-to-end hooks (App.tsx puts them on window for Playwright): the one place
+# this file reads the page's internals. Robot links are /robot/LINK, their geometry
+# /robot/LINK/visual_K, markers /markers/mK (c2rviz/viewer.py).
+PAGE_STATE = """() => {
+  const m = window.__viserMutable, t = window.__viserSceneTree, tp = window.__viserTestpoints;
+  if (!m || !t || !tp) return null;
+  const nodes = Object.keys(t.getState());
+  const visuals = nodes.filter((n) => /^\\/robot\\/[^/]+\\/visual_\\d+$/.test(n));
+  const poses = {};
+  for (const [n, p] of Object.entries(m.nodePoseData)) {
+    if (/^\\/robot\\/[^/]+$/.test(n)) poses[n] = [...p.wxyz, ...p.position];
+  }
+  return {
+    visuals: visuals.length,
+    mounted: visuals.filter((n) => m.nodeRefFromName[n]).length,
+    markers: nodes.filter((n) => /^\\/markers\\/[^/]+$/.test(n)).length,
+    queued: m.messageQueue.length,
+    frame: tp.rendererInfo.render.frame,
+    poses,
+  };
+}"""
 
 
 @pytest.fixture
@@ -77,7 +106,7 @@ def scene_pixels(page: Any) -> np.ndarray:
     return np.asarray(image, dtype=np.int16)[SCENE]
 
 
-def settle(page: Any, name: str, timeout_s: float = 10.0) -> np.ndarray:
+def settle(page: Any, name: str, timeout_s: float = 60.0) -> np.ndarray:
     """The drawn scene once two screenshots in a row agree; saved as ``name``.png."""
     previous = scene_pixels(page)
     deadline = time.monotonic() + timeout_s
@@ -97,12 +126,76 @@ def blue_pixels(scene: np.ndarray) -> int:
     return int(((b - r > 60) & (b > 150)).sum())
 
 
-def wait_for_robot(page: Any, timeout_s: float = 20.0) -> None:
-    """Wait until the robot's links are drawn, not only the panel and grid."""
-    deadline = time.monotonic() + timeout_s
-    while blue_pixels(scene_pixels(page)) < 1000:
-        assert time.monotonic() < deadline, "the robot was not drawn"
-        page.wait_for_timeout(200)
+def wait_until(check: Callable[[], tuple[bool, Any]], what: str) -> Any:
+    """Poll ``check`` (it returns done, what it saw) until done; return what it saw.
+
+    Fails after ``DEADLINE_S`` naming ``what``, with what was seen along the way
+    (every 10 s and last), so a slow machine and a real fault can be told apart.
+    """
+    start = time.monotonic()
+    seen: list[str] = []
+    while True:
+        done, state = check()
+        if done:
+            return state
+        waited = time.monotonic() - start
+        if not seen or waited >= 10 * len(seen):
+            seen.append(f"{waited:.0f} s: {state}")
+        assert waited < DEADLINE_S, f"{what} (after {waited:.0f} s; saw {seen}, last {state})"
+        time.sleep(0.1)
+
+
+def page_state(page: Any) -> dict[str, Any] | None:
+    """What the page holds: robot visuals (and how many are mounted), markers, poses."""
+    return page.evaluate(PAGE_STATE)
+
+
+def same_poses(a: dict[str, list[float]], b: dict[str, list[float]], tol: float = 1e-6) -> bool:
+    return a.keys() == b.keys() and all(np.allclose(a[k], b[k], atol=tol) for k in a)
+
+
+def wait_for_scene(
+    page: Any, what: str, expect: Callable[[dict[str, Any]], bool] = lambda state: True
+) -> dict[str, Any]:
+    """Wait until the page holds ``expect``'s scene, steadily, and has drawn a frame of it.
+
+    Steady: every scene message applied (empty queue), every robot visual
+    mounted, and the same nodes and poses in two polls in a row.
+    """
+    previous: list[dict[str, Any] | None] = [None]
+
+    def ready() -> tuple[bool, Any]:
+        state = page_state(page)
+        if state is None:
+            return False, "viser's test hooks not on the page (yet)"
+        steady = {k: v for k, v in state.items() if k != "frame"}
+        done = (
+            state["visuals"] > 0
+            and state["mounted"] == state["visuals"]
+            and state["queued"] == 0
+            and expect(state)
+            and steady == previous[0]
+        )
+        previous[0] = steady
+        return done, state
+
+    state = wait_until(ready, f"the page did not show {what}")
+    frame = state["frame"]
+    wait_until(
+        lambda: ((now := page_state(page)) is not None and now["frame"] > frame, now),
+        f"the page did not draw {what}",
+    )
+    return state
+
+
+def wait_for_robot(page: Any) -> dict[str, Any]:
+    """Wait until the robot's links are drawn, not only the panel and grid; its scene."""
+    state = wait_for_scene(page, "the robot")
+    wait_until(
+        lambda: ((n := blue_pixels(scene_pixels(page))) >= 1000, n),
+        "the robot was not drawn (blue pixels)",
+    )
+    return state
 
 
 def changed(a: np.ndarray, b: np.ndarray) -> int:
@@ -135,15 +228,12 @@ def open_page(browser: Any, url: str) -> Any:
     # fixedDpr: viser otherwise lowers the resolution when software WebGL is slow,
     # at a moment of its choosing, and identical scenes stop giving identical pixels.
     page.goto(url + "/?fixedDpr=1")
-    page.get_by_text(JOINTS[-1]).first.wait_for(timeout=30_000)  # the panel is built
+    page.get_by_text(JOINTS[-1]).first.wait_for(timeout=DEADLINE_S * 1000)  # the panel
     return page
 
 
-def wait_for(predicate: Callable[[], bool], timeout_s: float = 10.0) -> None:
-    deadline = time.monotonic() + timeout_s
-    while not predicate():
-        assert time.monotonic() < deadline, "timed out"
-        time.sleep(0.05)
+def wait_for(predicate: Callable[[], bool], what: str = "timed out") -> None:
+    wait_until(lambda: (predicate(), None), what)
 
 
 def test_the_page_follows_commands_and_commands_the_robot(
@@ -155,14 +245,17 @@ def test_the_page_follows_commands_and_commands_the_robot(
     page = open_page(browser, proc.viewer_url)
     # viser draws its share-link button as this icon (present by default); it is off.
     assert page.locator("svg.tabler-icon-share").count() == 0
-    wait_for_robot(page)
+    home_poses = wait_for_robot(page)["poses"]
     home = settle(page, "1-home")
 
     tcp = Tcp(proc.port)
     try:
         assert tcp.ask("degrees") == "ok"
         assert tcp.ask("move 0,1 90,45") == "ok"
-        wait_for(lambda: slider_input(page, "joint_s").input_value() == "90")
+        wait_for(lambda: slider_input(page, "joint_s").input_value() == "90", "slider at 90")
+        moved_poses = wait_for_scene(
+            page, "the move", lambda state: not same_poses(state["poses"], home_poses)
+        )["poses"]
         moved = settle(page, "2-moved")
         assert changed(home, moved) > 2000
         assert "move 0,1 90,45" in field(page, "Last commands").input_value()
@@ -172,26 +265,37 @@ def test_the_page_follows_commands_and_commands_the_robot(
         box = slider_input(page, "joint_e")
         box.fill("30")
         box.press("Enter")
-        wait_for(lambda: tcp.ask("where").split(",")[2] == "30")
+        wait_for(lambda: tcp.ask("where").split(",")[2] == "30", "joint_e at 30")
         assert tcp.ask("where") == "ok 90,45,30,0,0,0,0"
+        poses = wait_for_scene(
+            page, "the slider's move", lambda state: not same_poses(state["poses"], moved_poses)
+        )["poses"]
         settle(page, "3-slider")
 
         # A tab opened late shows the same state at once.
         late = open_page(browser, proc.viewer_url)
         wait_for_robot(late)
-        wait_for(lambda: panel_state(late) == panel_state(page))
+        wait_for(lambda: panel_state(late) == panel_state(page), "the same panel in both tabs")
+        wait_for_scene(late, "the same pose", lambda state: same_poses(state["poses"], poses))
         assert panel_state(late)["joint_e"] == "30"
         assert changed(settle(late, "4-late-tab"), settle(page, "4-first-tab")) < 20
         late.close()
 
         # Markers appear; `clear` removes them and homes: the page looks as it began.
         before = settle(page, "5-before-marks")
+        markers = wait_for_scene(page, "the scene before the marks")["markers"]
         for line in ("rgb 255,0,0", "marker cube", "mark 0.5,-0.5,0.3,0,0,0", "mark"):
             assert tcp.ask(line) == "ok"
+        wait_for_scene(page, "two markers", lambda state: state["markers"] == markers + 2)
         marked = settle(page, "6-marks")
         assert changed(before, marked) > 20
         assert tcp.ask("clear") == "ok"
-        wait_for(lambda: slider_input(page, "joint_s").input_value() == "0")
+        wait_for(lambda: slider_input(page, "joint_s").input_value() == "0", "slider at 0")
+        wait_for_scene(
+            page,
+            "the cleared scene",
+            lambda state: state["markers"] == 0 and same_poses(state["poses"], home_poses),
+        )
         cleared = settle(page, "7-cleared")
         assert changed(home, cleared) < 20
     finally:

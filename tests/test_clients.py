@@ -10,6 +10,7 @@ from __future__ import annotations
 import io
 import math
 import os
+import re
 import select
 import signal
 import socket
@@ -109,7 +110,7 @@ def test_client_gives_up_after_its_retry_time():
     start = time.monotonic()
     with pytest.raises(ServerUnavailable, match=f"no c2rviz server at 127.0.0.1:{port}"):
         client.open()
-    assert 0.3 <= time.monotonic() - start < 2.0
+    assert 0.3 <= time.monotonic() - start < 10.0  # gave up, and not at once
     assert len(notes) == 1 and "retrying" in notes[0]
 
 
@@ -119,7 +120,7 @@ def test_client_gives_up_after_its_retry_time():
 def test_player_plays_motoman_txt_to_the_seed_end_pose(server, connect, capsys):
     start = time.monotonic()
     assert player.main([MOTOMAN, "--port", str(server.port), "--speed", "1000"]) == 0
-    assert time.monotonic() - start < 5  # 26 s of sleeps at speed 1000
+    assert time.monotonic() - start < 20  # 26 s of sleeps at speed 1000
     assert where_degrees(server, connect) == SEED_END
     out = capsys.readouterr().out
     assert "[ 1/16] sleep 5 -> ok" in out
@@ -271,7 +272,7 @@ def test_the_player_finds_bundled_files_and_reports_missing_ones(tmp_path, monke
 def test_the_player_gives_up_when_no_server_answers(tmp_path, capsys):
     start = time.monotonic()
     assert player.main([MOTOMAN, "--port", str(free_port()), "--timeout", "0.3"]) == 1
-    assert time.monotonic() - start < 3
+    assert time.monotonic() - start < 15  # gave up after --timeout, did not hang
     assert "no c2rviz server at 127.0.0.1:" in capsys.readouterr().err
 
 
@@ -350,6 +351,28 @@ def test_piped_repl_exits_1_when_a_line_got_an_error(server, connect):
     assert "error: goto: joints needs 7 values, got 1" in local.stdout
 
 
+def test_the_readmes_quick_start_runs_as_shown(server):
+    """README's first example needs nothing but the installed client, and prints what it shows."""
+    readme = (ROOT / "README.md").read_text()
+    quick = readme.split("## Quick start")[1].split("\n## ")[0]
+    command, shown = re.search(r"```sh\n(printf .*)\n```\n\n```\n(.*?)```", quick, re.S).groups()
+    script, client = re.fullmatch(r"printf '(.*)' \| \.venv/bin/(c2rviz-cli)", command).groups()
+    assert client == "c2rviz-cli" and "nc " not in command
+    done = subprocess.run(
+        [sys.executable, REPL_SCRIPT, "--port", str(server.port)],
+        input=script.replace("\\n", "\n"),
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=env(),
+    )
+    said = shown.replace(":31000:", f":{server.port}:").splitlines()
+    assert done.stderr.splitlines() == said[:2]  # the connection messages
+    assert done.stdout.splitlines() == said[2:]  # the replies
+    assert done.returncode == 1  # as the README says: a line got an error
+    assert "sudo apt-get install netcat-openbsd" in quick
+
+
 def test_repl_goto_in_radians_and_its_errors(server, monkeypatch, capsys):
     text = (
         "goto 0.5,0,0,0,0,0,0 rate=1000\n"  # default step: 2 degrees = 0.0349 rad
@@ -400,22 +423,29 @@ def test_repl_quit_stops_the_server(c2rviz_process, monkeypatch, capsys):
 
 def test_repl_waits_for_a_server_that_starts_late(c2rviz_process):
     port = free_port()
-    repl_proc = subprocess.Popen(
-        [sys.executable, REPL_SCRIPT, "--port", str(port), "--timeout", "30"],
+    with subprocess.Popen(
+        [sys.executable, REPL_SCRIPT, "--port", str(port), "--timeout", "120"],
         stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
         env=env(),
-    )
-    try:
-        time.sleep(1.0)
-        assert repl_proc.poll() is None
-        c2rviz_process("--no-viewer", "--port", str(port))
-        out, err = repl_proc.communicate("where\nq\n", timeout=30)
-    finally:
-        repl_proc.kill()
-        repl_proc.wait()
+    ) as repl_proc:
+        try:
+            assert repl_proc.stderr is not None
+            said = b""
+            while b"retrying" not in said:  # it has tried once, found nothing, and waits
+                ready, _, _ = select.select([repl_proc.stderr], [], [], 60)
+                chunk = os.read(repl_proc.stderr.fileno(), 4096) if ready else b""
+                assert chunk, f"the REPL said {said!r} and then nothing"
+                said += chunk
+            assert repl_proc.poll() is None
+            c2rviz_process("--no-viewer", "--port", str(port))
+            out, err = repl_proc.communicate("where\nq\n", timeout=120)
+            err = said.decode() + err
+        finally:
+            repl_proc.kill()
+            repl_proc.wait()
     assert repl_proc.returncode == 0, err
     assert f"no server at 127.0.0.1:{port} yet" in err and "retrying" in err
     assert "Socket Connected" in err
@@ -434,7 +464,7 @@ def test_repl_gives_up_with_a_clear_message():
         env=env(),
     )
     assert done.returncode == 1
-    assert time.monotonic() - start < 6
+    assert time.monotonic() - start < 20  # gave up after --timeout, did not hang
     assert f"no c2rviz server at 127.0.0.1:{port} after 1." in done.stderr
     assert "giving up" in done.stderr
     assert "Traceback" not in done.stderr + done.stdout
@@ -471,7 +501,7 @@ class Terminal:
     def send(self, keys: str) -> None:
         os.write(self.master, keys.encode())
 
-    def expect(self, text: str, timeout: float = 15.0) -> str:
+    def expect(self, text: str, timeout: float = 60.0) -> str:
         """Wait until ``text`` appears; return the output up to it and consume it."""
         deadline = time.monotonic() + timeout
         while text not in self.seen:
@@ -490,7 +520,7 @@ class Terminal:
         before, self.seen = self.seen[:cut], self.seen[cut:]
         return before
 
-    def finish(self, timeout: float = 10.0) -> tuple[int, str]:
+    def finish(self, timeout: float = 60.0) -> tuple[int, str]:
         """Wait for the exit; return the status and the rest of the output."""
         status = self.proc.wait(timeout=timeout)
         while select.select([self.master], [], [], 0.2)[0]:
@@ -502,6 +532,27 @@ class Terminal:
                 break
             self.seen += data.decode(errors="replace")
         return status, self.seen
+
+    def wait_blocked_in(self, *kernel_functions: str, fallback_s: float) -> None:
+        """Wait until the process sleeps in one of ``kernel_functions`` (``/proc/PID/wchan``).
+
+        ``hrtimer_nanosleep`` is ``time.sleep``; ``poll_schedule_timeout`` or
+        ``do_select`` is readline waiting for a key. Where the kernel does not say
+        (wchan hidden), wait ``fallback_s`` instead.
+        """
+        deadline = time.monotonic() + 60
+        while True:
+            try:
+                where = Path(f"/proc/{self.proc.pid}/wchan").read_text().strip()
+            except OSError:
+                where = "0"
+            if where in ("", "0"):
+                time.sleep(fallback_s)
+                return
+            if any(name in where for name in kernel_functions):
+                return
+            assert time.monotonic() < deadline, f"still in {where!r}, not {kernel_functions}"
+            time.sleep(0.02)
 
     def close(self) -> None:
         if self.proc.poll() is None:
@@ -538,7 +589,7 @@ def test_repl_on_a_terminal(server, connect, terminal, tmp_path):
     term.send("bogus\n")
     term.expect("error: unknown command 'bogus'")
     term.send("sleep 30\n")
-    time.sleep(0.5)
+    term.wait_blocked_in("nanosleep", fallback_s=0.5)  # the local sleep has begun
     term.send("\x03")  # Ctrl-C stops the command, not the REPL
     term.expect("interrupted")
     term.send("where\n")
@@ -557,8 +608,8 @@ def test_repl_leaves_cleanly_on_ctrl_d_and_ctrl_c(server, terminal, key):
     term = terminal("--port", str(server.port))
     term.expect("> ")
     # CPython's readline misses a SIGINT that lands between drawing the prompt and
-    # waiting for input (a race no typist can hit): give it time to start waiting.
-    time.sleep(0.3)
+    # waiting for input (a race no typist can hit): wait until it waits.
+    term.wait_blocked_in("poll_schedule_timeout", "select", "poll", fallback_s=0.3)
     term.send(key)
     status, rest = term.finish()
     assert status == 0

@@ -53,7 +53,7 @@ def client_count(server):
     return server.call(lambda: len(server.server.connections))
 
 
-def wait_for(predicate, timeout=5.0):
+def wait_for(predicate, timeout=60.0):
     deadline = time.monotonic() + timeout
     while not predicate():
         assert time.monotonic() < deadline, "timed out"
@@ -252,7 +252,7 @@ def test_a_partial_line_at_disconnect_is_discarded(live, connect, how):
     server, _bystander, check = live()
     client = connect(server)
     client.send("joints 0,0,0,0,0,0,0.5")  # would be valid with its newline
-    time.sleep(0.05)
+    wait_for(lambda: max(server.call(lambda: [len(c.buffer) for c in server.server.connections])))
     if how == "close":
         client.close()
     else:
@@ -266,7 +266,7 @@ def test_a_reset_mid_line_ends_quietly(live, connect):
     server, _bystander, check = live()
     client = connect(server)
     client.send("move 0 0.5")
-    time.sleep(0.05)
+    wait_for(lambda: max(server.call(lambda: [len(c.buffer) for c in server.server.connections])))
     client.sock.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
     client.close()  # RST, not FIN
     wait_for(lambda: client_count(server) == 1)
@@ -304,7 +304,7 @@ def test_an_http_request_is_closed_at_its_first_line(live, connect, request_byte
 
 def test_a_real_http_client_gets_no_http_and_nothing_runs(live):
     server, _bystander, check = live()
-    conn = http.client.HTTPConnection(server.host, server.port, timeout=5)
+    conn = http.client.HTTPConnection(server.host, server.port, timeout=30)
     conn.request("POST", "/", body=b"home\n")
     with pytest.raises(http.client.HTTPException):
         conn.getresponse()
@@ -381,10 +381,10 @@ def test_an_idle_client_between_lines_is_not_dropped(live, connect):
 
 def test_a_steady_stream_split_across_reads_is_not_dropped(live, connect):
     """Each line finishes in time, but some line is always unfinished at a read's end."""
-    server, _bystander, check = live(partial_timeout_s=0.5)
+    server, _bystander, check = live(partial_timeout_s=1.0)  # each step: 10x slack
     client = connect(server)
     client.send("wh")
-    for _ in range(10):  # 10 x 0.1 s: well past the timeout in total
+    for _ in range(20):  # 20 x 0.1 s: well past the timeout in total
         time.sleep(0.1)
         client.send("ere\nwh")
         assert client.read_line() == WHERE
@@ -395,11 +395,11 @@ def test_a_steady_stream_split_across_reads_is_not_dropped(live, connect):
 
 def test_a_sleep_does_not_count_against_the_partial_timeout(live, connect):
     """While a client sleeps the server is not reading it: its line cannot finish."""
-    server, _bystander, check = live(partial_timeout_s=0.5)
+    server, _bystander, check = live(partial_timeout_s=1.0)  # each step: 10x slack
     client = connect(server)
     client.send("wh")
     time.sleep(0.1)
-    client.send("ere\nsleep 1\nwh")
+    client.send("ere\nsleep 2\nwh")
     assert client.read_line() == WHERE
     time.sleep(0.1)
     client.send("ere\n")
@@ -436,7 +436,7 @@ def test_a_quit_after_thousands_of_lines_answers_the_rest_with_shutting_down(liv
     while reply := client.read_line():
         got.append(reply)
     assert got == [WHERE] * 3000 + ["ok"] + [replies.SHUTTING_DOWN] * 2000
-    assert server.quit.wait(timeout=5)
+    assert server.quit.wait(timeout=60)
 
 
 def test_the_limits_table_matches_the_code():

@@ -194,7 +194,7 @@ def test_the_server_does_what_the_model_predicts(live, lines, seed):
     event(f"ok replies: {min(sum(r.startswith('ok') for r in expected), 3)}")
     event(f"state changed: {shadow.q != q or shadow.markers != markers}")
 
-    with socket.create_connection((server.host, server.port), timeout=3) as sock:
+    with socket.create_connection((server.host, server.port), timeout=30) as sock:
         sock.sendall(data if closes else data + b"names\n")
         got = read_replies(sock, len(expected) + (not closes), closes)
 

@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import select
 import signal
 import socket
 import time
+from collections.abc import Callable
 
 import pytest
 
@@ -25,12 +27,26 @@ def port_is_free(port: int) -> bool:
     return True
 
 
+def wait_until(predicate: Callable[[], bool], timeout_s: float = 60.0) -> None:
+    deadline = time.monotonic() + timeout_s
+    while not predicate():
+        assert time.monotonic() < deadline, "timed out"
+        time.sleep(0.01)
+
+
 def read_all(sock: socket.socket) -> list[str]:
     """Every reply line until the server closes the connection."""
     data = b""
     while chunk := sock.recv(65536):
         data += chunk
     return data.decode().splitlines()
+
+
+def wait_answered(socks: list[socket.socket]) -> None:
+    """Wait until each socket has a reply to read (the server has read its line), unread."""
+    for sock in socks:
+        ready, _, _ = select.select([sock], [], [], 60)
+        assert ready, "the server did not answer in 60 s"
 
 
 def open_clients(port: int) -> dict[str, list[socket.socket]]:
@@ -63,10 +79,10 @@ def open_clients(port: int) -> dict[str, list[socket.socket]]:
 def test_a_signal_stops_promptly_with_20_clients(c2rviz_process, sig):
     proc = c2rviz_process("--no-viewer", "--max-unread", str(64 << 20))  # floods stay connected
     clients = open_clients(proc.port)
-    time.sleep(0.3)  # let the server read what was sent
+    wait_answered(clients["sent-bye"])  # the server has read what was sent
     start = time.monotonic()
     proc.popen.send_signal(sig)
-    assert proc.wait(timeout=10) == 0
+    assert proc.wait(timeout=25) == 0  # well before the 30 s sleeps end
     took = time.monotonic() - start
     print(f"{sig.name}: stopped {took:.2f} s after the signal, 20 clients connected")
     for sock in clients["idle"]:
@@ -91,11 +107,11 @@ def test_a_signal_stops_promptly_with_20_clients(c2rviz_process, sig):
 def test_quit_answers_every_line_already_read_then_exits_cleanly(c2rviz_process):
     proc = c2rviz_process("--no-viewer")
     clients = open_clients(proc.port)
-    quitter = socket.create_connection(("127.0.0.1", proc.port), timeout=10)
-    time.sleep(0.2)
+    quitter = socket.create_connection(("127.0.0.1", proc.port), timeout=60)
+    wait_answered(clients["sent-bye"])  # the server has read what was sent
     quitter.sendall(b"where\nquit\nwhere\nhome\n")
     assert read_all(quitter) == [HOME, "ok", replies.SHUTTING_DOWN, replies.SHUTTING_DOWN]
-    assert proc.wait(timeout=10) == 0  # well before the 30 s sleeps end
+    assert proc.wait(timeout=25) == 0  # well before the 30 s sleeps end
     for sock in clients["sleeping"]:
         assert read_all(sock) == [replies.SHUTTING_DOWN] * 3
     for sock in clients["idle"] + clients["partial"]:
@@ -112,7 +128,7 @@ def test_the_port_is_free_after_stop(start_server, connect):
     idle, sleeper = connect(server), connect(server)
     assert idle.ask("where") == HOME
     sleeper.send("sleep 30\nwhere\n")
-    time.sleep(0.1)
+    wait_until(lambda: "sleep 30" in server.call(lambda: list(server.scene.commands)))
     server.stop()
     assert idle.closed_by_server()
     assert sleeper.read_line() == replies.SHUTTING_DOWN
@@ -151,7 +167,7 @@ def test_a_stop_mid_flood_answers_what_was_read_in_order(start_server):
     reader = threading.Thread(target=lambda: replies_seen.extend(read_all(sock)))
     reader.start()
     sock.sendall(b"where\n" * 100_000)  # lands in kernel buffers; the server is still reading
-    time.sleep(0.05)
+    wait_until(lambda: server.call(lambda: len(server.scene.commands)) > 0)  # it has begun
     server.stop()
     reader.join(timeout=10)
     sock.close()
