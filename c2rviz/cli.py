@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import errno
 import ipaddress
 import logging
 import signal
@@ -134,10 +135,31 @@ def _open_scene(settings: Settings, robot: Robot) -> Scene:
     return ViserScene(robot, settings.viewer_host, settings.viewer_port, settings.hz)
 
 
+def _cannot_listen(host: str, port: int, exc: OSError) -> str:
+    """Why the command server cannot start, in one sentence."""
+    if exc.errno == errno.EADDRINUSE:
+        return (
+            f"cannot listen for commands on {host}:{port}: the port is in use "
+            "(another c2rviz?); choose another with --port (0 picks a free one)"
+        )
+    return f"cannot listen for commands on {host}:{port}: {exc.strerror or exc}"
+
+
 async def serve(settings: Settings, robot: Robot) -> int:
-    """Run the viewer and the command server until ``quit``, SIGINT or SIGTERM."""
+    """Run the viewer and the command server until ``quit``, SIGINT or SIGTERM.
+
+    The command port is bound first: when it is taken the program says so and
+    stops before the viewer starts (so no word about the viewer's port either).
+    """
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
+    world = World(robot, hz=settings.hz, defaults=settings.session)
+    server = CommandServer(world, settings.limits, on_quit=stop.set)
+    try:
+        host, port = await server.start(settings.host, settings.port)
+    except OSError as exc:
+        print(f"c2rviz: {_cannot_listen(settings.host, settings.port, exc)}", file=sys.stderr)
+        return 2
     try:
         scene = _open_scene(settings, robot)
     except OSError as exc:
@@ -146,19 +168,10 @@ async def serve(settings: Settings, robot: Robot) -> int:
             f"{exc.strerror or exc}",
             file=sys.stderr,
         )
+        await server.stop()
         return 2
-    world = World(robot, scene, hz=settings.hz, defaults=settings.session)
+    world.add_observers([scene])  # no client is served before this: nothing awaited since
     scene.start(world, loop)
-    server = CommandServer(world, settings.limits, on_quit=stop.set)
-    try:
-        host, port = await server.start(settings.host, settings.port)
-    except OSError as exc:
-        print(
-            f"c2rviz: cannot listen on {settings.host}:{settings.port}: {exc.strerror}",
-            file=sys.stderr,
-        )
-        scene.stop()
-        return 2
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, stop.set)
     names = " ".join(robot.joint_names)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import shutil
+import socket
 
 import pytest
 from conftest import ROOT
@@ -102,6 +103,23 @@ def test_main_exits_2_with_one_clear_sentence(argv, message, capsys):
     assert err.count("\n") == 0, err
     if argv == ["--robot", "r2d2"]:
         assert "choose from: fanuc_lrmate200id, kuka_lwr, motoman_sia20d" in err
+
+
+def test_a_taken_command_port_is_the_one_thing_said(capsys, caplog):
+    """Both ports taken (a second c2rviz): one sentence on the command port, exit 2, and
+    nothing from the viewer (it once said first that it had moved to the next port)."""
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        assert main(["--port", str(port), "--viser-port", str(port)]) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert caplog.records == []  # the viewer never started, so it had nothing to say
+    assert err == (
+        f"c2rviz: cannot listen for commands on 127.0.0.1:{port}: the port is in use "
+        "(another c2rviz?); choose another with --port (0 picks a free one)\n"
+    )
 
 
 def test_port_zero_prints_the_port_it_picked(c2rviz_process):
