@@ -171,6 +171,7 @@ async def serve(settings: Settings, robot: Robot) -> int:
         await server.stop()
         return 2
     world.add_observers([scene])  # no client is served before this: nothing awaited since
+    server.viewer_url = scene.url
     scene.start(world, loop)
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, stop.set)

@@ -18,6 +18,7 @@ __all__ = [
     "SHUTTING_DOWN",
     "error",
     "incomplete_line",
+    "not_http",
     "numbers",
     "ok",
     "too_many_clients",
@@ -64,3 +65,22 @@ def incomplete_line(timeout_s: float) -> str:
 
 def unread_replies(limit: int) -> str:
     return f"error: over {limit} bytes of unread replies; closing"
+
+
+def not_http(viewer_url: str | None) -> bytes:
+    """The whole answer to an HTTP request on the command port: a 400 a browser shows.
+
+    Its body is one ``error:`` line (so a line client reads it as one too) saying
+    what the port is and where the viewer is (``viewer_url``; None: no viewer).
+    """
+    viewer = f"the viewer is at {viewer_url}" if viewer_url else "no viewer is running"
+    body = (
+        f"error: this is the c2rviz command port (one text command per line), not HTTP; {viewer}\n"
+    ).encode()
+    head = (
+        "HTTP/1.1 400 Bad Request\r\n"
+        "Content-Type: text/plain; charset=utf-8\r\n"
+        f"Content-Length: {len(body)}\r\n"
+        "Connection: close\r\n\r\n"
+    )
+    return head.encode() + body
