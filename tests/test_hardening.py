@@ -291,8 +291,11 @@ def test_a_reset_with_replies_pending_ends_quietly(live, connect):
         b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n",
         b"POST /move HTTP/1.1\r\nHost: x\r\nContent-Length: 5\r\n\r\nquit\n",
         b"Host: 127.0.0.1:31000\r\nhome\r\n",
+        b"post / HTTP/1.1\r\nhome\r\nquit\r\n",
+        b"POST  /  HTTP/1.1\r\nhome\r\nquit\r\n",
+        b"GET /\r\nX-Forwarded-For: 10.0.0.1\r\nhome\r\nquit\r\n",
     ],
-    ids=["get", "post-with-quit-body", "header-first"],
+    ids=["get", "post-with-quit-body", "header-first", "lowercase", "double-space", "http-0.9"],
 )
 def test_an_http_request_is_closed_at_its_first_line(live, connect, request_bytes):
     server, _bystander, check = live()
