@@ -10,6 +10,7 @@ from collections.abc import Iterable
 
 from . import commands  # noqa: F401  (registers every verb)
 from .registry import help_text
+from .tolerance import limit_text
 
 __all__ = [
     "BYE",
@@ -18,6 +19,7 @@ __all__ = [
     "SHUTTING_DOWN",
     "error",
     "incomplete_line",
+    "limit",
     "not_http",
     "numbers",
     "ok",
@@ -53,6 +55,20 @@ def numbers(values: Iterable[float]) -> str:
     order 1 to 360.
     """
     return ",".join([f"{value:.10g}" if abs(value) > 1e-9 else "0" for value in values])
+
+
+def limit(value: float) -> str:
+    """One joint limit as ``limits``, limit errors and the page print it.
+
+    Args:
+        value: The limit in the unit shown ([rad], [deg] or [m]).
+
+    Returns:
+        10 significant digits, no trailing zeros (``-89.9999999``, ``3.1416``);
+        ``0`` within 1e-9 of zero. A value printed this way and sent back is
+        within the limit's tolerance (``tolerance.within_limit``).
+    """
+    return limit_text(value)
 
 
 def too_many_clients(limit: int) -> str:

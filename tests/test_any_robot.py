@@ -26,6 +26,7 @@ from c2rviz.robot import Robot
 
 DATA = Path(__file__).parent / "data"
 TREE = DATA / "tree_robot" / "tree.urdf"
+LIMITS_URDF = DATA / "limits_robot" / "limits.urdf"
 TINY_PACKAGE = DATA / "tiny_ws" / "src" / "tiny_description"
 
 needs_erd = pytest.mark.skipif(
@@ -247,6 +248,34 @@ def test_continuous_joint_takes_any_angle(client: Client, tree_server: ServerThr
     assert client.ask("move 3 720") == "ok"
     assert client.ask("where") == "ok 0,0,0,720"
     assert tree_server.q[3] == pytest.approx(4 * math.pi)
+
+
+# --- limits that print badly: puma560's +-1.570796325 rad, the seed's +-3.1416 rad ---------
+
+
+@pytest.fixture
+def limits_client() -> Iterator[Client]:
+    server = ServerThread(Robot.from_urdf(LIMITS_URDF), ServerLimits()).start()
+    client = Client(server.host, server.port)
+    yield client
+    client.close()
+    server.stop()
+
+
+def test_a_limit_prints_one_way_in_limits_and_errors(limits_client: Client) -> None:
+    client = limits_client
+    assert client.ask("degrees") == "ok"
+    low, high = client.ask("limits").removeprefix("ok ").split(",")[0].split(" ")[0].split("..")
+    assert (low, high) == ("-89.9999999", "89.9999999")
+    assert client.ask("move 0 89.99999999") == (
+        "error: joint1 (index 0) = 89.99999999 deg is outside its limits "
+        "-89.9999999..89.9999999 deg"
+    )
+    assert client.ask("move 0 89.9999999") == "ok"  # the printed limit is accepted
+    assert client.ask("radians") == "ok"
+    assert client.ask("move 1 3.1416000032") == (
+        "error: joint2 (index 1) = 3.141600003 rad is outside its limits -3.1416..3.1416 rad"
+    )
 
 
 def test_ini_section_with_package_path_and_xacro_args(tmp_path: Path) -> None:

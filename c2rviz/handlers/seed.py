@@ -135,7 +135,7 @@ def pose(session: Session, command: Pose) -> str:
 def limits(session: Session, command: Limits) -> str:
     table = session.table
     ranges = [
-        f"{replies.numbers([lo])}..{replies.numbers([hi])} {unit}"
+        f"{replies.limit(lo)}..{replies.limit(hi)} {unit}"
         for lo, hi, unit in zip(table.lower, table.upper, table.unit)
     ]
     if command.all:
