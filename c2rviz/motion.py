@@ -29,8 +29,9 @@ moves). A plan that leaves the limits is replaced by a brake to rest and a move
 from there; only if even the brake left them (a state this planner made cannot
 need that) are sampled positions clamped.
 
-Continuous joints have infinite limits and go to the literal value given (no
-wrapping: the caller chooses the turn). Prismatic joints are in [m].
+Continuous joints have the robot's finite limits (``robot.CONTINUOUS_LIMIT``,
+kept like any other) and go to the literal value given (no wrapping: the caller
+chooses the turn). Prismatic joints are in [m].
 """
 
 from __future__ import annotations
