@@ -145,15 +145,19 @@ def _cannot_listen(host: str, port: int, exc: OSError) -> str:
     return f"cannot listen for commands on {host}:{port}: {exc.strerror or exc}"
 
 
-async def serve(settings: Settings, robot: Robot) -> int:
+async def serve(settings: Settings, robot: Robot, name: str | None = None) -> int:
     """Run the viewer and the command server until ``quit``, SIGINT or SIGTERM.
+
+    ``name`` is the robot's name as the user chose it (``--robot kuka_lwr``), which
+    the banner and ``names`` say; None: the model's name (the URDF's ``<robot name>``).
 
     The command port is bound first: when it is taken the program says so and
     stops before the viewer starts (so no word about the viewer's port either).
     """
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
-    world = World(robot, hz=settings.hz, defaults=settings.session)
+    name = name or robot.name
+    world = World({name: robot}, hz=settings.hz, defaults=settings.session)
     server = CommandServer(world, settings.limits, on_quit=stop.set)
     try:
         host, port = await server.start(settings.host, settings.port)
@@ -176,9 +180,10 @@ async def serve(settings: Settings, robot: Robot) -> int:
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, stop.set)
     names = " ".join(robot.joint_names)
+    model = "" if name == robot.name else f" (model {robot.name})"
     print(
-        f"c2rviz: {robot.name}, chain {robot.base} -> {robot.eelink}, joints 0..{robot.n - 1}: "
-        f"{names}",
+        f"c2rviz: {name}{model}, chain {robot.base} -> {robot.eelink}, "
+        f"joints 0..{robot.n - 1}: {names}",
         flush=True,
     )
     print(f"c2rviz: commands on {host}:{port} (try: nc {host} {port}, then 'help')", flush=True)
@@ -231,8 +236,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except C2rvizError as exc:
         print(f"c2rviz: {exc}", file=sys.stderr)
         return 2
+    # The name the user chose; a --urdf without --robot is named by its model.
+    name = robot.name if args.urdf is not None and args.robot is None else settings.robot
     try:
-        return asyncio.run(serve(settings, robot))
+        return asyncio.run(serve(settings, robot, name))
     except KeyboardInterrupt:  # a second Ctrl-C while stopping
         return 130
 

@@ -6,7 +6,7 @@ import shutil
 import socket
 
 import pytest
-from conftest import ROOT
+from conftest import ROOT, Client
 
 from c2rviz.cli import main
 from c2rviz.config import ServerLimits, find_ini, load_settings
@@ -126,6 +126,24 @@ def test_port_zero_prints_the_port_it_picked(c2rviz_process):
     proc = c2rviz_process("--no-viewer")
     assert proc.port > 0
     assert any(f"commands on 127.0.0.1:{proc.port}" in line for line in proc.output)
+
+
+def test_the_robot_goes_by_the_name_the_user_chose(c2rviz_process):
+    """--robot kuka_lwr (whose URDF says lwr): kuka_lwr in the banner, names and errors."""
+    proc = c2rviz_process("--robot", "kuka_lwr", "--no-viewer")
+    banner = next(line for line in proc.output if "chain" in line)
+    assert banner.startswith("c2rviz: kuka_lwr (model lwr), chain lwr_base_link -> lwr_7_link,")
+    client = Client("127.0.0.1", proc.port)
+    try:
+        joints = ",".join(f"lwr_{i}_joint" for i in range(7))
+        assert client.ask("names") == f"ok kuka_lwr {joints}"
+        assert client.ask("move 9 1") == (
+            "error: joint index 9 out of range: kuka_lwr has joints 0..6"
+        )
+        assert client.ask("quit") == "ok"
+    finally:
+        client.close()
+    assert proc.wait() == 0
 
 
 TINY_WS = ROOT / "tests" / "data" / "tiny_ws"

@@ -82,7 +82,7 @@ def move(session: Session, command: Move) -> Reply:
     n = session.n
     for index in command.indices:
         if index >= n:
-            raise JointIndexError(index, session.robot.name, n)
+            raise JointIndexError(index, session.state.name, n)
     q = list(session.state.target)
     for index, value in zip(command.indices, session.to_si(command.indices, command.values)):
         q[index] = value
@@ -152,7 +152,7 @@ def limits(session: Session, command: Limits) -> str:
 
 @handler(Names)
 def names(session: Session, command: Names) -> str:
-    return replies.ok(f"{session.robot.name} {','.join(session.robot.joint_names)}")
+    return replies.ok(f"{session.state.name} {','.join(session.robot.joint_names)}")
 
 
 @handler(Version)
