@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import errno
 import ipaddress
 import logging
 import signal
@@ -141,10 +142,36 @@ def _open_scene(settings: Settings, robot: Robot) -> Scene:
     return ViserScene(robot, settings.viewer_host, settings.viewer_port, settings.hz)
 
 
-async def serve(settings: Settings, robot: Robot) -> int:
-    """Run the viewer and the command server until ``quit``, SIGINT or SIGTERM."""
+def _cannot_listen(host: str, port: int, exc: OSError) -> str:
+    """Why the command server cannot start, in one sentence."""
+    if exc.errno == errno.EADDRINUSE:
+        return (
+            f"cannot listen for commands on {host}:{port}: the port is in use "
+            "(another c2rviz?); choose another with --port (0 picks a free one)"
+        )
+    return f"cannot listen for commands on {host}:{port}: {exc.strerror or exc}"
+
+
+async def serve(settings: Settings, robot: Robot, name: str | None = None) -> int:
+    """Run the viewer and the command server until ``quit``, SIGINT or SIGTERM.
+
+    ``name`` is the robot's name as the user chose it (``--robot kuka_lwr``), which
+    the banner and ``names`` say; None: the model's name (the URDF's ``<robot name>``).
+
+    The command port is bound first: when it is taken the program says so and
+    stops before the viewer starts (so no word about the viewer's port either).
+    """
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
+    name = name or robot.name
+    disabled = {name: read_srdf(settings.srdf)} if settings.srdf is not None else None
+    world = World({name: robot}, hz=settings.hz, defaults=settings.session, disabled_pairs=disabled)
+    server = CommandServer(world, settings.limits, on_quit=stop.set)
+    try:
+        host, port = await server.start(settings.host, settings.port)
+    except OSError as exc:
+        print(f"c2rviz: {_cannot_listen(settings.host, settings.port, exc)}", file=sys.stderr)
+        return 2
     try:
         scene = _open_scene(settings, robot)
     except OSError as exc:
@@ -153,26 +180,18 @@ async def serve(settings: Settings, robot: Robot) -> int:
             f"{exc.strerror or exc}",
             file=sys.stderr,
         )
+        await server.stop()
         return 2
-    disabled = {robot.name: read_srdf(settings.srdf)} if settings.srdf is not None else None
-    world = World(robot, scene, hz=settings.hz, defaults=settings.session, disabled_pairs=disabled)
+    world.add_observers([scene])  # no client is served before this: nothing awaited since
+    server.viewer_url = scene.url
     scene.start(world, loop)
-    server = CommandServer(world, settings.limits, on_quit=stop.set)
-    try:
-        host, port = await server.start(settings.host, settings.port)
-    except OSError as exc:
-        print(
-            f"c2rviz: cannot listen on {settings.host}:{settings.port}: {exc.strerror}",
-            file=sys.stderr,
-        )
-        scene.stop()
-        return 2
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, stop.set)
     names = " ".join(robot.joint_names)
+    model = "" if name == robot.name else f" (model {robot.name})"
     print(
-        f"c2rviz: {robot.name}, chain {robot.base} -> {robot.eelink}, joints 0..{robot.n - 1}: "
-        f"{names}",
+        f"c2rviz: {name}{model}, chain {robot.base} -> {robot.eelink}, "
+        f"joints 0..{robot.n - 1}: {names}",
         flush=True,
     )
     print(f"c2rviz: commands on {host}:{port} (try: nc {host} {port}, then 'help')", flush=True)
@@ -225,8 +244,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except C2rvizError as exc:
         print(f"c2rviz: {exc}", file=sys.stderr)
         return 2
+    # The name the user chose; a --urdf without --robot is named by its model.
+    name = robot.name if args.urdf is not None and args.robot is None else settings.robot
     try:
-        return asyncio.run(serve(settings, robot))
+        return asyncio.run(serve(settings, robot, name))
     except KeyboardInterrupt:  # a second Ctrl-C while stopping
         return 130
 

@@ -76,10 +76,14 @@ _NUMBER_CHARS_RE = re.compile(r"[0-9.,eE+-]*")
 _INDEX_RE = re.compile(r"[0-9]+")
 _INDEX_LIST_RE = re.compile(r"[0-9]+(?:,[0-9]+)*")
 _AROUND_COMMA_RE = re.compile(r"[ \t]*,[ \t]*")
-# An HTTP request line, or one of the headers every HTTP client sends. Only
-# these: a typo such as "where:" stays an unknown command, not a disconnect.
+# An HTTP request line (a method word, any case, then whitespace and "/"; or anything
+# ending in " HTTP/1.1": HTTP/0.9's "GET /", "OPTIONS *", "CONNECT host:443 HTTP/1.1"),
+# or one of the headers every HTTP client sends. Only these: a typo such as "where:"
+# stays an unknown command, not a disconnect. Tried on the stripped line, and only when
+# its first word is no verb.
 _HTTP_RE = re.compile(
-    r"[A-Z]+ \S+ HTTP/[0-9.]+"
+    r"(?i:get|post|put|delete|head|options|patch|connect|trace)\s+/.*"
+    r"|.*\sHTTP/[0-9]\.[0-9]"
     r"|(?i:host|user-agent|accept|accept-encoding|accept-language|connection|content-length"
     r"|content-type|cookie|upgrade|origin|referer|sec-websocket-key):.*"
 )

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from .tolerance import limit_text, texts_apart
+
 __all__ = [
     "ArmMoved",
     "BadArguments",
@@ -103,9 +105,17 @@ class JointLimitError(C2rvizError):
         self.lower = lower
         self.upper = upper
         self.unit = unit
+        # The limits print as `limits` prints them; the one passed, with more digits
+        # if need be, so that the value never looks inside the printed range.
+        if value < lower:
+            value_text, low = texts_apart(value, lower)
+            high = limit_text(upper)
+        else:
+            value_text, high = texts_apart(value, upper)
+            low = limit_text(lower)
         super().__init__(
-            f"{joint} (index {index}) = {value:.10g} {unit} is outside its limits "
-            f"{lower:.4g}..{upper:.4g} {unit}"
+            f"{joint} (index {index}) = {value_text} {unit} is outside its limits "
+            f"{low}..{high} {unit}"
         )
 
 

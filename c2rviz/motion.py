@@ -37,8 +37,9 @@ a brake to rest followed by a move from rest. What is left, of rounding size
 (under 1e-8 in 60,000 random plans), is ``Motion.overshoot``, and sampled
 positions are clamped to the limits whenever it is not 0.
 
-Continuous joints have infinite limits and go to the literal value given (no
-wrapping: the caller chooses the turn). Prismatic joints are in [m].
+Continuous joints have the robot's finite limits (``robot.CONTINUOUS_LIMIT``,
+kept like any other) and go to the literal value given (no wrapping: the caller
+chooses the turn). Prismatic joints are in [m].
 """
 
 from __future__ import annotations

@@ -66,8 +66,9 @@ class MotionLimits:
         velocity: Maximum speed [rad/s or m/s] at speed fraction 1.
         acceleration: Maximum acceleration [rad/s^2 or m/s^2] at speed fraction 1.
         jerk: Maximum jerk [rad/s^3 or m/s^3] at speed fraction 1.
-        lower: Lower position limit [rad or m]; ``-inf`` for a continuous joint.
-        upper: Upper position limit [rad or m]; ``inf`` for a continuous joint.
+        lower: Lower position limit [rad or m] (a continuous joint's is finite too:
+            ``-robot.CONTINUOUS_LIMIT``; ``-inf`` is allowed for no limit).
+        upper: Upper position limit [rad or m].
 
     Raises:
         MotionLimitError: a count that differs from ``len(velocity)``, a

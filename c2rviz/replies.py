@@ -10,6 +10,7 @@ from collections.abc import Iterable
 
 from . import commands  # noqa: F401  (registers every verb)
 from .registry import help_text
+from .tolerance import limit_text
 
 __all__ = [
     "BYE",
@@ -18,6 +19,8 @@ __all__ = [
     "SHUTTING_DOWN",
     "error",
     "incomplete_line",
+    "limit",
+    "not_http",
     "numbers",
     "ok",
     "too_many_clients",
@@ -54,6 +57,20 @@ def numbers(values: Iterable[float]) -> str:
     return ",".join([f"{value:.10g}" if abs(value) > 1e-9 else "0" for value in values])
 
 
+def limit(value: float) -> str:
+    """One joint limit as ``limits``, limit errors and the page print it.
+
+    Args:
+        value: The limit in the unit shown ([rad], [deg] or [m]).
+
+    Returns:
+        10 significant digits, no trailing zeros (``-89.9999999``, ``3.1416``);
+        ``0`` within 1e-9 of zero. A value printed this way and sent back is
+        within the limit's tolerance (``tolerance.within_limit``).
+    """
+    return limit_text(value)
+
+
 def too_many_clients(limit: int) -> str:
     return f"error: too many clients (limit {limit}); closing"
 
@@ -64,3 +81,22 @@ def incomplete_line(timeout_s: float) -> str:
 
 def unread_replies(limit: int) -> str:
     return f"error: over {limit} bytes of unread replies; closing"
+
+
+def not_http(viewer_url: str | None) -> bytes:
+    """The whole answer to an HTTP request on the command port: a 400 a browser shows.
+
+    Its body is one ``error:`` line (so a line client reads it as one too) saying
+    what the port is and where the viewer is (``viewer_url``; None: no viewer).
+    """
+    viewer = f"the viewer is at {viewer_url}" if viewer_url else "no viewer is running"
+    body = (
+        f"error: this is the c2rviz command port (one text command per line), not HTTP; {viewer}\n"
+    ).encode()
+    head = (
+        "HTTP/1.1 400 Bad Request\r\n"
+        "Content-Type: text/plain; charset=utf-8\r\n"
+        f"Content-Length: {len(body)}\r\n"
+        "Connection: close\r\n\r\n"
+    )
+    return head.encode() + body

@@ -21,9 +21,18 @@ import pinocchio as pin
 from .errors import RobotError
 from .sources import RobotSource, load_source
 
-__all__ = ["ChainJoint", "Robot"]
+__all__ = ["CONTINUOUS_LIMIT", "ChainJoint", "Robot"]
 
 _UNBOUNDED = 1e10  # Pinocchio's stand-in for "no limit" is a huge number.
+
+CONTINUOUS_LIMIT = 1e6
+"""Limit [rad, or m] of a joint the URDF leaves unbounded: it takes -1e6..1e6.
+
+About 159,000 turns (57,295,779.51 deg), so no real use meets it; finite, so
+every value ``where`` replies is a finite number that can be sent back (an
+unbounded joint once took 1.7e308 rad, and ``where`` in degrees said ``inf``).
+A value past it is refused like any limit; motion planning keeps within it too
+(it reads ``Robot.lower``/``upper``)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -33,10 +42,12 @@ class ChainJoint:
     Attributes:
         name: Joint name from the URDF.
         prismatic: True for a prismatic joint (values in [m]), else revolute [rad].
-        lower: Lower limit [rad or m]; ``-inf`` for a continuous joint.
-        upper: Upper limit [rad or m]; ``inf`` for a continuous joint.
+        lower: Lower limit [rad or m]; ``-CONTINUOUS_LIMIT`` for a continuous joint.
+        upper: Upper limit [rad or m]; ``CONTINUOUS_LIMIT`` for a continuous joint.
         idx_q: Index of the joint's first entry in Pinocchio's configuration.
         nq: 1, or 2 for a continuous joint (stored as cos, sin).
+        continuous: The URDF gives no limits (a continuous joint): any angle, not
+            wrapped (720 deg stays 720), within the finite ``CONTINUOUS_LIMIT``.
     """
 
     name: str
@@ -45,10 +56,7 @@ class ChainJoint:
     upper: float
     idx_q: int
     nq: int
-
-    @property
-    def continuous(self) -> bool:
-        return math.isinf(self.lower) and math.isinf(self.upper)
+    continuous: bool = False
 
 
 class Robot:
@@ -183,14 +191,15 @@ class Robot:
                     "only revolute, continuous and prismatic joints can be in the chain"
                 )
             prismatic = kind.startswith("JointModelP")
-            if jm.nq == 2:  # continuous: unbounded revolute stored as (cos, sin)
-                lower, upper = -math.inf, math.inf
-            else:
-                lower = float(model.lowerPositionLimit[jm.idx_q])
-                upper = float(model.upperPositionLimit[jm.idx_q])
-                if lower <= -_UNBOUNDED and upper >= _UNBOUNDED:
-                    lower, upper = -math.inf, math.inf
-            chain.append(ChainJoint(model.names[j], prismatic, lower, upper, jm.idx_q, jm.nq))
+            lower = float(model.lowerPositionLimit[jm.idx_q])
+            upper = float(model.upperPositionLimit[jm.idx_q])
+            # nq 2: a continuous joint, stored as (cos, sin), whose limits mean nothing
+            continuous = jm.nq == 2 or (lower <= -_UNBOUNDED and upper >= _UNBOUNDED)
+            if continuous:
+                lower, upper = -CONTINUOUS_LIMIT, CONTINUOUS_LIMIT
+            chain.append(
+                ChainJoint(model.names[j], prismatic, lower, upper, jm.idx_q, jm.nq, continuous)
+            )
         if not chain:
             raise RobotError(
                 f"no movable joint between base {self.base!r} and eelink {self.eelink!r} "

@@ -181,7 +181,13 @@ class Connection(asyncio.Protocol):
                     self._write(out)
                     self._hang_up(lines[i + 1 :])
                     return
-            except (ForeignProtocol, LineTooLong) as exc:
+            except ForeignProtocol:  # a browser, most likely: an HTTP answer it can show
+                self._write(out)
+                if not self.closing and self.transport is not None:
+                    self.transport.write(replies.not_http(self.server.viewer_url))
+                self._close()  # the rest of the request (its headers, a body) never runs
+                return
+            except LineTooLong as exc:
                 out.append(replies.error(exc))
                 self._write(out)
                 self._close()
@@ -339,6 +345,7 @@ class CommandServer:
         limits: ServerLimits | None = None,
         on_quit: Callable[[], None] | None = None,
         robot: str | None = None,
+        viewer_url: str | None = None,
     ) -> None:
         """Set up the server; ``start`` makes it listen.
 
@@ -348,8 +355,12 @@ class CommandServer:
             on_quit: Called once when a client sends ``quit``.
             robot: The robot its clients drive until they say ``robot NAME`` (None:
                 the world's default).
+            viewer_url: The page's address, told to a browser that opens the
+                command port (None: no viewer). The attribute may be set later,
+                once the viewer is up.
         """
         self.world = world
+        self.viewer_url = viewer_url
         self.limits = limits if limits is not None else ServerLimits()
         self.on_quit = on_quit
         self.robot = robot

@@ -25,11 +25,10 @@ from .config import ServerLimits
 from .errors import C2rvizError, JointLimitError, PathCollides
 from .registry import HANDLERS, Reply
 from .robot import Robot
+from .tolerance import within_limit
 from .world import RobotState, World
 
 __all__ = ["Session", "UnitTable"]
-
-_TOLERANCE = 1e-9  # relative slack at a limit, so a value read back with `where` is accepted
 
 
 @dataclass(frozen=True, slots=True)
@@ -196,11 +195,7 @@ class Session:
             upper = table.upper[i]
             if lower <= value <= upper:
                 out.append(value * table.scale[i])
-            elif (
-                lower - _TOLERANCE * max(1.0, abs(lower))
-                <= value
-                <= upper + _TOLERANCE * max(1.0, abs(upper))
-            ):
+            elif within_limit(value, lower, upper):  # a rounding error past it: at the limit
                 out.append(robot.lower[i] if value < lower else robot.upper[i])
             else:
                 raise JointLimitError(robot.joint_names[i], i, value, lower, upper, table.unit[i])

@@ -22,10 +22,12 @@ from c2rviz import cli
 from c2rviz.catalogue import EXAMPLE_ROBOTS, example_robot_data_dir, example_robots
 from c2rviz.config import ServerLimits, find_ini, load_settings
 from c2rviz.errors import ConfigError, RobotError
-from c2rviz.robot import Robot
+from c2rviz.motion import motion_limits
+from c2rviz.robot import CONTINUOUS_LIMIT, Robot
 
 DATA = Path(__file__).parent / "data"
 TREE = DATA / "tree_robot" / "tree.urdf"
+LIMITS_URDF = DATA / "limits_robot" / "limits.urdf"
 TINY_PACKAGE = DATA / "tiny_ws" / "src" / "tiny_description"
 
 needs_erd = pytest.mark.skipif(
@@ -237,9 +239,9 @@ def test_prismatic_joint_takes_metres_in_every_mode(client: Client, mode: str) -
     assert (x, y, z) == pytest.approx((0.3, 0, 0.4 - 0.35), abs=1e-9)
     reply = client.ask("move 0 30")
     assert reply.startswith("error: lift (index 0) = 30 m is outside its limits 0..0.5 m")
-    unit = "deg" if mode == "degrees" else "rad"
     assert client.ask("limits").startswith("ok 0..0.5 m,")  # the lift says metres
-    assert client.ask("limits").endswith(f",-inf..inf {unit}")  # the wrist is continuous
+    wrist = "-57295779.51..57295779.51 deg" if mode == "degrees" else "-1000000..1000000 rad"
+    assert client.ask("limits").endswith(f",{wrist}")  # the wrist is continuous: +-1e6 rad
 
 
 def test_continuous_joint_takes_any_angle(client: Client, tree_server: ServerThread) -> None:
@@ -247,6 +249,71 @@ def test_continuous_joint_takes_any_angle(client: Client, tree_server: ServerThr
     assert client.ask("move 3 720") == "ok"
     assert client.ask("where") == "ok 0,0,0,720"
     assert tree_server.q[3] == pytest.approx(4 * math.pi)
+
+
+# --- limits that print badly: puma560's +-1.570796325 rad, the seed's +-3.1416 rad ---------
+
+
+@pytest.fixture
+def limits_client() -> Iterator[Client]:
+    server = ServerThread(Robot.from_urdf(LIMITS_URDF), ServerLimits()).start()
+    client = Client(server.host, server.port)
+    yield client
+    client.close()
+    server.stop()
+
+
+def test_a_limit_prints_one_way_in_limits_and_errors(limits_client: Client) -> None:
+    client = limits_client
+    assert client.ask("degrees") == "ok"
+    low, high = client.ask("limits").removeprefix("ok ").split(",")[0].split(" ")[0].split("..")
+    assert (low, high) == ("-89.9999999", "89.9999999")
+    assert client.ask("move 0 89.99999999") == (
+        "error: joint1 (index 0) = 89.99999999 deg is outside its limits "
+        "-89.9999999..89.9999999 deg"
+    )
+    assert client.ask("move 0 89.9999999") == "ok"  # the printed limit is accepted
+    assert client.ask("radians") == "ok"
+    assert client.ask("move 1 3.1416000032") == (
+        "error: joint2 (index 1) = 3.141600003 rad is outside its limits -3.1416..3.1416 rad"
+    )
+
+
+@pytest.mark.parametrize(
+    ("mode", "edge"), [("degrees", "57295779.51"), ("radians", "1000000")], ids=["deg", "rad"]
+)
+def test_a_continuous_joint_is_bounded_so_where_is_always_accepted(
+    limits_client: Client, mode: str, edge: str
+) -> None:
+    """+-CONTINUOUS_LIMIT (1e6 rad), refused past it like any limit; every reply finite."""
+    client = limits_client
+    unit = "deg" if mode == "degrees" else "rad"
+    assert client.ask(mode) == "ok"
+    assert client.ask("move 2 1.7e308") == (
+        f"error: joint3 (index 2) = 1.7e+308 {unit} is outside its limits -{edge}..{edge} {unit}"
+    )
+    assert client.ask("move 2 -1.7976931348623157e308").startswith(
+        "error: joint3 (index 2) = -1.797693135e+308"
+    )
+    for value in (edge, f"-{edge}", "123456.789012345", "720"):
+        assert client.ask(f"move 2 {value}") == "ok"
+        where = client.ask("where")
+        assert all(math.isfinite(float(v)) for v in where.removeprefix("ok ").split(","))
+        assert client.ask("joints " + where.removeprefix("ok ")) == "ok"  # sent back
+        assert client.ask("where") == where
+
+
+def test_motion_keeps_a_continuous_joint_within_the_same_bound(limits_client: Client) -> None:
+    """The planner takes the robot's limits, so it goes where the session lets it."""
+    robot = Robot.from_urdf(LIMITS_URDF)
+    limits = motion_limits(robot)
+    assert (limits.lower[2], limits.upper[2]) == (-CONTINUOUS_LIMIT, CONTINUOUS_LIMIT)
+    client = limits_client
+    assert client.ask("joints 0,0,999999.9") == "ok"
+    assert client.ask("motion on") == "ok"
+    # A rounding error past the limit counts as at it, for the session and the planner.
+    assert client.ask("move 2 1000000.0005") == "ok"  # on arrival
+    assert client.ask("where") == "ok 0,0,1000000"
 
 
 def test_ini_section_with_package_path_and_xacro_args(tmp_path: Path) -> None:

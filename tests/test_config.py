@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import shutil
+import socket
 
 import pytest
-from conftest import ROOT
+from conftest import ROOT, Client
 
 from c2rviz.cli import main
 from c2rviz.config import ServerLimits, find_ini, load_settings
@@ -104,10 +105,45 @@ def test_main_exits_2_with_one_clear_sentence(argv, message, capsys):
         assert "choose from: fanuc_lrmate200id, kuka_lwr, motoman_sia20d" in err
 
 
+def test_a_taken_command_port_is_the_one_thing_said(capsys, caplog):
+    """Both ports taken (a second c2rviz): one sentence on the command port, exit 2, and
+    nothing from the viewer (it once said first that it had moved to the next port)."""
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        assert main(["--port", str(port), "--viser-port", str(port)]) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert caplog.records == []  # the viewer never started, so it had nothing to say
+    assert err == (
+        f"c2rviz: cannot listen for commands on 127.0.0.1:{port}: the port is in use "
+        "(another c2rviz?); choose another with --port (0 picks a free one)\n"
+    )
+
+
 def test_port_zero_prints_the_port_it_picked(c2rviz_process):
     proc = c2rviz_process("--no-viewer")
     assert proc.port > 0
     assert any(f"commands on 127.0.0.1:{proc.port}" in line for line in proc.output)
+
+
+def test_the_robot_goes_by_the_name_the_user_chose(c2rviz_process):
+    """--robot kuka_lwr (whose URDF says lwr): kuka_lwr in the banner, names and errors."""
+    proc = c2rviz_process("--robot", "kuka_lwr", "--no-viewer")
+    banner = next(line for line in proc.output if "chain" in line)
+    assert banner.startswith("c2rviz: kuka_lwr (model lwr), chain lwr_base_link -> lwr_7_link,")
+    client = Client("127.0.0.1", proc.port)
+    try:
+        joints = ",".join(f"lwr_{i}_joint" for i in range(7))
+        assert client.ask("names") == f"ok kuka_lwr {joints}"
+        assert client.ask("move 9 1") == (
+            "error: joint index 9 out of range: kuka_lwr has joints 0..6"
+        )
+        assert client.ask("quit") == "ok"
+    finally:
+        client.close()
+    assert proc.wait() == 0
 
 
 TINY_WS = ROOT / "tests" / "data" / "tiny_ws"

@@ -17,6 +17,8 @@ import socket
 import struct
 import threading
 import time
+import urllib.error
+import urllib.request
 from pathlib import Path
 
 import pytest
@@ -289,26 +291,53 @@ def test_a_reset_with_replies_pending_ends_quietly(live, connect):
         b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n",
         b"POST /move HTTP/1.1\r\nHost: x\r\nContent-Length: 5\r\n\r\nquit\n",
         b"Host: 127.0.0.1:31000\r\nhome\r\n",
+        b"post / HTTP/1.1\r\nhome\r\nquit\r\n",
+        b"POST  /  HTTP/1.1\r\nhome\r\nquit\r\n",
+        b"GET /\r\nX-Forwarded-For: 10.0.0.1\r\nhome\r\nquit\r\n",
     ],
-    ids=["get", "post-with-quit-body", "header-first"],
+    ids=["get", "post-with-quit-body", "header-first", "lowercase", "double-space", "http-0.9"],
 )
 def test_an_http_request_is_closed_at_its_first_line(live, connect, request_bytes):
     server, _bystander, check = live()
     client = connect(server)
     client.send(request_bytes)
-    assert client.read_line().startswith("error: this is the c2rviz command port")
-    assert client.closed_by_server()
+    assert client.file.read() == replies.not_http(None)  # all of it, then the close
     assert not server.quit.is_set()
     check()
 
 
-def test_a_real_http_client_gets_no_http_and_nothing_runs(live):
+VIEWER_URL = "http://127.0.0.1:8080"
+
+
+@pytest.mark.parametrize("method", ["GET", "POST", "HEAD"])
+def test_a_real_http_client_is_told_where_the_viewer_is_and_nothing_runs(live, method):
     server, _bystander, check = live()
-    conn = http.client.HTTPConnection(server.host, server.port, timeout=30)
-    conn.request("POST", "/", body=b"home\n")
-    with pytest.raises(http.client.HTTPException):
-        conn.getresponse()
+    server.call(setattr, server.server, "viewer_url", VIEWER_URL)  # as cli.serve does
+    conn = http.client.HTTPConnection(server.host, server.port, timeout=5)
+    # One write: the request line, the headers and a body of commands that must not run.
+    conn.request(method, "/", body=b"home\nquit\n")
+    response = conn.getresponse()
+    assert response.status == 400
+    assert response.getheader("Content-Type") == "text/plain; charset=utf-8"
+    assert response.getheader("Connection") == "close"
+    body = response.read().decode()
     conn.close()
+    if method != "HEAD":
+        assert body == (
+            "error: this is the c2rviz command port (one text command per line), not HTTP; "
+            f"the viewer is at {VIEWER_URL}\n"
+        )
+    assert not server.quit.is_set()
+    check()
+
+
+def test_a_browser_url_on_the_command_port_gets_a_400_it_can_show(live):
+    server, _bystander, check = live()
+    with pytest.raises(urllib.error.HTTPError) as caught:
+        urllib.request.urlopen(f"http://{server.host}:{server.port}/", timeout=5)
+    assert caught.value.code == 400
+    assert "c2rviz command port" in caught.value.read().decode()
+    caught.value.close()
     check()
 
 

@@ -33,7 +33,7 @@ from c2rviz.motion_limits import (
     DEFAULT_REVOLUTE_VELOCITY,
     JERK_PER_VELOCITY,
 )
-from c2rviz.robot import Robot
+from c2rviz.robot import CONTINUOUS_LIMIT, Robot
 
 TREE = Path(__file__).parent / "data" / "tree_robot" / "tree.urdf"
 BUNDLED = ("motoman_sia20d", "fanuc_lrmate200id", "kuka_lwr")
@@ -97,8 +97,11 @@ def assert_within(
 
 def far_pair(limits: MotionLimits) -> tuple[list[float], list[float]]:
     """A start near every lower limit and a target near every upper one (continuous: 0 -> 7 rad)."""
-    lower = np.where(np.isfinite(limits.lower), limits.lower, 0.0)
-    upper = np.where(np.isfinite(limits.upper), limits.upper, 7.0)
+    # Continuous joints are bounded at +-CONTINUOUS_LIMIT (1e6 rad): a move of that span
+    # would take days; they go 0 -> 7 rad.
+    continuous = np.abs(np.array(limits.lower)) >= CONTINUOUS_LIMIT
+    lower = np.where(continuous, 0.0, limits.lower)
+    upper = np.where(continuous, 7.0, limits.upper)
     span = upper - lower
     return (lower + 0.1 * span).tolist(), (upper - 0.1 * span).tolist()
 
@@ -421,7 +424,7 @@ def scenarios(draw: st.DrawFn) -> Scenario:
     def configuration() -> list[float]:
         values = []
         for low, high in zip(limits.lower, limits.upper):
-            low, high = (low, high) if math.isfinite(low) else (-7.0, 7.0)
+            low, high = (low, high) if abs(low) < CONTINUOUS_LIMIT else (-7.0, 7.0)
             fraction = draw(st.sampled_from([0.0, 1.0]) | st.floats(0, 1))
             values.append(min(low + fraction * (high - low), high))
         return values

@@ -142,8 +142,8 @@ def predict(data: bytes, session: Session) -> tuple[list[str], bool]:
         except UnicodeDecodeError:
             out.append("error: " + replies.NOT_UTF8)
             continue
-        except ForeignProtocol as exc:
-            return [*out, replies.error(exc)], True
+        except ForeignProtocol:  # an HTTP 400, read here line by line
+            return [*out, *replies.not_http(None).decode().split("\n")[:-1]], True
         except C2rvizError as exc:
             out.append(replies.error(exc))
             continue

@@ -91,7 +91,7 @@ def test_limits_are_checked_in_the_clients_units(server, connect):
     client = connect(server)
     assert client.ask("degrees") == "ok"
     assert client.ask("move 1 120") == (
-        "error: joint_l (index 1) = 120 deg is outside its limits -109.4..109.4 deg"
+        "error: joint_l (index 1) = 120 deg is outside its limits -109.4349389..109.4349389 deg"
     )
     assert client.ask("radians") == "ok"
     assert client.ask("move 1 2") == (

@@ -85,7 +85,7 @@ def move(session: Session, command: Move) -> Reply:
     n = session.n
     for index in command.indices:
         if index >= n:
-            raise JointIndexError(index, session.robot.name, n)
+            raise JointIndexError(index, session.state.name, n)
     q = list(session.state.target)
     for index, value in zip(command.indices, session.to_si(command.indices, command.values)):
         q[index] = value
@@ -140,7 +140,7 @@ def pose(session: Session, command: Pose) -> str:
 def limits(session: Session, command: Limits) -> str:
     table = session.table
     ranges = [
-        f"{replies.numbers([lo])}..{replies.numbers([hi])} {unit}"
+        f"{replies.limit(lo)}..{replies.limit(hi)} {unit}"
         for lo, hi, unit in zip(table.lower, table.upper, table.unit)
     ]
     if command.all:
@@ -157,7 +157,7 @@ def limits(session: Session, command: Limits) -> str:
 
 @handler(Names)
 def names(session: Session, command: Names) -> str:
-    return replies.ok(f"{session.robot.name} {','.join(session.robot.joint_names)}")
+    return replies.ok(f"{session.state.name} {','.join(session.robot.joint_names)}")
 
 
 @handler(Version)
