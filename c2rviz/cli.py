@@ -10,9 +10,14 @@ import logging
 import signal
 import sys
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+import pinocchio as pin
+
 from .catalogue import catalogue, listing
+from .cell import load_cell
 from .collision_geometry import read_srdf
 from .config import Settings, find_ini, load_settings, read_robots
 from .errors import C2rvizError
@@ -45,6 +50,12 @@ def build_parser() -> argparse.ArgumentParser:
         "arm such as ur5 or panda (default: motoman_sia20d; see --list-robots)",
     )
     add("--list-robots", action="store_true", help="list the robots --robot can name, and exit")
+    add(
+        "--cell",
+        metavar="NAME|PATH",
+        help="serve the robots of [cell:NAME] in the ini (or of the ini file PATH), each on "
+        "its own port, in one world and one page (README: Several robots)",
+    )
     add("--urdf", metavar="PATH", type=Path, help="load this URDF or .xacro instead of the robot's")
     add(
         "--package-path",
@@ -152,49 +163,67 @@ def _cannot_listen(host: str, port: int, exc: OSError) -> str:
     return f"cannot listen for commands on {host}:{port}: {exc.strerror or exc}"
 
 
-async def serve(settings: Settings, robot: Robot, name: str | None = None) -> int:
-    """Run the viewer and the command server until ``quit``, SIGINT or SIGTERM.
+@dataclass(frozen=True)
+class Member:
+    """One robot the program serves: its name, model, place in the world and port."""
 
-    ``name`` is the robot's name as the user chose it (``--robot kuka_lwr``), which
-    the banner and ``names`` say; None: the model's name (the URDF's ``<robot name>``).
+    name: str
+    robot: Robot
+    origin: pin.SE3
+    port: int
 
-    The command port is bound first: when it is taken the program says so and
-    stops before the viewer starts (so no word about the viewer's port either).
+
+async def serve(settings: Settings, members: Sequence[Member], cell: str | None = None) -> int:
+    """Run the viewer and a command server per robot until ``quit``, SIGINT or SIGTERM.
+
+    ``members`` are the robots, each by the name the user chose (``--robot kuka_lwr``,
+    or a cell's member name), which the banner and ``names`` say. Every command port
+    is bound first: when one is taken the program says so and stops before the
+    viewer starts (so no word about the viewer's port either).
     """
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
-    name = name or robot.name
-    disabled = {name: read_srdf(settings.srdf)} if settings.srdf is not None else None
-    world = World({name: robot}, hz=settings.hz, defaults=settings.session, disabled_pairs=disabled)
-    server = CommandServer(world, settings.limits, on_quit=stop.set)
+    srdf = read_srdf(settings.srdf) if settings.srdf is not None else None
+    world = World(
+        {m.name: m.robot for m in members},
+        hz=settings.hz,
+        defaults=settings.session,
+        origins={m.name: m.origin for m in members},
+        disabled_pairs={members[0].name: srdf} if srdf is not None else None,
+    )
+    servers: list[CommandServer] = []
+    for member in members:
+        server = CommandServer(world, settings.limits, on_quit=stop.set, robot=member.name)
+        try:
+            host, port = await server.start(settings.host, member.port)
+        except OSError as exc:
+            print(f"c2rviz: {_cannot_listen(settings.host, member.port, exc)}", file=sys.stderr)
+            for started in servers:
+                await started.stop()
+            return 2
+        world.state(member.name).port = port
+        servers.append(server)
     try:
-        host, port = await server.start(settings.host, settings.port)
-    except OSError as exc:
-        print(f"c2rviz: {_cannot_listen(settings.host, settings.port, exc)}", file=sys.stderr)
-        return 2
-    try:
-        scene = _open_scene(settings, robot)
+        scene = _open_scene(settings, members[0].robot)
     except OSError as exc:
         print(
             f"c2rviz: cannot serve the viewer on {settings.viewer_host}:{settings.viewer_port}: "
             f"{exc.strerror or exc}",
             file=sys.stderr,
         )
-        await server.stop()
+        for server in servers:
+            await server.stop()
         return 2
     world.add_observers([scene])  # no client is served before this: nothing awaited since
-    server.viewer_url = scene.url
+    for server in servers:
+        server.viewer_url = scene.url
     scene.start(world, loop)
     for sig in (signal.SIGINT, signal.SIGTERM):
         loop.add_signal_handler(sig, stop.set)
-    names = " ".join(robot.joint_names)
-    model = "" if name == robot.name else f" (model {robot.name})"
-    print(
-        f"c2rviz: {name}{model}, chain {robot.base} -> {robot.eelink}, "
-        f"joints 0..{robot.n - 1}: {names}",
-        flush=True,
-    )
-    print(f"c2rviz: commands on {host}:{port} (try: nc {host} {port}, then 'help')", flush=True)
+    if cell is not None:
+        print(f"c2rviz: cell {cell}: {', '.join(m.name for m in members)}", flush=True)
+    for member in members:
+        _banner(member, settings.host, world.state(member.name).port, cell is not None)
     if scene.url:
         print(f"c2rviz: viewer at {scene.url}", flush=True)
     for what, address in (("command server", settings.host), ("viewer", settings.viewer_host)):
@@ -210,11 +239,58 @@ async def serve(settings: Settings, robot: Robot, name: str | None = None) -> in
     finally:
         for sig in (signal.SIGINT, signal.SIGTERM):
             loop.remove_signal_handler(sig)
-        await server.stop()
+        for server in servers:
+            await server.stop()
         world.close()
         scene.stop()
     print("c2rviz: stopped", flush=True)
     return 0
+
+
+def _banner(member: Member, host: str, port: int | None, in_cell: bool) -> None:
+    robot, name = member.robot, member.name
+    model = "" if name == robot.name else f" (model {robot.name})"
+    who = f"{name}: " if in_cell else ""
+    print(
+        f"c2rviz: {name}{model}, chain {robot.base} -> {robot.eelink}, "
+        f"joints 0..{robot.n - 1}: {' '.join(robot.joint_names)}",
+        flush=True,
+    )
+    print(
+        f"c2rviz: {who}commands on {host}:{port} (try: c2rviz-cli --port {port}, then 'help')",
+        flush=True,
+    )
+
+
+def _members(settings: Settings, args: argparse.Namespace) -> tuple[list[Member], str | None]:
+    """The robots to serve: the cell's (``--cell``), or the one robot of the settings."""
+    if args.cell is not None:
+        cell = load_cell(args.cell, settings.ini)
+        members = []
+        for member in cell.members:
+            entry = member.entry
+            robot = Robot.from_urdf(
+                entry.urdf,
+                entry.base,
+                entry.eelink,
+                package_paths=entry.package_paths,
+                xacro_args=entry.xacro_args,
+            )
+            x, y, z, roll, pitch, yaw = member.origin
+            origin = pin.SE3(pin.rpy.rpyToMatrix(roll, pitch, yaw), np.array([x, y, z]))
+            members.append(Member(member.name, robot, origin, member.port))
+        return members, cell.name
+    assert settings.urdf is not None
+    robot = Robot.from_urdf(
+        settings.urdf,
+        settings.base,
+        settings.eelink,
+        package_paths=settings.package_paths,
+        xacro_args=settings.xacro_args,
+    )
+    # The name the user chose; a --urdf without --robot is named by its model.
+    name = robot.name if args.urdf is not None and args.robot is None else settings.robot
+    return [Member(name, robot, pin.SE3.Identity(), settings.port)], None
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -225,7 +301,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         format="c2rviz: %(levelname)s: %(message)s",
     )
     overrides = {
-        k: v for k, v in vars(args).items() if k not in ("config", "verbose", "list_robots")
+        k: v for k, v in vars(args).items() if k not in ("config", "verbose", "list_robots", "cell")
     }
     try:
         if args.list_robots:
@@ -233,21 +309,14 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(listing(catalogue(read_robots(ini), ini).values()))
             return 0
         settings = load_settings(find_ini(args.config), overrides)
-        assert settings.urdf is not None
-        robot = Robot.from_urdf(
-            settings.urdf,
-            settings.base,
-            settings.eelink,
-            package_paths=settings.package_paths,
-            xacro_args=settings.xacro_args,
-        )
+        members, cell = _members(settings, args)
+        if settings.srdf is not None:
+            read_srdf(settings.srdf)  # a bad SRDF stops here, with its one sentence
     except C2rvizError as exc:
         print(f"c2rviz: {exc}", file=sys.stderr)
         return 2
-    # The name the user chose; a --urdf without --robot is named by its model.
-    name = robot.name if args.urdf is not None and args.robot is None else settings.robot
     try:
-        return asyncio.run(serve(settings, robot, name))
+        return asyncio.run(serve(settings, members, cell))
     except KeyboardInterrupt:  # a second Ctrl-C while stopping
         return 130
 

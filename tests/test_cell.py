@@ -4,6 +4,11 @@ from __future__ import annotations
 
 import asyncio
 import math
+import os
+import re
+import socket
+import subprocess
+import sys
 import threading
 from collections.abc import Iterator
 from pathlib import Path
@@ -14,6 +19,7 @@ import pytest
 from conftest import ROOT, Client, load_robot
 
 from c2rviz.cell import load_cell
+from c2rviz.cli import main
 from c2rviz.config import ServerLimits
 from c2rviz.errors import ConfigError
 from c2rviz.scene import RecordingScene
@@ -229,3 +235,75 @@ def test_an_unknown_cell_lists_the_cells(tmp_path: Path):
     ini = write_ini(tmp_path, CELL_INI)
     with pytest.raises(ConfigError, match=r"no \[cell:three\] in .* \(choose from: twoarms\)"):
         load_cell("three", ini)
+
+
+def test_the_program_serves_a_cell(tmp_path: Path):
+    """``c2rviz --cell FILE``: every robot on its own port, named in the banner."""
+    ini = write_ini(
+        tmp_path, CELL_INI.replace("port = 31000", "port = 0").replace("port = 31001", "port = 0")
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "c2rviz", "--cell", str(ini), "--no-viewer"],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    try:
+        assert proc.stdout is not None
+        ports: dict[str, int] = {}
+        lines = []
+        while len(ports) < 2:
+            line = proc.stdout.readline()
+            assert line, "c2rviz stopped:\n" + "".join(lines)
+            lines.append(line)
+            if m := re.search(r"c2rviz: (\w+): commands on [\d.]+:(\d+)", line):
+                ports[m.group(1)] = int(m.group(2))
+        assert "c2rviz: cell twoarms: left, right\n" in lines
+        assert any(
+            line.startswith("c2rviz: right (model fanuc_lrmate200id), chain") for line in lines
+        )
+        left, right = Client("127.0.0.1", ports["left"]), Client("127.0.0.1", ports["right"])
+        assert left.ask("robot") == "ok left" and right.ask("robot") == "ok right"
+        assert right.ask("robots") == f"ok left:{ports['left']},right:{ports['right']}"
+        assert left.ask("quit") == "ok"
+        left.close()
+        right.close()
+        assert proc.wait(timeout=60) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        assert proc.stdout is not None
+        proc.stdout.close()
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (("port = 31001", "port = 31000"), "uses port 31000 twice"),
+        (("robot = fanuc_lrmate200id", "robot = nosuch"), "unknown robot 'nosuch'"),
+        (("origin = 1.2,0,0,0,0,180", "origin = 1.2,0,0,0,0"), "must be 6 numbers"),
+    ],
+    ids=["duplicate-port", "unknown-robot", "five-numbers"],
+)
+def test_a_bad_cell_exits_2_with_one_sentence(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], change: tuple[str, str], message: str
+):
+    ini = write_ini(tmp_path, CELL_INI.replace(*change))
+    assert main(["--cell", str(ini), "--no-viewer"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("c2rviz: ") and message in err and err.count("\n") == 1
+
+
+def test_a_cell_port_in_use_exits_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]):
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        taken = busy.getsockname()[1]
+        text = CELL_INI.replace("port = 31000", "port = 0").replace(
+            "port = 31001", f"port = {taken}"
+        )
+        assert main(["--cell", str(write_ini(tmp_path, text)), "--no-viewer"]) == 2
+    assert f"cannot listen for commands on 127.0.0.1:{taken}" in capsys.readouterr().err
