@@ -45,12 +45,16 @@ class CellMember:
         entry: Which robot it is (URDF, chain ends).
         origin: x, y, z [m], roll, pitch, yaw [rad] of its base in the cell frame.
         port: Its command port (0 picks a free one).
+        extras: Its robot section's ``tool`` and motion limits, as written (``furnish``).
+        ini: The file the cell was read from.
     """
 
     name: str
     entry: CatalogueEntry
     origin: tuple[float, float, float, float, float, float]
     port: int
+    extras: tuple[tuple[str, str], ...] = ()
+    ini: Path | None = None
 
 
 @dataclass(frozen=True)
@@ -127,7 +131,9 @@ def _member(
         raise ConfigError(f"[{name}] of {ini} needs robot = NAME (any name --robot takes)")
     entry = find_robot(items["robot"], robots, ini)
     port = number(f"[{name}] port", items.get("port", "0"), int, 0, 65535)
-    return CellMember(name, entry, _origin(items.get("origin", "0,0,0,0,0,0"), name), port)
+    extras = robots[entry.name].extras if entry.name in robots else ()
+    origin = _origin(items.get("origin", "0,0,0,0,0,0"), name)
+    return CellMember(name, entry, origin, port, extras, ini)
 
 
 def _origin(text: str, name: str) -> tuple[float, float, float, float, float, float]:

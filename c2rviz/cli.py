@@ -18,9 +18,12 @@ import pinocchio as pin
 
 from .catalogue import catalogue, listing
 from .cell import load_cell
+from .collision import CollisionModel
 from .collision_geometry import read_srdf
 from .config import Settings, find_ini, load_settings, read_robots
 from .errors import C2rvizError
+from .furnish import IniObject, ini_objects, limits_from, tool_from
+from .motion import MotionLimits
 from .robot import Robot
 from .scene import NullScene, Scene
 from .server import CommandServer
@@ -165,12 +168,16 @@ def _cannot_listen(host: str, port: int, exc: OSError) -> str:
 
 @dataclass(frozen=True)
 class Member:
-    """One robot the program serves: its name, model, place in the world and port."""
+    """One robot the program serves: its name, model, place in the world and port, and
+    what the ini gives it (``furnish``)."""
 
     name: str
     robot: Robot
     origin: pin.SE3
     port: int
+    limits: MotionLimits
+    tool: pin.SE3 | None = None
+    objects: tuple[IniObject, ...] = ()
 
 
 async def serve(settings: Settings, members: Sequence[Member], cell: str | None = None) -> int:
@@ -189,8 +196,15 @@ async def serve(settings: Settings, members: Sequence[Member], cell: str | None 
         hz=settings.hz,
         defaults=settings.session,
         origins={m.name: m.origin for m in members},
+        limits={m.name: m.limits for m in members},
         disabled_pairs={members[0].name: srdf} if srdf is not None else None,
     )
+    try:
+        for member in members:
+            _furnish(world, member)
+    except C2rvizError as exc:
+        print(f"c2rviz: {exc}", file=sys.stderr)
+        return 2
     servers: list[CommandServer] = []
     for member in members:
         server = CommandServer(world, settings.limits, on_quit=stop.set, robot=member.name)
@@ -262,23 +276,63 @@ def _banner(member: Member, host: str, port: int | None, in_cell: bool) -> None:
     )
 
 
+def _furnish(world: World, member: Member) -> None:
+    """Give a robot of the world its ini tool and objects (a bad object raises)."""
+    if member.tool is not None:
+        world.set_tool(member.name, member.tool)
+    for name, shape, size, placement, rgba, mesh in member.objects:
+
+        def add(model: CollisionModel) -> None:
+            model.set_object(name, shape, size, placement, rgba, mesh)  # noqa: B023 (run now)
+
+        world.edit_objects(member.name, add)
+
+
+def _member(
+    name: str,
+    robot: Robot,
+    origin: pin.SE3,
+    port: int,
+    section: str,
+    extras: tuple[tuple[str, str], ...],
+    ini: Path | None,
+    first: bool,
+) -> Member:
+    given = dict(extras)
+    objects = tuple(ini_objects(ini, name, first)) if ini is not None else ()
+    return Member(
+        name,
+        robot,
+        origin,
+        port,
+        limits_from(section, given, robot),
+        tool_from(section, given),
+        objects,
+    )
+
+
 def _members(settings: Settings, args: argparse.Namespace) -> tuple[list[Member], str | None]:
     """The robots to serve: the cell's (``--cell``), or the one robot of the settings."""
     if args.cell is not None:
         cell = load_cell(args.cell, settings.ini)
-        members = []
-        for member in cell.members:
-            entry = member.entry
+        members: list[Member] = []
+        for part in cell.members:
+            found = part.entry
             robot = Robot.from_urdf(
-                entry.urdf,
-                entry.base,
-                entry.eelink,
-                package_paths=entry.package_paths,
-                xacro_args=entry.xacro_args,
+                found.urdf,
+                found.base,
+                found.eelink,
+                package_paths=found.package_paths,
+                xacro_args=found.xacro_args,
             )
-            x, y, z, roll, pitch, yaw = member.origin
+            x, y, z, roll, pitch, yaw = part.origin
             origin = pin.SE3(pin.rpy.rpyToMatrix(roll, pitch, yaw), np.array([x, y, z]))
-            members.append(Member(member.name, robot, origin, member.port))
+            first = not members
+            members.append(
+                _member(
+                    part.name, robot, origin, part.port, found.name, part.extras, part.ini, first
+                )
+            )
         return members, cell.name
     assert settings.urdf is not None
     robot = Robot.from_urdf(
@@ -290,7 +344,11 @@ def _members(settings: Settings, args: argparse.Namespace) -> tuple[list[Member]
     )
     # The name the user chose; a --urdf without --robot is named by its model.
     name = robot.name if args.urdf is not None and args.robot is None else settings.robot
-    return [Member(name, robot, pin.SE3.Identity(), settings.port)], None
+    entry = settings.robots.get(settings.robot)
+    extras = entry.extras if entry is not None and args.urdf is None else ()
+    identity = pin.SE3.Identity()
+    member = _member(name, robot, identity, settings.port, name, extras, settings.ini, True)
+    return [member], None
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -80,6 +80,9 @@ class RobotEntry:
     xacro_args: tuple[str, ...] = ()
     ini: Path | None = None
     """The file the section was read from."""
+    extras: tuple[tuple[str, str], ...] = ()
+    """``tool``, ``max_velocity``, ``max_acceleration``, ``max_jerk`` as written (see
+    ``furnish``, which checks them)."""
 
     def check_package_paths(self) -> None:
         """Raise ConfigError, naming ``[section] package_path``, for an entry that is no folder."""
@@ -143,7 +146,8 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
 }
 _TEXT_OPTIONS = ("host", "viewer_host", "robot", "motion", "guard")
 _CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on")}
-_ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args"]
+_EXTRA_KEYS = ["tool", "max_velocity", "max_acceleration", "max_jerk"]
+_ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args", *_EXTRA_KEYS]
 _LIMIT_FIELDS = {f for f in ServerLimits.__dataclass_fields__}
 _SESSION_FIELDS = {f for f in SessionDefaults.__dataclass_fields__}
 
@@ -197,7 +201,7 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
                 )
     robots = {}
     for section in parser.sections():
-        if section == "options" or section.startswith("cell:"):
+        if section in ("options", "objects") or section.startswith(("cell:", "objects:")):
             continue
         items = dict(parser.items(section))
         if "robot" in items:  # a member of a cell (see cell.py), not a robot of its own
@@ -218,6 +222,7 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
             _package_paths(items.get("package_path", ""), path),
             tuple(items.get("xacro_args", "").split()),
             path,
+            tuple((key, items[key]) for key in _EXTRA_KEYS if key in items),
         )
     return values, robots
 
