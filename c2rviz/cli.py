@@ -1,35 +1,21 @@
-"""``c2rviz``: load the robot, start the viewer and the command server, run until quit."""
+"""``c2rviz``: the flags, the settings, and then the program (``program.serve``)."""
 
 from __future__ import annotations
 
 import argparse
 import asyncio
-import errno
-import ipaddress
 import logging
-import signal
 import sys
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-import pinocchio as pin
-
 from .catalogue import catalogue, listing
-from .cell import load_cell
-from .collision import CollisionModel
 from .collision_geometry import read_srdf
-from .config import Settings, find_ini, load_settings, read_robots
+from .config import find_ini, load_settings, read_robots
 from .errors import C2rvizError
-from .furnish import IniObject, ini_objects, limits_from, tool_from
-from .motion import MotionLimits
-from .robot import Robot
-from .scene import NullScene, Scene
-from .server import CommandServer
-from .world import World
+from .program import MOTION_FLAGS, members, serve
 
-__all__ = ["build_parser", "main", "serve"]
+__all__ = ["build_parser", "main"]
 
 log = logging.getLogger("c2rviz")
 
@@ -106,6 +92,19 @@ def build_parser() -> argparse.ArgumentParser:
         help="new connections refuse colliding targets and paths (default off)",
     )
     add("--srdf", metavar="FILE", type=Path, help="SRDF whose disable_collisions are honoured")
+    for key, unit in (("velocity", "s"), ("acceleration", "s^2"), ("jerk", "s^3")):
+        add(
+            f"--max-{key}",
+            metavar="V[,V...]",
+            help=f"every robot's {key} limit, rad or m per {unit}: one number, or one per joint "
+            "(over the ini's; default: "
+            + {
+                "velocity": "the URDF's",
+                "acceleration": "2 x velocity",
+                "jerk": "10 x velocity",
+            }[key]
+            + ")",
+        )
     add(
         "--no-viewer",
         dest="viewer",
@@ -139,218 +138,6 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _is_loopback(host: str) -> bool:
-    if host == "localhost":
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:
-        return False
-
-
-def _open_scene(settings: Settings, robot: Robot) -> Scene:
-    if not settings.viewer:
-        return NullScene()
-    from .viewer import ViserScene  # viser is heavy: import only when it is used
-
-    return ViserScene(robot, settings.viewer_host, settings.viewer_port, settings.hz)
-
-
-def _cannot_listen(host: str, port: int, exc: OSError) -> str:
-    """Why the command server cannot start, in one sentence."""
-    if exc.errno == errno.EADDRINUSE:
-        return (
-            f"cannot listen for commands on {host}:{port}: the port is in use "
-            "(another c2rviz?); choose another with --port (0 picks a free one)"
-        )
-    return f"cannot listen for commands on {host}:{port}: {exc.strerror or exc}"
-
-
-@dataclass(frozen=True)
-class Member:
-    """One robot the program serves: its name, model, place in the world and port, and
-    what the ini gives it (``furnish``)."""
-
-    name: str
-    robot: Robot
-    origin: pin.SE3
-    port: int
-    limits: MotionLimits
-    tool: pin.SE3 | None = None
-    objects: tuple[IniObject, ...] = ()
-
-
-async def serve(settings: Settings, members: Sequence[Member], cell: str | None = None) -> int:
-    """Run the viewer and a command server per robot until ``quit``, SIGINT or SIGTERM.
-
-    ``members`` are the robots, each by the name the user chose (``--robot kuka_lwr``,
-    or a cell's member name), which the banner and ``names`` say. Every command port
-    is bound first: when one is taken the program says so and stops before the
-    viewer starts (so no word about the viewer's port either).
-    """
-    loop = asyncio.get_running_loop()
-    stop = asyncio.Event()
-    srdf = read_srdf(settings.srdf) if settings.srdf is not None else None
-    world = World(
-        {m.name: m.robot for m in members},
-        hz=settings.hz,
-        defaults=settings.session,
-        origins={m.name: m.origin for m in members},
-        limits={m.name: m.limits for m in members},
-        disabled_pairs={members[0].name: srdf} if srdf is not None else None,
-    )
-    try:
-        for member in members:
-            _furnish(world, member)
-    except C2rvizError as exc:
-        print(f"c2rviz: {exc}", file=sys.stderr)
-        return 2
-    servers: list[CommandServer] = []
-    for member in members:
-        server = CommandServer(world, settings.limits, on_quit=stop.set, robot=member.name)
-        try:
-            host, port = await server.start(settings.host, member.port)
-        except OSError as exc:
-            print(f"c2rviz: {_cannot_listen(settings.host, member.port, exc)}", file=sys.stderr)
-            for started in servers:
-                await started.stop()
-            return 2
-        world.state(member.name).port = port
-        servers.append(server)
-    try:
-        scene = _open_scene(settings, members[0].robot)
-    except OSError as exc:
-        print(
-            f"c2rviz: cannot serve the viewer on {settings.viewer_host}:{settings.viewer_port}: "
-            f"{exc.strerror or exc}",
-            file=sys.stderr,
-        )
-        for server in servers:
-            await server.stop()
-        return 2
-    world.add_observers([scene])  # no client is served before this: nothing awaited since
-    for server in servers:
-        server.viewer_url = scene.url
-    scene.start(world, loop)
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        loop.add_signal_handler(sig, stop.set)
-    if cell is not None:
-        print(f"c2rviz: cell {cell}: {', '.join(m.name for m in members)}", flush=True)
-    for member in members:
-        _banner(member, settings.host, world.state(member.name).port, cell is not None)
-    if scene.url:
-        print(f"c2rviz: viewer at {scene.url}", flush=True)
-    for what, address in (("command server", settings.host), ("viewer", settings.viewer_host)):
-        if not _is_loopback(address) and (what == "command server" or settings.viewer):
-            print(
-                f"c2rviz: warning: the {what} listens on {address}: anyone who can reach it "
-                "can move the robot and stop the program",
-                file=sys.stderr,
-                flush=True,
-            )
-    try:
-        await stop.wait()
-    finally:
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            loop.remove_signal_handler(sig)
-        for server in servers:
-            await server.stop()
-        world.close()
-        scene.stop()
-    print("c2rviz: stopped", flush=True)
-    return 0
-
-
-def _banner(member: Member, host: str, port: int | None, in_cell: bool) -> None:
-    robot, name = member.robot, member.name
-    model = "" if name == robot.name else f" (model {robot.name})"
-    who = f"{name}: " if in_cell else ""
-    print(
-        f"c2rviz: {name}{model}, chain {robot.base} -> {robot.eelink}, "
-        f"joints 0..{robot.n - 1}: {' '.join(robot.joint_names)}",
-        flush=True,
-    )
-    print(
-        f"c2rviz: {who}commands on {host}:{port} (try: c2rviz-cli --port {port}, then 'help')",
-        flush=True,
-    )
-
-
-def _furnish(world: World, member: Member) -> None:
-    """Give a robot of the world its ini tool and objects (a bad object raises)."""
-    if member.tool is not None:
-        world.set_tool(member.name, member.tool)
-    for name, shape, size, placement, rgba, mesh in member.objects:
-
-        def add(model: CollisionModel) -> None:
-            model.set_object(name, shape, size, placement, rgba, mesh)  # noqa: B023 (run now)
-
-        world.edit_objects(member.name, add)
-
-
-def _member(
-    name: str,
-    robot: Robot,
-    origin: pin.SE3,
-    port: int,
-    section: str,
-    extras: tuple[tuple[str, str], ...],
-    ini: Path | None,
-    first: bool,
-) -> Member:
-    given = dict(extras)
-    objects = tuple(ini_objects(ini, name, first)) if ini is not None else ()
-    return Member(
-        name,
-        robot,
-        origin,
-        port,
-        limits_from(section, given, robot),
-        tool_from(section, given),
-        objects,
-    )
-
-
-def _members(settings: Settings, args: argparse.Namespace) -> tuple[list[Member], str | None]:
-    """The robots to serve: the cell's (``--cell``), or the one robot of the settings."""
-    if args.cell is not None:
-        cell = load_cell(args.cell, settings.ini)
-        members: list[Member] = []
-        for part in cell.members:
-            found = part.entry
-            robot = Robot.from_urdf(
-                found.urdf,
-                found.base,
-                found.eelink,
-                package_paths=found.package_paths,
-                xacro_args=found.xacro_args,
-            )
-            x, y, z, roll, pitch, yaw = part.origin
-            origin = pin.SE3(pin.rpy.rpyToMatrix(roll, pitch, yaw), np.array([x, y, z]))
-            first = not members
-            members.append(
-                _member(
-                    part.name, robot, origin, part.port, found.name, part.extras, part.ini, first
-                )
-            )
-        return members, cell.name
-    assert settings.urdf is not None
-    robot = Robot.from_urdf(
-        settings.urdf,
-        settings.base,
-        settings.eelink,
-        package_paths=settings.package_paths,
-        xacro_args=settings.xacro_args,
-    )
-    # The name the user chose; a --urdf without --robot is named by its model.
-    name = robot.name if args.urdf is not None and args.robot is None else settings.robot
-    entry = settings.robots.get(settings.robot)
-    extras = entry.extras if entry is not None and args.urdf is None else ()
-    identity = pin.SE3.Identity()
-    member = _member(name, robot, identity, settings.port, name, extras, settings.ini, True)
-    return [member], None
-
-
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``c2rviz`` command; returns the exit status."""
     args = build_parser().parse_args(argv)
@@ -359,7 +146,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         format="c2rviz: %(levelname)s: %(message)s",
     )
     overrides = {
-        k: v for k, v in vars(args).items() if k not in ("config", "verbose", "list_robots", "cell")
+        k: v
+        for k, v in vars(args).items()
+        if k not in ("config", "verbose", "list_robots", "cell", *MOTION_FLAGS)
     }
     try:
         if args.list_robots:
@@ -367,14 +156,14 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(listing(catalogue(read_robots(ini), ini).values()))
             return 0
         settings = load_settings(find_ini(args.config), overrides)
-        members, cell = _members(settings, args)
+        robots, cell = members(settings, args)
         if settings.srdf is not None:
             read_srdf(settings.srdf)  # a bad SRDF stops here, with its one sentence
     except C2rvizError as exc:
         print(f"c2rviz: {exc}", file=sys.stderr)
         return 2
     try:
-        return asyncio.run(serve(settings, members, cell))
+        return asyncio.run(serve(settings, robots, cell))
     except KeyboardInterrupt:  # a second Ctrl-C while stopping
         return 130
 

@@ -76,3 +76,12 @@ def test_bad_ini_furniture_exits_2_naming_it(
     assert main(["--config", str(ini), "--no-viewer", "--port", "0"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("c2rviz: ") and message in err and err.count("\n") == 1, err
+
+
+def test_flags_override_the_ini_motion_limits(ini: Path, c2rviz_process):
+    proc = c2rviz_process("--config", str(ini), "--no-viewer", "--max-velocity", "0.5")
+    client = Client("127.0.0.1", proc.port)
+    try:
+        assert " v=0.5 a=1 j=20" in client.ask("limits all")[3:].split(",")[0]
+    finally:
+        client.close()

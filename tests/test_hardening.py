@@ -312,7 +312,7 @@ VIEWER_URL = "http://127.0.0.1:8080"
 @pytest.mark.parametrize("method", ["GET", "POST", "HEAD"])
 def test_a_real_http_client_is_told_where_the_viewer_is_and_nothing_runs(live, method):
     server, _bystander, check = live()
-    server.call(setattr, server.server, "viewer_url", VIEWER_URL)  # as cli.serve does
+    server.call(setattr, server.server, "viewer_url", VIEWER_URL)  # as program.serve does
     conn = http.client.HTTPConnection(server.host, server.port, timeout=5)
     # One write: the request line, the headers and a body of commands that must not run.
     conn.request(method, "/", body=b"home\nquit\n")

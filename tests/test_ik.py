@@ -97,7 +97,10 @@ def test_solves_random_reachable_targets(name: str) -> None:
 def test_property_any_reachable_target_from_any_seed(
     name: str, target_at: list[float], seed_at: list[float]
 ) -> None:
-    """Targets anywhere in the limits, the limits themselves included; any seed."""
+    """Targets anywhere in the limits, the limits themselves included; any seed: an answer
+    is always right (within the tolerances and the limits), and a refusal says how far
+    its closest pose was, which is past the tolerances. How often a reachable target is
+    refused (under 1 %) is test_solves_random_reachable_targets's to count."""
     ik = solver(name)
     robot = ik.robot
 
@@ -105,7 +108,11 @@ def test_property_any_reachable_target_from_any_seed(
         return [lo + f * (hi - lo) for f, lo, hi in zip(fractions, robot.lower, robot.upper)]
 
     target = robot.ee_pose(at(target_at))
-    q = ik.solve(target, at(seed_at))
+    try:
+        q = ik.solve(target, at(seed_at))
+    except Unreachable as refused:
+        assert refused.distance_m > POSITION_TOL_M or refused.angle_rad > ANGLE_TOL_RAD
+        return
     distance, angle = errors(robot, q, target, pin.SE3.Identity())
     assert distance <= POSITION_TOL_M and angle <= ANGLE_TOL_RAD
     assert within_limits(robot, q)
