@@ -14,9 +14,12 @@ from pathlib import Path
 from .catalogue import catalogue, listing
 from .config import Settings, find_ini, load_settings, read_robots
 from .errors import C2rvizError
+from .lang.record import Record
+from .recordings import Recordings
 from .robot import Robot
 from .scene import NullScene, Scene
 from .server import CommandServer
+from .trail import TrailKeeper
 from .world import World
 
 __all__ = ["build_parser", "main", "serve"]
@@ -113,6 +116,16 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="S",
         help="longest sleep command (default 3600)",
     )
+    add(
+        "--record",
+        metavar="NAME",
+        help="record from start to exit into NAME.txt and NAME.csv in the recording folder",
+    )
+    add(
+        "--record-dir",
+        metavar="DIR",
+        help="where recordings go (default ./recordings; created when needed)",
+    )
     add("-v", "--verbose", action="store_true", help="log every connection")
     return parser
 
@@ -148,6 +161,12 @@ async def serve(settings: Settings, robot: Robot) -> int:
         )
         return 2
     world = World(robot, scene, hz=settings.hz, defaults=settings.session)
+    try:
+        _keep(world, settings)
+    except C2rvizError as exc:
+        print(f"c2rviz: {exc}", file=sys.stderr)
+        scene.stop()
+        return 2
     scene.start(world, loop)
     server = CommandServer(world, settings.limits, on_quit=stop.set)
     try:
@@ -185,9 +204,27 @@ async def serve(settings: Settings, robot: Robot) -> int:
             loop.remove_signal_handler(sig)
         await server.stop()
         world.travels.stop_all()
+        await _stop_recording(world)
         scene.stop()
     print("c2rviz: stopped", flush=True)
     return 0
+
+
+def _keep(world: World, settings: Settings) -> None:
+    """Where recordings go and how long trails get; ``--record NAME`` begins now."""
+    TrailKeeper.of(world, settings.trail_points)
+    desk = Recordings.of(world, settings.record_dir)
+    if settings.record is not None:
+        Record.parse("record", [settings.record])  # the name's rules, as for the verb
+        desk.start(settings.record, world.default)
+
+
+async def _stop_recording(world: World) -> None:
+    desk = Recordings.of(world)
+    if desk.current is not None:
+        done = await desk.stop("the program stopped")
+        where = done.txt if done.error is None else f"{done.csv} ({done.error})"
+        print(f"c2rviz: recorded {done.name}: {done.frames} frames, {where}", flush=True)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

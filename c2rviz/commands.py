@@ -453,3 +453,4 @@ def parse_line(line: str) -> object | None:
 
 # The verbs beyond the seed's, one module per concern (they use the pieces above).
 from .lang import motion as _motion  # noqa: E402, F401
+from .lang import record as _record  # noqa: E402, F401

@@ -116,6 +116,12 @@ class Settings:
     """``package://`` search folders (``DIR`` or ``NAME=DIR``), flags first."""
     xacro_args: tuple[str, ...] = ()
     """``name:=value`` for a ``.xacro`` robot, the robot section's then the flags'."""
+    record_dir: Path = Path("recordings")
+    """Where ``record NAME`` writes (the ini's is relative to the ini file)."""
+    record: str | None = None
+    """Record from start to exit under this name (``--record``)."""
+    trail_points: int = 20_000
+    """Points a ``trail`` keeps at most."""
     limits: ServerLimits = field(default_factory=ServerLimits)
     session: SessionDefaults = field(default_factory=SessionDefaults)
     robots: Mapping[str, RobotEntry] = field(default_factory=dict)
@@ -133,8 +139,9 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "partial_timeout": ("partial_timeout_s", float, 0.01, 86400),
     "max_sleep": ("max_sleep_s", float, 0, 1e6),
     "speed": ("speed", float, 1, 100),
+    "trail_points": ("trail_points", int, 16, 10_000_000),
 }
-_TEXT_OPTIONS = ("host", "viewer_host", "robot", "motion")
+_TEXT_OPTIONS = ("host", "viewer_host", "robot", "motion", "record_dir")
 _CHOICES = {"motion": ("off", "on", "follow")}
 _ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args"]
 _LIMIT_FIELDS = {f for f in ServerLimits.__dataclass_fields__}
@@ -182,7 +189,7 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
             elif key in _TEXT_OPTIONS:
                 if text not in _CHOICES.get(key, (text,)):
                     raise ConfigError(f"[options] {key} = {text!r} is not one", _CHOICES[key])
-                values[key] = text
+                values[key] = path.parent / text if key == "record_dir" else text
             else:
                 raise ConfigError(
                     f"unknown key {key!r} in [options] of {path}",
@@ -234,6 +241,8 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
             flag = "--" + key.replace("_", "-").replace("viewer", "viser")
             raise ConfigError(f"{flag} {given[name]:g} is outside {low:g}..{high:g}")
     values.update(given)
+    if "record_dir" in values:
+        values["record_dir"] = Path(values["record_dir"])
     for key in ("package_paths", "xacro_args"):
         values[key] = tuple(values.get(key, ()))
     limit_values = {k: values.pop(k) for k in list(values) if k in _LIMIT_FIELDS}

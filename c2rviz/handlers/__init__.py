@@ -4,6 +4,6 @@ Importing this package registers every handler in ``registry.HANDLERS``; the
 verbs themselves are declared in ``commands`` and ``lang``.
 """
 
-from . import motion, seed
+from . import motion, record, seed
 
-__all__ = ["motion", "seed"]
+__all__ = ["motion", "record", "seed"]
