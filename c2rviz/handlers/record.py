@@ -66,6 +66,7 @@ async def _stopped(finished: asyncio.Future[Recorded]) -> str:
     if recorded.error is not None:
         return replies.error(f"record: {recorded.name} stopped early ({recorded.error})")
     return replies.ok(
-        f"recorded {recorded.name}: {recorded.frames} frames, {recorded.duration_s:.3f} s "
+        f"recorded {recorded.name}: {recorded.frames} frame{'s' * (recorded.frames != 1)}, "
+        f"{recorded.duration_s:.3f} s "
         f"({recorded.txt}, {recorded.csv})"
     )
