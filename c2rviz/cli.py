@@ -13,7 +13,7 @@ from pathlib import Path
 
 from .catalogue import catalogue, listing
 from .config import Settings, find_ini, load_settings, read_robots
-from .errors import C2rvizError
+from .errors import C2rvizError, ConfigError
 from .lang.record import Record
 from .recordings import Recordings
 from .robot import Robot
@@ -215,7 +215,8 @@ def _keep(world: World, settings: Settings) -> None:
     TrailKeeper.of(world, settings.trail_points)
     desk = Recordings.of(world, settings.record_dir)
     if settings.record is not None:
-        Record.parse("record", [settings.record])  # the name's rules, as for the verb
+        if Record.parse("record", [settings.record]).stop:  # the verb's rules for a name
+            raise ConfigError("--record needs a name; 'stop' is not one")
         desk.start(settings.record, world.default)
 
 

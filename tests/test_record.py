@@ -26,6 +26,8 @@ from conftest import Client, ServerThread, load_robot
 from test_watch import STATE, is_reply, read_until
 
 from c2rviz import player
+from c2rviz.config import load_settings
+from c2rviz.errors import ConfigError
 from c2rviz.recordings import Recordings
 from c2rviz.trail import DEFAULT_TRAIL_POINTS, TrailKeeper
 from c2rviz.world import World
@@ -342,3 +344,33 @@ def test_thinning_at_any_cap(cap: int):
     assert len(keeper.points("motoman_sia20d")) == 0 and world.observers == []
     with pytest.raises(ValueError, match="at least 16 points"):
         TrailKeeper(world, 15)
+
+
+def test_settings_for_recordings_and_trails(tmp_path: Path):
+    ini = tmp_path / "c2rviz.ini"
+    ini.write_text("[options]\nrecord_dir = takes\ntrail_points = 500\n")
+    settings = load_settings(ini, {"urdf": ini})
+    assert settings.record_dir == tmp_path / "takes"  # relative to the ini file
+    assert settings.trail_points == 500 and settings.record is None
+    flags = load_settings(ini, {"urdf": ini, "record_dir": "here", "record": "x"})
+    assert flags.record_dir == Path("here") and flags.record == "x"
+    assert load_settings(None, {"urdf": ini}).record_dir == Path("recordings")
+    ini.write_text("[options]\ntrail_points = 5\n")
+    with pytest.raises(ConfigError, match="trail_points = 5 is outside 16..1e"):
+        load_settings(ini, {"urdf": ini})
+
+
+@pytest.mark.parametrize(
+    ("name", "message"),
+    [("../x", "bad name '../x'"), ("stop", "--record needs a name; 'stop' is not one")],
+)
+def test_record_flag_refuses_a_bad_name(tmp_path: Path, name: str, message: str):
+    done = subprocess.run(
+        [sys.executable, "-m", "c2rviz", "--no-viewer", "--port", "0", "--record", name]
+        + ["--record-dir", str(tmp_path)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 2 and message in done.stderr
+    assert list(tmp_path.iterdir()) == []

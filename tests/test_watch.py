@@ -264,3 +264,38 @@ def test_cli_watch_prints_the_stream_until_ctrl_c(server: ServerThread, connect)
             proc.wait()
         proc.stdout.close()  # type: ignore[union-attr]
         proc.stderr.close()  # type: ignore[union-attr]
+
+
+def test_repl_watch_prints_the_stream_until_ctrl_c_then_goes_on(server: ServerThread, connect):
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "c2rviz.repl", "--port", str(server.port)],
+        cwd=ROOT,
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert proc.stdin is not None and proc.stdout is not None
+        proc.stdin.write("degrees\nwatch 10\n")
+        proc.stdin.flush()
+        assert proc.stdout.readline() == "ok\n"  # degrees
+        first = proc.stdout.readline().rstrip("\n")
+        assert first.endswith(" 0,0,0,0,0,0,0") and STATE.fullmatch(first), first
+        assert connect(server).ask("move 1 0.5") == "ok"  # radians, from another client
+        moved = proc.stdout.readline().rstrip("\n")
+        assert moved.endswith(f" 0,{replies.numbers([math.degrees(0.5)])},0,0,0,0,0"), moved
+        proc.send_signal(2)  # Ctrl-C ends the watch, not the REPL
+        proc.stdin.write("move 1 0\nwhere\n")
+        proc.stdin.close()
+        rest = proc.stdout.read()
+        assert proc.wait(timeout=30) == 0
+        assert rest.splitlines()[0] == "ok"  # no stream line after the watch ended
+        assert "  1  joint_l  0" in rest
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+        for stream in (proc.stdin, proc.stdout, proc.stderr):
+            if stream is not None and not stream.closed:
+                stream.close()
