@@ -87,15 +87,23 @@ def percentile(values: Sequence[float], q: float) -> float:
     return ordered[min(len(ordered) - 1, int(q / 100 * len(ordered)))]
 
 
-def measure(proc: Launched, pipelined: int, round_trips: int) -> tuple[float, float, float]:
-    """Commands/s pipelined; request/reply p50 and p99 [us]."""
+Figures = tuple[float, float, float, float]
+
+
+def measure(proc: Launched, pipelined: int, round_trips: int) -> Figures:
+    """Commands/s pipelined, the server's CPU per command then [us]; request/reply p50 and
+    p99 [us]."""
     lines = loadgen.joints_lines(N_JOINTS, 1000)
+    cpu = proc.cpu_s()
     rate = loadgen.pipelined(proc.address, lines, pipelined // len(lines))
+    cpu_us = (proc.cpu_s() - cpu) / pipelined * 1e6
     times = loadgen.request_reply(proc.address, lines, round_trips)
-    return rate, percentile(times, 50) * 1e6, percentile(times, 99) * 1e6
+    return rate, cpu_us, percentile(times, 50) * 1e6, percentile(times, 99) * 1e6
 
 
-def one_mode(proc: Launched, control: Control, mode: str, rep: int, plan: argparse.Namespace):
+def one_mode(
+    proc: Launched, control: Control, mode: str, rep: int, plan: argparse.Namespace
+) -> Figures:
     watcher = Watcher(proc.address, 1000) if mode == "watched" else None
     if mode == "recording":
         control.ask(f"record bench{rep} overwrite")
@@ -156,7 +164,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     plan.pipelined, plan.round_trips = (10_000, 500) if plan.quick else (100_000, 10_000)
     reps = 1 if plan.quick else plan.reps
     print(f"c2rviz record/watch overhead: {pin_cpus(not plan.no_pin)}", flush=True)
-    results: dict[str, list[tuple[float, float, float]]] = {mode: [] for mode in MODES}
+    results: dict[str, list[Figures]] = {mode: [] for mode in MODES}
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         argv_ = [sys.executable, "-m", "c2rviz", "--port", "0", "--no-viewer"]
@@ -172,16 +180,19 @@ def main(argv: Sequence[str] | None = None) -> int:
         finally:
             control.close()
             proc.stop()
-    print(f"\n{'mode':<10} {'pipelined cmd/s':>16} {'vs plain':>9} {'p50 us':>8} {'p99 us':>8}")
-    plain = statistics.median(r[0] for r in results["plain"])
-    plain_p99 = statistics.median(r[2] for r in results["plain"])
+    print(
+        f"\n{'mode':<10} {'pipelined cmd/s':>16} {'vs plain':>9} {'CPU us/cmd':>11} "
+        f"{'p50 us':>8} {'p99 us':>8} {'p99 vs plain':>13}"
+    )
+
+    def median(mode: str, k: int) -> float:
+        return statistics.median(r[k] for r in results[mode])
+
     for mode in MODES:
-        rate = statistics.median(r[0] for r in results[mode])
-        p50 = statistics.median(r[1] for r in results[mode])
-        p99 = statistics.median(r[2] for r in results[mode])
+        rate, cpu, p50, p99 = (median(mode, k) for k in range(4))
         print(
-            f"{mode:<10} {rate:>16,.0f} {rate / plain:>8.1%} {p50:>8.1f} {p99:>8.1f}"
-            f"  (p99 {p99 / plain_p99:.0%} of plain)"
+            f"{mode:<10} {rate:>16,.0f} {rate / median('plain', 0):>9.1%} {cpu:>11.2f} "
+            f"{p50:>8.1f} {p99:>8.1f} {p99 / median('plain', 3):>13.1%}"
         )
     print(
         f"\nreplay: {frames} frames over {recorded_s:.2f} s recorded; the last moving state "

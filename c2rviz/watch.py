@@ -291,15 +291,16 @@ class WatchHub(Observer):
     # The world's effects.
 
     def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
-        seq = self.next_seq()
-        state = tuple(q)
+        self._seq = seq = self._seq + 1  # on every command of a flood: kept lean
+        values = q if q.__class__ is tuple else tuple(q)
         for stream in self.active:
             if stream.robot == robot:
-                stream.state(state, t, seq)
+                stream.state(values, t, seq)
         travel = self.world.robots[robot].travel
         if travel.active:
-            self._moving.add(robot)
-        elif robot in self._moving:
+            if robot not in self._moving:
+                self._moving.add(robot)
+        elif self._moving and robot in self._moving:
             self._moving.discard(robot)
             stopped_at = self._stopping.pop(robot, None)
             if travel.synced:  # it came to rest (not cut short by an instant command)
