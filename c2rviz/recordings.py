@@ -145,8 +145,10 @@ class Recordings:
         self.last = recorder.finish()
 
     def _detach(self, recorder: Recorder, why: str) -> None:
+        """The recording ends (once: a write error while closing says nothing more)."""
+        if self.current is not recorder:
+            return
+        self.current = None
         if recorder in self.world.observers:
             self.world.remove_observer(recorder)
-        if self.current is recorder:
-            self.current = None
         WatchHub.of(self.world).event(f"record-stopped {recorder.name}: {why}")
