@@ -134,6 +134,16 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="S",
         help="longest sleep command (default 3600)",
     )
+    add(
+        "--record",
+        metavar="NAME",
+        help="record from start to exit into NAME.txt and NAME.csv in the recording folder",
+    )
+    add(
+        "--record-dir",
+        metavar="DIR",
+        help="where recordings go (default ./recordings; created when needed)",
+    )
     add("-v", "--verbose", action="store_true", help="log every connection")
     return parser
 

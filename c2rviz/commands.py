@@ -466,4 +466,5 @@ def parse_line(line: str) -> object | None:
 from .lang import cartesian as _cartesian  # noqa: E402, F401
 from .lang import cell as _cell  # noqa: E402, F401
 from .lang import motion as _motion  # noqa: E402, F401
+from .lang import record as _record  # noqa: E402, F401
 from .lang import workcell as _workcell  # noqa: E402, F401

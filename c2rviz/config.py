@@ -123,6 +123,12 @@ class Settings:
     """``package://`` search folders (``DIR`` or ``NAME=DIR``), flags first."""
     xacro_args: tuple[str, ...] = ()
     """``name:=value`` for a ``.xacro`` robot, the robot section's then the flags'."""
+    record_dir: Path = Path("recordings")
+    """Where ``record NAME`` writes (the ini's is relative to the ini file)."""
+    record: str | None = None
+    """Record from start to exit under this name (``--record``)."""
+    trail_points: int = 20_000
+    """Points a ``trail`` keeps at most."""
     limits: ServerLimits = field(default_factory=ServerLimits)
     session: SessionDefaults = field(default_factory=SessionDefaults)
     robots: Mapping[str, RobotEntry] = field(default_factory=dict)
@@ -143,8 +149,9 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "max_sleep": ("max_sleep_s", float, 0, 1e6),
     "speed": ("speed", float, 1, 100),
     "lspeed": ("lspeed", float, 0.001, 5),
+    "trail_points": ("trail_points", int, 16, 10_000_000),
 }
-_TEXT_OPTIONS = ("host", "viewer_host", "robot", "motion", "guard")
+_TEXT_OPTIONS = ("host", "viewer_host", "robot", "motion", "guard", "record_dir")
 _CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on")}
 _EXTRA_KEYS = ["tool", "max_velocity", "max_acceleration", "max_jerk"]
 _ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args", *_EXTRA_KEYS]
@@ -193,7 +200,12 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
             elif key in _TEXT_OPTIONS:
                 if text not in _CHOICES.get(key, (text,)):
                     raise ConfigError(f"[options] {key} = {text!r} is not one", _CHOICES[key])
-                values[key] = (text == "on") if key == "guard" else text
+                if key == "guard":
+                    values[key] = text == "on"
+                elif key == "record_dir":
+                    values[key] = path.parent / text
+                else:
+                    values[key] = text
             else:
                 raise ConfigError(
                     f"unknown key {key!r} in [options] of {path}",
@@ -250,6 +262,8 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
     if "guard" in given:
         given["guard"] = given["guard"] == "on"
     values.update(given)
+    if "record_dir" in values:
+        values["record_dir"] = Path(values["record_dir"])
     for key in ("package_paths", "xacro_args"):
         values[key] = tuple(values.get(key, ()))
     limit_values = {k: values.pop(k) for k in list(values) if k in _LIMIT_FIELDS}

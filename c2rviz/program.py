@@ -23,12 +23,15 @@ from .cell import load_cell
 from .collision import CollisionModel
 from .collision_geometry import read_srdf
 from .config import Settings
-from .errors import C2rvizError
+from .errors import C2rvizError, ConfigError
 from .furnish import IniObject, ini_objects, limits_from, tool_from
+from .lang.record import Record
 from .motion import MotionLimits
+from .recordings import Recordings
 from .robot import Robot
 from .scene import NullScene, Scene
 from .server import CommandServer
+from .trail import TrailKeeper
 from .world import World
 
 __all__ = ["MOTION_FLAGS", "Member", "members", "serve"]
@@ -97,6 +100,7 @@ async def serve(settings: Settings, members: Sequence[Member], cell: str | None 
     try:
         for member in members:
             _furnish(world, member)
+        _keep(world, settings)
     except C2rvizError as exc:
         print(f"c2rviz: {exc}", file=sys.stderr)
         return 2
@@ -151,6 +155,7 @@ async def serve(settings: Settings, members: Sequence[Member], cell: str | None 
         for server in servers:
             await server.stop()
         world.close()
+        await _stop_recording(world)
         scene.stop()
     print("c2rviz: stopped", flush=True)
     return 0
@@ -257,3 +262,21 @@ def members(settings: Settings, args: argparse.Namespace) -> tuple[list[Member],
     identity = pin.SE3.Identity()
     member = _member(name, robot, identity, settings.port, name, extras, settings.ini, True, flags)
     return [member], None
+
+
+def _keep(world: World, settings: Settings) -> None:
+    """Where recordings go and how long trails get; ``--record NAME`` begins now."""
+    TrailKeeper.of(world, settings.trail_points)
+    desk = Recordings.of(world, settings.record_dir)
+    if settings.record is not None:
+        if Record.parse("record", [settings.record]).stop:  # the verb's rules for a name
+            raise ConfigError("--record needs a name; 'stop' is not one")
+        desk.start(settings.record, world.default)
+
+
+async def _stop_recording(world: World) -> None:
+    desk = Recordings.of(world)
+    if desk.current is not None:
+        done = await desk.stop("the program stopped")
+        where = done.txt if done.error is None else f"{done.csv} ({done.error})"
+        print(f"c2rviz: recorded {done.name}: {done.frames} frames, {where}", flush=True)

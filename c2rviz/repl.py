@@ -21,9 +21,10 @@ import argparse
 import contextlib
 import math
 import os
+import socket
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import TextIO
 
@@ -37,16 +38,18 @@ from .client import (
 )
 from .commands import USAGE, Joints, Sleep, parse_line
 from .errors import BadArguments, C2rvizError, JointCountError, JointLimitError
+from .lang.record import Watch
 from .player import Progress, check_robot, load_script, play, robot_mismatch
 from .tolerance import within_limit
 
-__all__ = ["LOCAL_USAGE", "Repl", "build_parser", "main"]
+__all__ = ["LOCAL_USAGE", "Repl", "build_parser", "main", "watch_lines"]
 
 LOCAL_USAGE = {
     "file": ("file NAME [speed=X]", "play a command file (here, else commands/); X divides sleeps"),
     "sleep": ("sleep S", "wait S seconds here"),
     "where": ("where", "joint names and values, in this connection's units"),
     "goto": ("goto v0,...,vn-1 [step=S] [rate=HZ]", "move there smoothly in small joints steps"),
+    "watch": ("watch [HZ]", "print the server's state and event lines until Ctrl-C"),
     "help": ("help", "this list"),
     "q": ("q", "leave (the server keeps running)"),
     "quit": ("quit", "stop the server, then leave"),
@@ -112,6 +115,7 @@ class Repl:
             "sleep": self._sleep,
             "where": self._where,
             "goto": self._goto,
+            "watch": self._watch,
             "help": self._help,
             "q": lambda words: False,
             "quit": self._quit,
@@ -185,7 +189,7 @@ class Repl:
                 "(the server stopped or restarted); reconnecting"
             )
         local = self._local.get(verb)
-        if local is not None and (verb in ("file", "sleep", "goto") or len(words) == 1):
+        if local is not None and (verb in ("file", "sleep", "goto", "watch") or len(words) == 1):
             return local(words[1:])
         reply = self.ask(line)
         self.show(reply)
@@ -290,6 +294,18 @@ class Repl:
         self.show(f"ok (goto: {steps} steps in {time.monotonic() - start:.2f} s)")
         return True
 
+    def _watch(self, words: list[str]) -> bool:
+        """Print the stream (on a connection of its own) until Ctrl-C."""
+        command = parse_line(" ".join(["watch", *words]))
+        assert isinstance(command, Watch)
+        client = self.client
+        try:
+            for line in watch_lines(client.host, client.port, command.hz, client.degrees):
+                self.show(line)
+        except KeyboardInterrupt:
+            return True
+        raise ConnectionLost(client.host, client.port)
+
     def _help(self, words: list[str]) -> bool:
         self.show("local commands (this client):")
         width = max(len(usage) for usage, _ in LOCAL_USAGE.values())
@@ -309,6 +325,50 @@ class Repl:
         self.show(reply)
         self.errors += not reply.startswith("ok")
         return False
+
+
+def watch_lines(host: str, port: int, hz: float | None, degrees: bool) -> Iterator[str]:
+    """The ``state`` and ``event`` lines of a new connection that asked ``watch [HZ]``
+    (in degrees if ``degrees``), until the server closes it.
+
+    Raises:
+        ServerUnavailable: no server at ``host:port``.
+        C2rvizError: the server refused ``watch`` (its ``error:`` reply).
+    """
+    try:
+        sock = socket.create_connection((host, port), timeout=5.0)
+    except OSError as exc:
+        raise ServerUnavailable(host, port, 0.0, exc.strerror or str(exc)) from None
+    with sock, sock.makefile("rb") as reader:
+        sock.settimeout(None)
+        asked = ["degrees"] if degrees else []
+        asked.append("watch" if hz is None else f"watch {hz!r}")
+        sock.sendall("".join(f"{line}\n" for line in asked).encode())
+        for _ in asked:
+            reply = reader.readline().decode("utf-8", "replace").rstrip("\r\n")
+            if not reply.startswith("ok"):
+                raise C2rvizError(reply.removeprefix("error: ") or "the server closed")
+        for raw in reader:
+            yield raw.decode("utf-8", "replace").rstrip("\r\n")
+
+
+def _watch_main(host: str, port: int, hz: str, out: TextIO) -> int:
+    """``c2rviz-cli --watch [HZ]``: print the stream until Ctrl-C (status 0) or until the
+    server goes (status 1)."""
+    try:
+        command = parse_line(f"watch {hz}")
+        assert isinstance(command, Watch)
+        for line in watch_lines(host, port, command.hz, False):
+            print(line, file=out, flush=True)
+    except KeyboardInterrupt:
+        return 0
+    except C2rvizError as exc:
+        print(f"c2rviz-cli: {exc}", file=sys.stderr)
+        return 1 if isinstance(exc, ServerUnavailable) else 2
+    except BrokenPipeError:  # the reader of our output left
+        return 0
+    print(f"c2rviz-cli: connection to {host}:{port} closed by the server", file=sys.stderr)
+    return 1
 
 
 def _setup_readline() -> Callable[[], None] | None:
@@ -355,6 +415,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add("--rate", type=float, default=50.0, metavar="HZ", help="goto steps per second (50)")
     add("--speed", type=float, default=1.0, metavar="X", help="file: divide sleeps by X (1)")
+    add(
+        "--watch",
+        nargs="?",
+        const="",
+        metavar="HZ",
+        help="print the server's state and event lines (at most HZ states a second; "
+        "default its frame rate) until Ctrl-C, instead of reading commands",
+    )
     return parser
 
 
@@ -371,6 +439,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     except C2rvizError as exc:
         print(f"c2rviz-cli: {exc}", file=sys.stderr)
         return 2
+    if args.watch is not None:
+        return _watch_main(host, port, args.watch, sys.stdout)
     interactive = sys.stdin.isatty()
     info = sys.stdout if interactive else sys.stderr
 

@@ -20,6 +20,7 @@ from .commands import ForeignProtocol, parse_line
 from .config import ServerLimits
 from .errors import C2rvizError, LineError, LineTooLong
 from .session import Session
+from .watch import STREAM_ALLOWANCE_BYTES, WatchHub
 from .world import World
 
 __all__ = ["CommandServer", "Connection"]
@@ -52,6 +53,7 @@ class Connection(asyncio.Protocol):
         self.closing = False
         self.eof = False
         self.closed = asyncio.get_running_loop().create_future()
+        self.stream = server.watch.open(self.session, self)  # idle until `watch`
 
     @property
     def waiting(self) -> bool:
@@ -81,6 +83,7 @@ class Connection(asyncio.Protocol):
     def connection_lost(self, exc: Exception | None) -> None:
         self._cancel_timers()
         self.closing = True
+        self.server.watch.close(self.session)
         if self.pending is not None:
             self.pending.cancel()
         server = self.server
@@ -108,6 +111,14 @@ class Connection(asyncio.Protocol):
         if not self.waiting:
             self._close()
         return True  # keep the write side open until the replies are out
+
+    # The watch stream (c2rviz.watch) writes only while the write buffer is low.
+
+    def pause_writing(self) -> None:
+        self.stream.pause()
+
+    def resume_writing(self) -> None:
+        self.stream.resume()
 
     # line handling
 
@@ -268,7 +279,7 @@ class Connection(asyncio.Protocol):
             return
         self.transport.write(("\n".join(out) + "\n").encode())
         unread = self.transport.get_write_buffer_size()
-        if unread > self.limits.max_unread:
+        if unread > self.limits.max_unread + (STREAM_ALLOWANCE_BYTES if self.stream.used else 0):
             log.warning("closing %s: %d bytes of replies unread", self.peer, unread)
             self.closing = True
             self.transport.abort()
@@ -368,6 +379,7 @@ class CommandServer:
         self.open: set[Connection] = set()  # those and the refused ones, until their socket closes
         self.stopping = False
         self.quit_requested = False
+        self.watch = WatchHub.of(world)  # `watch` streams count time from here
         self._server: asyncio.Server | None = None
 
     async def start(self, host: str = "127.0.0.1", port: int = 0) -> tuple[str, int]:

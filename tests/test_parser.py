@@ -37,6 +37,7 @@ from c2rviz.errors import BadArguments, LineError, UnknownCommand
 from c2rviz.lang.cartesian import Ik, LinearSpeed, MoveL, MoveTo, Tool
 from c2rviz.lang.cell import RobotChoice, RobotsList
 from c2rviz.lang.motion import MotionMode, Speed, Status, Stop, Target, Wait
+from c2rviz.lang.record import Record, Trail, Unwatch, Watch
 from c2rviz.lang.workcell import Collisions, Guard, ObjectEdit, Objects
 
 GOOD = [
@@ -110,6 +111,19 @@ GOOD = [
     ("wait", Wait(), "wait"),
     ("target", Target(), "target"),
     ("status", Status(), "status"),
+    ("watch", Watch(None), "watch-default"),
+    ("watch 20", Watch(20.0), "watch-hz"),
+    ("WATCH 0.5", Watch(0.5), "watch-slow"),
+    ("watch 1000", Watch(1000.0), "watch-highest"),
+    ("unwatch", Unwatch(), "unwatch"),
+    ("trail", Trail(None), "trail-ask"),
+    ("trail on", Trail("on"), "trail-on"),
+    ("trail OFF", Trail("off"), "trail-off"),
+    ("trail clear", Trail("clear"), "trail-clear"),
+    ("record", Record(), "record-ask"),
+    ("record demo_1", Record("demo_1"), "record"),
+    ("record Take-2.v3 OVERWRITE", Record("Take-2.v3", overwrite=True), "record-overwrite"),
+    ("record stop", Record(stop=True), "record-stop"),
     ("help", Help(), "help"),
     ("version", Version(), "version"),
     ("sleep 0", Sleep(0.0), "sleep-zero"),
@@ -192,6 +206,22 @@ BAD = [
     ("speed nan", BadArguments, "bad number 'nan'", "speed-nan"),
     ("speed -5", BadArguments, "-5 is outside 1..100", "speed-negative"),
     ("stop now", BadArguments, "stop: takes no arguments", "stop-arg"),
+    ("watch 0", BadArguments, "HZ must be above 0 and at most 1000, got 0", "watch-zero"),
+    ("watch -1", BadArguments, "HZ must be above 0 and at most 1000, got -1", "watch-negative"),
+    ("watch 1e9", BadArguments, "at most 1000, got 1e+09", "watch-huge"),
+    ("watch fast", BadArguments, "bad number 'fast'", "watch-word"),
+    ("watch 1 2", BadArguments, "watch: takes 1 argument, got 2", "watch-two"),
+    ("unwatch now", BadArguments, "unwatch: takes no arguments", "unwatch-arg"),
+    ("trail sideways", BadArguments, "unknown action 'sideways'; choose on, off", "trail-bad"),
+    ("trail on off", BadArguments, "trail: takes 1 argument, got 2", "trail-two"),
+    ("record ../x", BadArguments, "bad name '../x'", "record-parent"),
+    ("record a/b", BadArguments, "bad name 'a/b'", "record-folder"),
+    ("record .hidden", BadArguments, "not starting with '.'", "record-dot"),
+    ("record a\\b", BadArguments, "bad name", "record-backslash"),
+    ("record " + "n" * 101, BadArguments, "bad name", "record-too-long"),
+    ("record x now", BadArguments, "unknown option 'now'; only 'overwrite'", "record-option"),
+    ("record stop overwrite", BadArguments, "'stop' takes no option", "record-stop-option"),
+    ("record a b c", BadArguments, "takes at most 2 arguments, got 3", "record-three"),
     ("degree 1", BadArguments, "(usage: degrees)", "alias-usage"),
     ("jump 1", UnknownCommand, "unknown command 'jump' (try 'help')", "unknown-verb"),
     ("x" * 100, UnknownCommand, "'" + "x" * 40 + "...'", "unknown-long-verb-cut"),

@@ -4,6 +4,6 @@ Importing this package registers every handler in ``registry.HANDLERS``; the
 verbs themselves are declared in ``commands`` and ``lang``.
 """
 
-from . import cartesian, cell, motion, seed, workcell
+from . import cartesian, cell, motion, record, seed, workcell
 
-__all__ = ["cartesian", "cell", "motion", "seed", "workcell"]
+__all__ = ["cartesian", "cell", "motion", "record", "seed", "workcell"]
