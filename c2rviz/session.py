@@ -30,6 +30,8 @@ from .world import RobotState, World
 
 __all__ = ["Session", "UnitTable"]
 
+_CADENCE_S = 0.02  # a pause this soon after the previous one's end continues its cadence
+
 
 @dataclass(frozen=True, slots=True)
 class UnitTable:
@@ -89,6 +91,7 @@ class Session:
         self.rgb: tuple[float, float, float] = (1.0, 0.0, 0.0)
         self.shape = "sphere"
         self.hangup: str | None = None
+        self._pause_end = -math.inf  # when the latest `after` was due [loop time, s]
         self.motion = world.defaults.motion
         self.speed = world.defaults.speed
         self.guard = world.defaults.guard
@@ -172,10 +175,19 @@ class Session:
         return reply
 
     def after(self, seconds: float, reply: str) -> asyncio.Future[str]:
-        """A reply that comes ``seconds`` [s] from now (on the running loop)."""
+        """A reply that comes ``seconds`` [s] from now (on the running loop).
+
+        A pause that follows the previous one at once (within ``_CADENCE_S``: the
+        source went straight on, as a played script does between ``sleep`` lines)
+        counts from that one's end, so a timer that fires a little late does not
+        make a replay drift: ``sleep`` keeps a script's cadence.
+        """
         loop = asyncio.get_running_loop()
+        now = loop.time()
+        start = self._pause_end if 0.0 <= now - self._pause_end <= _CADENCE_S else now
+        self._pause_end = start + seconds
         future: asyncio.Future[str] = loop.create_future()
-        timer = loop.call_later(seconds, _settle, future, reply)
+        timer = loop.call_at(self._pause_end, _settle, future, reply)
         future.add_done_callback(lambda _: timer.cancel())
         return future
 
