@@ -92,6 +92,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="new connections refuse colliding targets and paths (default off)",
     )
     add("--srdf", metavar="FILE", type=Path, help="SRDF whose disable_collisions are honoured")
+    add("--max-objects", type=int, metavar="N", help="workcell objects per robot (default 100)")
     for key, unit in (("velocity", "s"), ("acceleration", "s^2"), ("jerk", "s^3")):
         add(
             f"--max-{key}",

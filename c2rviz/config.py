@@ -133,6 +133,8 @@ class Settings:
     session: SessionDefaults = field(default_factory=SessionDefaults)
     robots: Mapping[str, RobotEntry] = field(default_factory=dict)
     ini: Path | None = None
+    max_objects: int = 100
+    """Most workcell objects per robot."""
     srdf: Path | None = None
     """An SRDF whose ``disable_collisions`` pairs are never checked."""
 
@@ -150,6 +152,7 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "speed": ("speed", float, 1, 100),
     "lspeed": ("lspeed", float, 0.001, 5),
     "trail_points": ("trail_points", int, 16, 10_000_000),
+    "max_objects": ("max_objects", int, 0, 10_000),
 }
 _TEXT_OPTIONS = ("host", "viewer_host", "robot", "motion", "guard", "record_dir")
 _CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on")}

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 from .collision import CollisionModel, Pair
 from .scene import Observer
+from .workcell import MAX_OBJECTS
 
 if TYPE_CHECKING:
     from .world import RobotState
@@ -34,6 +35,7 @@ class Contacts(Observer):
         tell: Callable[[str, list[Pair]], None],
         frame_s: float,
         disabled: dict[str, Sequence[Pair]] | None = None,
+        max_objects: int = MAX_OBJECTS,
     ) -> None:
         """Set up.
 
@@ -42,11 +44,13 @@ class Contacts(Observer):
             tell: Fans a robot's new colliding pairs out to the observers.
             frame_s: Shortest time between two checks of a robot [s].
             disabled: Pairs never checked, by robot (from an SRDF).
+            max_objects: Most workcell objects per robot.
         """
         self.states = states
         self.tell = tell
         self.frame_s = frame_s
         self.disabled = disabled or {}
+        self.max_objects = max_objects
         self.models: dict[str, CollisionModel] = {}
         self.pairs: dict[str, list[Pair]] = {}
         self._dirty: set[str] = set()
@@ -57,7 +61,9 @@ class Contacts(Observer):
         model = self.models.get(robot)
         if model is None:
             state = self.states[robot]
-            model = CollisionModel(state.robot, disabled=self.disabled.get(robot, ()))
+            model = CollisionModel(
+                state.robot, disabled=self.disabled.get(robot, ()), max_objects=self.max_objects
+            )
             self.models[robot] = model
             self.pairs[robot] = []
             self.changed(robot)

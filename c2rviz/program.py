@@ -96,6 +96,7 @@ async def serve(settings: Settings, members: Sequence[Member], cell: str | None 
         origins={m.name: m.origin for m in members},
         limits={m.name: m.limits for m in members},
         disabled_pairs={members[0].name: srdf} if srdf is not None else None,
+        max_objects=settings.max_objects,
     )
     try:
         for member in members:

@@ -31,6 +31,7 @@ from .motion import MotionLimits, motion_limits
 from .robot import Robot
 from .scene import MAX_MARKERS, Marker, Observer
 from .travel import Travel, Travels
+from .workcell import MAX_OBJECTS
 
 __all__ = ["RobotState", "World"]
 
@@ -82,6 +83,7 @@ class World:
         defaults: SessionDefaults | None = None,
         origins: Mapping[str, pin.SE3] | None = None,
         disabled_pairs: Mapping[str, Sequence[Pair]] | None = None,
+        max_objects: int = MAX_OBJECTS,
     ) -> None:
         """Set up the world.
 
@@ -97,6 +99,7 @@ class World:
             origins: Where each robot's root stands in the world frame (default: at
                 the world's origin).
             disabled_pairs: Link pairs never checked for collision, by robot (an SRDF's).
+            max_objects: Most workcell objects per robot.
         """
         named = {robots.name: robots} if isinstance(robots, Robot) else dict(robots)
         self.robots = {name: RobotState(name, robot) for name, robot in named.items()}
