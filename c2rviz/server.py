@@ -11,6 +11,7 @@ client that breaks one is told why and closed, and no other client notices.
 from __future__ import annotations
 
 import asyncio
+import itertools
 import logging
 from collections.abc import Awaitable, Callable
 from itertools import chain
@@ -176,7 +177,14 @@ class Connection(asyncio.Protocol):
         reply = out.append
         run = self.session.run
         session = self.session
+        skip_to = 0
         for i, line in enumerate(lines):
+            if i < skip_to:
+                continue  # answered as part of a run of plain `joints` lines
+            if line.__class__ is str and line.startswith(_PLAIN_JOINTS):
+                skip_to = self._joints_run(lines, i, out)
+                if skip_to > i:
+                    continue
             try:
                 if line.__class__ is not str:
                     raise line  # type: ignore[misc]
@@ -209,6 +217,26 @@ class Connection(asyncio.Protocol):
                 log.exception("internal error on %r from %s", line, self.peer)
                 reply(replies.error("internal error (see the server log)"))
         self._write(out)
+
+    def _joints_run(self, lines: list[Line], start: int, out: list[str]) -> int:
+        """Answer the run of plain ``joints`` lines from ``start`` as a batch, if it checks
+        whole (``Session.joints_run``); return where the run ends (``start``: not taken)."""
+        end = start
+        texts = []
+        for line in itertools.islice(lines, start, None):
+            if line.__class__ is not str or not line.startswith(_PLAIN_JOINTS):  # type: ignore[union-attr]
+                break
+            text = line[line.index(" ") + 1 :]  # type: ignore[union-attr]
+            texts.append(text[:-1] if text.endswith("\r") else text)
+            end += 1
+        if end - start < 2 or not self.session.joints_run(texts):
+            return start
+        note = self.server.world.note
+        source = self.session.source
+        for line in itertools.islice(lines, start, end):
+            note(source, line, True)  # type: ignore[arg-type]
+        out.extend([replies.OK] * (end - start))
+        return end
 
     def _hang_up(self, rest: list[Line]) -> None:
         """After ``bye`` or ``quit``: close (``quit`` also stops the program)."""
@@ -343,6 +371,7 @@ def _is_command(line: Line) -> bool:
         return True
 
 
+_PLAIN_JOINTS = ("joints ", "j ")  # how a controller streaming setpoints writes them
 _BATCH_BYTES = 8192  # complete lines run per client per loop turn: at most ~20 ms of work
 _LINGER_S = 2.0  # after the last reply, how long a closing client's input is read and dropped
 

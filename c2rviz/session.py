@@ -12,9 +12,12 @@ bad command never moves the robot partly.
 from __future__ import annotations
 
 import asyncio
+import itertools
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
+from operator import le, mul
 
 from . import (
     handlers,  # noqa: F401  (registers the handler of every verb)
@@ -30,6 +33,7 @@ from .world import RobotState, World
 
 __all__ = ["Session", "UnitTable"]
 
+_NUMBER_CHARS = re.compile(r"[0-9.,eE+-]*")  # as commands.numbers lets float() judge them
 _CADENCE_S = 0.02  # a pause this soon after the previous one's end continues its cadence
 
 
@@ -140,6 +144,37 @@ class Session:
             hit = model.first_collision_on_segment(self.now(), q)
         if hit is not None:
             raise PathCollides(*hit[1], hit[0], self.motion == "off" and not path)
+
+    def joints_run(self, texts: Sequence[str]) -> bool:
+        """A run of ``joints`` lines (their value lists) checked as one: with ``motion off``
+        and no guard, if every line has n values within the limits, only the last is
+        applied (the ones before would be shown for no time at all) and True is returned;
+        else False, and nothing changed: the lines are then run one by one, so every
+        reply and error is exactly as if they had been."""
+        if self.motion != "off" or self.guard:
+            return False
+        commas = self.n - 1
+        joined = ",".join(texts)
+        if _NUMBER_CHARS.fullmatch(joined) is None or any(t.count(",") != commas for t in texts):
+            return False
+        try:
+            flat = list(map(float, joined.split(",")))
+        except ValueError:
+            return False  # an empty or malformed value: its line says which
+        table = self.table
+        if not (
+            math.isfinite(sum(flat))
+            and all(map(le, itertools.cycle(table.lower), flat))
+            and all(map(le, flat, itertools.cycle(table.upper)))
+        ):
+            return False
+        last = flat[-self.n :]
+        self.world.set_q(
+            last if table.identity else list(map(mul, last, table.scale)),
+            self.state.name,
+            self.source,
+        )
+        return True
 
     def now(self) -> tuple[float, ...]:
         """The robot's joints at this instant [rad or m] (mid-move too)."""

@@ -271,3 +271,47 @@ def test_many_clients_share_one_robot(server, connect):
         t.join()
     assert errors == []
     assert server.q == pytest.approx([0.49] * 7)
+
+
+RUNS = {
+    "plain": ["joints 0.1,0.2,0.3,0.1,0.2,0.3,0.1", "j 0.2,0.2,0.3,0.1,0.2,0.3,0.2"] * 50,
+    "crlf": ["joints 0.1,0.2,0.3,0.1,0.2,0.3,0.1\r", "j 0.3,0,0,0,0,0,0\r"] * 20,
+    "bad-in-the-middle": [
+        "joints 0.1,0.2,0.3,0.1,0.2,0.3,0.1",
+        "joints 0.1,0.2,0.3",  # too few
+        "joints 0.1,9,0.3,0.1,0.2,0.3,0.1",  # joint_l past its limit
+        "joints 0.1,0.2,,0.1,0.2,0.3,0.1",  # empty value
+        "joints 0.1,0.2,nan,0.1,0.2,0.3,0.1",
+        "j 1e309,0,0,0,0,0,0",
+        "joints 0.5,0.5,0.5,0.5,0.5,0.5,0.5",
+    ],
+    "at-the-limit": ["joints 0,1.910000001,0,0,0,0,0", "joints 0,-1.91,0,0,0,0,0"],
+    "mixed": ["joints 0.1,0.2,0.3,0.1,0.2,0.3,0.1", "where", "j 0.2,0,0,0,0,0,0", "move 0 0.4"]
+    + ["joints 0.1,0.1,0.1,0.1,0.1,0.1,0.1"] * 3
+    + ["JOINTS 0.2,0,0,0,0,0,0", "joints  0.3,0,0,0,0,0,0", "joints 0.4,0,0,0,0,0,0 # note"],
+}
+
+
+@pytest.mark.parametrize("name", list(RUNS))
+def test_runs_of_joints_lines_answer_as_line_by_line(server, connect, name):
+    """Plain joints lines read together are checked as one batch and only the last is
+    shown; every reply, error and the final state equal running them one by one."""
+    from c2rviz.session import Session
+    from c2rviz.world import World
+
+    shadow = Session(World(server.robot))
+    expected = []
+    for line in RUNS[name]:
+        try:
+            expected.append(shadow.run(line))
+        except c2rviz.C2rvizError as exc:
+            expected.append(replies.error(exc))
+    client = connect(server)
+    frames_before = server.call(lambda: len(server.scene.joints))
+    client.send("".join(line + "\n" for line in RUNS[name]))
+    assert [client.read_line() for _ in expected] == expected
+    assert server.q == shadow.world.q
+    noted = server.call(lambda: len(server.scene.commands) + len(server.scene.refused))
+    assert noted >= len(RUNS[name])
+    if name == "plain":  # one batch of 100 lines: far fewer states shown than lines
+        assert server.call(lambda: len(server.scene.joints)) - frames_before < len(RUNS[name])
