@@ -6,6 +6,7 @@ import argparse
 import asyncio
 import ipaddress
 import logging
+import secrets
 import signal
 import sys
 from collections.abc import Sequence
@@ -22,6 +23,8 @@ from .world import World
 __all__ = ["build_parser", "main", "serve"]
 
 log = logging.getLogger("c2rviz")
+
+_STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -76,6 +79,21 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="PORT",
         help="port for the browser view (default 8080)",
     )
+    add(
+        "--viewer-origin",
+        dest="viewer_origins",
+        metavar="ORIGIN",
+        action="append",
+        help="an origin besides the viewer's own allowed to open its websocket, e.g. "
+        "https://robot.example.org behind a reverse proxy (repeatable)",
+    )
+    add(
+        "--viewer-token",
+        metavar="TOKEN",
+        help="the page and its websocket need ?token=TOKEN (the printed URL carries it; "
+        "default: none on loopback, else one generated at start)",
+    )
+    add("--max-viewers", type=int, metavar="N", help="viewer tabs at once (default 16)")
     add("--hz", type=float, help="most scene updates per second (default 100)")
     add(
         "--motion",
@@ -126,20 +144,26 @@ def _is_loopback(host: str) -> bool:
         return False
 
 
-def _open_scene(settings: Settings, robot: Robot) -> Scene:
+def _open_scene(settings: Settings, world: World) -> Scene:
     if not settings.viewer:
         return NullScene()
+    from .view.policy import DoorPolicy
     from .viewer import ViserScene  # viser is heavy: import only when it is used
 
-    return ViserScene(robot, settings.viewer_host, settings.viewer_port, settings.hz)
+    token = settings.viewer_token
+    if token is None and not _is_loopback(settings.viewer_host):
+        token = secrets.token_urlsafe(16)
+    policy = DoorPolicy(settings.viewer_origins, token, settings.max_viewers)
+    return ViserScene(world, settings.viewer_host, settings.viewer_port, settings.hz, policy=policy)
 
 
 async def serve(settings: Settings, robot: Robot) -> int:
-    """Run the viewer and the command server until ``quit``, SIGINT or SIGTERM."""
+    """Run the viewer and the command server until ``quit``, SIGINT, SIGTERM or SIGHUP."""
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
+    world = World(robot, hz=settings.hz, defaults=settings.session)
     try:
-        scene = _open_scene(settings, robot)
+        scene = _open_scene(settings, world)
     except OSError as exc:
         print(
             f"c2rviz: cannot serve the viewer on {settings.viewer_host}:{settings.viewer_port}: "
@@ -147,7 +171,10 @@ async def serve(settings: Settings, robot: Robot) -> int:
             file=sys.stderr,
         )
         return 2
-    world = World(robot, scene, hz=settings.hz, defaults=settings.session)
+    except C2rvizError as exc:
+        print(f"c2rviz: {exc}", file=sys.stderr)
+        return 2
+    world.add_observers([scene])
     scene.start(world, loop)
     server = CommandServer(world, settings.limits, on_quit=stop.set)
     try:
@@ -159,7 +186,7 @@ async def serve(settings: Settings, robot: Robot) -> int:
         )
         scene.stop()
         return 2
-    for sig in (signal.SIGINT, signal.SIGTERM):
+    for sig in _STOP_SIGNALS:
         loop.add_signal_handler(sig, stop.set)
     names = " ".join(robot.joint_names)
     print(
@@ -170,18 +197,26 @@ async def serve(settings: Settings, robot: Robot) -> int:
     print(f"c2rviz: commands on {host}:{port} (try: nc {host} {port}, then 'help')", flush=True)
     if scene.url:
         print(f"c2rviz: viewer at {scene.url}", flush=True)
-    for what, address in (("command server", settings.host), ("viewer", settings.viewer_host)):
-        if not _is_loopback(address) and (what == "command server" or settings.viewer):
-            print(
-                f"c2rviz: warning: the {what} listens on {address}: anyone who can reach it "
-                "can move the robot and stop the program",
-                file=sys.stderr,
-                flush=True,
-            )
+    if not _is_loopback(settings.host):
+        print(
+            f"c2rviz: warning: the command server listens on {settings.host}: anyone who can "
+            "reach it can move the robot and stop the program",
+            file=sys.stderr,
+            flush=True,
+        )
+    if settings.viewer and not _is_loopback(settings.viewer_host):
+        made = " (generated for this run; --viewer-token sets one)"
+        print(
+            f"c2rviz: warning: the viewer listens on {settings.viewer_host}: anyone who can "
+            "reach it and has its URL with the token can move the robot"
+            f"{made if settings.viewer_token is None else ''}",
+            file=sys.stderr,
+            flush=True,
+        )
     try:
         await stop.wait()
     finally:
-        for sig in (signal.SIGINT, signal.SIGTERM):
+        for sig in _STOP_SIGNALS:
             loop.remove_signal_handler(sig)
         await server.stop()
         world.travels.stop_all()

@@ -108,6 +108,12 @@ class Settings:
     viewer_host: str = "127.0.0.1"
     viewer_port: int = 8080
     viewer: bool = True
+    viewer_origins: tuple[str, ...] = ()
+    """Origins allowed to open the viewer's websocket besides its own (a reverse proxy)."""
+    viewer_token: str | None = None
+    """The token the page needs (``?token=``); None: none, unless bound beyond loopback."""
+    max_viewers: int = 16
+    """Viewer tabs connected at once."""
     robot: str = "motoman_sia20d"
     urdf: Path | None = None
     base: str | None = None
@@ -133,8 +139,9 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "partial_timeout": ("partial_timeout_s", float, 0.01, 86400),
     "max_sleep": ("max_sleep_s", float, 0, 1e6),
     "speed": ("speed", float, 1, 100),
+    "max_viewers": ("max_viewers", int, 1, 1024),
 }
-_TEXT_OPTIONS = ("host", "viewer_host", "robot", "motion")
+_TEXT_OPTIONS = ("host", "viewer_host", "robot", "motion", "viewer_token", "viewer_origins")
 _CHOICES = {"motion": ("off", "on", "follow")}
 _ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args"]
 _LIMIT_FIELDS = {f for f in ServerLimits.__dataclass_fields__}
@@ -182,7 +189,7 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
             elif key in _TEXT_OPTIONS:
                 if text not in _CHOICES.get(key, (text,)):
                     raise ConfigError(f"[options] {key} = {text!r} is not one", _CHOICES[key])
-                values[key] = text
+                values[key] = tuple(text.split()) if key == "viewer_origins" else text
             else:
                 raise ConfigError(
                     f"unknown key {key!r} in [options] of {path}",
@@ -233,10 +240,10 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
     given = {k: v for k, v in overrides.items() if v is not None}
     for key, (name, _kind, low, high) in _OPTIONS.items():
         if name in given and not low <= given[name] <= high:
-            flag = "--" + key.replace("_", "-").replace("viewer", "viser")
+            flag = "--" + key.replace("viewer_", "viser_").replace("_", "-")
             raise ConfigError(f"{flag} {given[name]:g} is outside {low:g}..{high:g}")
     values.update(given)
-    for key in ("package_paths", "xacro_args"):
+    for key in ("package_paths", "xacro_args", "viewer_origins"):
         values[key] = tuple(values.get(key, ()))
     limit_values = {k: values.pop(k) for k in list(values) if k in _LIMIT_FIELDS}
     session_values = {k: values.pop(k) for k in list(values) if k in _SESSION_FIELDS}
