@@ -8,7 +8,6 @@ real websocket (``viewer_tabs.Tab``), as a page sends it.
 
 from __future__ import annotations
 
-import asyncio
 import io
 import logging
 import socket
@@ -23,7 +22,7 @@ import pytest
 import trimesh
 import yourdfpy
 from conftest import ROBOTS, load_robot
-from viewer_tabs import Tab
+from viewer_tabs import Harness
 
 from c2rviz.robot import Robot
 from c2rviz.scene import Marker
@@ -33,59 +32,13 @@ from c2rviz.visuals import load_link_geometry
 from c2rviz.world import World
 
 
-class Harness:
-    """A scene, its world and the loop they share."""
-
-    def __init__(self, robot: Robot, hz: float = 100.0, port: int = 0) -> None:
-        self.robot = robot
-        self.loop = asyncio.new_event_loop()
-        self.world = World(robot, None, np.random.default_rng(7))
-        self.scene = ViserScene(self.world, "127.0.0.1", port, hz)
-        self.world.add_observers([self.scene])
-        self.scene.start(self.world, self.loop)
-        self.panel = self.scene.panels[self.world.default]
-        self.tabs: list[Tab] = []
-        self.run(0.0)
-
-    def run(self, seconds: float) -> None:
-        """Let the loop run for ``seconds`` (its due sends go out)."""
-        self.loop.run_until_complete(asyncio.sleep(seconds))
-
-    def until(self, condition: Callable[[], bool], what: str, timeout_s: float = 60.0) -> None:
-        """Run the loop until ``condition`` holds (a generous bound: we wait for a signal)."""
-        deadline = time.monotonic() + timeout_s
-        while not condition():
-            assert time.monotonic() < deadline, f"timed out waiting for {what}"
-            self.run(0.01)
-
-    def tab(self, **kwargs: Any) -> Tab:
-        """A page connected to the scene (closed with the harness)."""
-        tab = Tab(self.scene.url, **kwargs)
-        self.tabs.append(tab)
-        self.until(lambda: tab.received != [], "the scene to reach the tab")
-        return tab
-
-    def call(self, fn: Callable[[], Any]) -> Any:
-        """Run ``fn`` on the loop, as the world's callers do."""
-
-        async def on_loop() -> Any:
-            return fn()
-
-        return self.loop.run_until_complete(on_loop())
-
-    def close(self) -> None:
-        for tab in self.tabs:
-            tab.close()
-        self.scene.stop()
-        self.loop.close()
-
-
 @pytest.fixture
 def harness() -> Iterator[Callable[..., Harness]]:
     made: list[Harness] = []
 
     def make(robot: str | Robot = "motoman_sia20d", **kwargs: Any) -> Harness:
-        h = Harness(load_robot(robot) if isinstance(robot, str) else robot, **kwargs)
+        chosen = load_robot(robot) if isinstance(robot, str) else robot
+        h = Harness(World(chosen, None, np.random.default_rng(7)), **kwargs)
         made.append(h)
         return h
 

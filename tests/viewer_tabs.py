@@ -1,14 +1,16 @@
-"""A viewer tab as viser's page is one: a websocket that speaks viser's wire format.
+"""A viewer tab as viser's page is one, and a scene to connect it to.
 
-``Tab`` connects with viser's subprotocol, sends a camera update first (viser
-counts a tab in after it), sends page input (``set``) and, on a thread of its
-own, reads and decodes every frame viser sends (zstd-compressed msgpack
-windows), so tests can wait for what a page would have been told.
+``Tab`` is a websocket that speaks viser's wire format: it connects with
+viser's subprotocol, sends a camera update first (viser counts a tab in after
+it), sends page input (``set``) and, on a thread of its own, reads and
+decodes every frame viser sends (zstd-compressed msgpack windows), so tests
+can wait for what a page would have been told. ``Harness`` runs a real
+``ViserScene`` on a world, with the asyncio loop driven from the test.
 """
 
 from __future__ import annotations
 
-import math
+import asyncio
 import threading
 import time
 from collections.abc import Callable
@@ -19,6 +21,9 @@ import viser
 import zstandard
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import ClientConnection, connect
+
+from c2rviz.viewer import ViserScene
+from c2rviz.world import World
 
 VERSION = f"viser-v{viser.__version__}"
 CAMERA = {
@@ -126,5 +131,48 @@ class Tab:
                 self._changed.notify_all()
 
 
-def close_to(a: float, b: float) -> bool:
-    return math.isclose(a, b, rel_tol=0.0, abs_tol=1e-6)
+class Harness:
+    """A real ``ViserScene``, its world and the asyncio loop they share (run from the test)."""
+
+    def __init__(self, world: World, hz: float = 100.0, port: int = 0, **options: Any) -> None:
+        self.world = world
+        self.robot = world.robot
+        self.loop = asyncio.new_event_loop()
+        self.scene = ViserScene(world, "127.0.0.1", port, hz, **options)
+        self.world.add_observers([self.scene])
+        self.scene.start(self.world, self.loop)
+        self.panel = self.scene.panels[self.world.default]
+        self.tabs: list[Tab] = []
+        self.run(0.0)
+
+    def run(self, seconds: float) -> None:
+        """Let the loop run for ``seconds`` (its due sends go out)."""
+        self.loop.run_until_complete(asyncio.sleep(seconds))
+
+    def until(self, condition: Callable[[], bool], what: str, timeout_s: float = 60.0) -> None:
+        """Run the loop until ``condition`` holds (a generous bound: we wait for a signal)."""
+        deadline = time.monotonic() + timeout_s
+        while not condition():
+            assert time.monotonic() < deadline, f"timed out waiting for {what}"
+            self.run(0.01)
+
+    def tab(self, **kwargs: Any) -> Tab:
+        """A page connected to the scene (closed with the harness)."""
+        tab = Tab(self.scene.url, **kwargs)
+        self.tabs.append(tab)
+        self.until(lambda: tab.received != [], "the scene to reach the tab")
+        return tab
+
+    def call(self, fn: Callable[[], Any]) -> Any:
+        """Run ``fn`` on the loop, as the world's callers do."""
+
+        async def on_loop() -> Any:
+            return fn()
+
+        return self.loop.run_until_complete(on_loop())
+
+    def close(self) -> None:
+        for tab in self.tabs:
+            tab.close()
+        self.scene.stop()
+        self.loop.close()
