@@ -11,6 +11,7 @@ import gzip
 import os
 import socket
 import threading
+import urllib.error
 import urllib.request
 from collections.abc import Callable, Iterator
 from typing import Any
@@ -428,3 +429,24 @@ def test_a_tab_that_closes_mid_flood_leaves_the_others_served(
         "the staying tab to see the move",
     )
     assert leaving.closed.is_set()
+
+
+def test_a_viewer_beyond_loopback_gets_a_token_and_says_so(c2rviz_process: Any) -> None:
+    proc = c2rviz_process("--viser-host", "0.0.0.0", "--viser-port", "0")
+    assert proc.viewer_url is not None and "/?token=" in proc.viewer_url
+    warning = proc.popen.stdout.readline()
+    assert warning.startswith("c2rviz: warning: the viewer listens on 0.0.0.0: ")
+    assert "generated for this run; --viewer-token sets one" in warning
+    port = int(proc.viewer_url.split("/?")[0].rsplit(":", 1)[1])
+    with pytest.raises(urllib.error.HTTPError) as refused:
+        urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=10)
+    assert refused.value.code == 403
+    with pytest.raises(InvalidStatus):
+        Tab(f"http://127.0.0.1:{port}/")
+    tab = Tab(proc.viewer_url)  # the printed URL is the way in
+    tab.wait(lambda: tab.received != [], "the scene")
+    tab.close()
+    with socket.create_connection(("127.0.0.1", proc.port), timeout=10) as sock:
+        sock.sendall(b"quit\n")
+        assert sock.recv(10) == b"ok\n"
+    assert proc.wait(timeout=30) == 0
