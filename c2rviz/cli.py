@@ -78,6 +78,21 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="PORT",
         help="port for the browser view (default 8080)",
     )
+    add(
+        "--viewer-origin",
+        dest="viewer_origins",
+        metavar="ORIGIN",
+        action="append",
+        help="an origin besides the viewer's own allowed to open its websocket, e.g. "
+        "https://robot.example.org behind a reverse proxy (repeatable)",
+    )
+    add(
+        "--viewer-token",
+        metavar="TOKEN",
+        help="the page and its websocket need ?token=TOKEN (the printed URL carries it; "
+        "default: none on loopback, else one generated at start)",
+    )
+    add("--max-viewers", type=int, metavar="N", help="viewer tabs at once (default 16)")
     add("--hz", type=float, help="most scene updates per second (default 100)")
     add(
         "--motion",

@@ -115,6 +115,12 @@ class Settings:
     viewer_host: str = "127.0.0.1"
     viewer_port: int = 8080
     viewer: bool = True
+    viewer_origins: tuple[str, ...] = ()
+    """Origins allowed to open the viewer's websocket besides its own (a reverse proxy)."""
+    viewer_token: str | None = None
+    """The token the page needs (``?token=``); None: none, unless bound beyond loopback."""
+    max_viewers: int = 16
+    """Viewer tabs connected at once."""
     robot: str = "motoman_sia20d"
     urdf: Path | None = None
     base: str | None = None
@@ -153,8 +159,18 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "lspeed": ("lspeed", float, 0.001, 5),
     "trail_points": ("trail_points", int, 16, 10_000_000),
     "max_objects": ("max_objects", int, 0, 10_000),
+    "max_viewers": ("max_viewers", int, 1, 1024),
 }
-_TEXT_OPTIONS = ("host", "viewer_host", "robot", "motion", "guard", "record_dir")
+_TEXT_OPTIONS = (
+    "host",
+    "viewer_host",
+    "robot",
+    "motion",
+    "guard",
+    "record_dir",
+    "viewer_token",
+    "viewer_origins",
+)
 _CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on")}
 _EXTRA_KEYS = ["tool", "max_velocity", "max_acceleration", "max_jerk"]
 _ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args", *_EXTRA_KEYS]
@@ -207,6 +223,8 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
                     values[key] = text == "on"
                 elif key == "record_dir":
                     values[key] = path.parent / text
+                elif key == "viewer_origins":
+                    values[key] = tuple(text.split())
                 else:
                     values[key] = text
             else:
@@ -260,14 +278,14 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
     given = {k: v for k, v in overrides.items() if v is not None}
     for key, (name, _kind, low, high) in _OPTIONS.items():
         if name in given and not low <= given[name] <= high:
-            flag = "--" + key.replace("_", "-").replace("viewer", "viser")
+            flag = "--" + key.replace("viewer_", "viser_").replace("_", "-")
             raise ConfigError(f"{flag} {given[name]:g} is outside {low:g}..{high:g}")
     if "guard" in given:
         given["guard"] = given["guard"] == "on"
     values.update(given)
     if "record_dir" in values:
         values["record_dir"] = Path(values["record_dir"])
-    for key in ("package_paths", "xacro_args"):
+    for key in ("package_paths", "xacro_args", "viewer_origins"):
         values[key] = tuple(values.get(key, ()))
     limit_values = {k: values.pop(k) for k in list(values) if k in _LIMIT_FIELDS}
     session_values = {k: values.pop(k) for k in list(values) if k in _SESSION_FIELDS}

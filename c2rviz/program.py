@@ -10,6 +10,7 @@ import argparse
 import asyncio
 import errno
 import ipaddress
+import secrets
 import signal
 import sys
 from collections.abc import Sequence
@@ -46,12 +47,22 @@ def _is_loopback(host: str) -> bool:
         return False
 
 
-def _open_scene(settings: Settings, robot: Robot) -> Scene:
+_STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+def _open_scene(settings: Settings, world: World, title: str | None) -> Scene:
     if not settings.viewer:
         return NullScene()
+    from .view.policy import DoorPolicy
     from .viewer import ViserScene  # viser is heavy: import only when it is used
 
-    return ViserScene(robot, settings.viewer_host, settings.viewer_port, settings.hz)
+    token = settings.viewer_token
+    if token is None and not _is_loopback(settings.viewer_host):
+        token = secrets.token_urlsafe(16)
+    policy = DoorPolicy(settings.viewer_origins, token, settings.max_viewers)
+    return ViserScene(
+        world, settings.viewer_host, settings.viewer_port, settings.hz, policy=policy, title=title
+    )
 
 
 def _cannot_listen(host: str, port: int, exc: OSError) -> str:
@@ -118,11 +129,12 @@ async def serve(settings: Settings, members: Sequence[Member], cell: str | None 
         world.state(member.name).port = port
         servers.append(server)
     try:
-        scene = _open_scene(settings, members[0].robot)
-    except OSError as exc:
+        scene = _open_scene(settings, world, cell)
+    except (OSError, C2rvizError) as exc:
+        problem = exc.strerror or exc if isinstance(exc, OSError) else exc
         print(
             f"c2rviz: cannot serve the viewer on {settings.viewer_host}:{settings.viewer_port}: "
-            f"{exc.strerror or exc}",
+            f"{problem}",
             file=sys.stderr,
         )
         for server in servers:
@@ -132,7 +144,7 @@ async def serve(settings: Settings, members: Sequence[Member], cell: str | None 
     for server in servers:
         server.viewer_url = scene.url
     scene.start(world, loop)
-    for sig in (signal.SIGINT, signal.SIGTERM):
+    for sig in _STOP_SIGNALS:
         loop.add_signal_handler(sig, stop.set)
     if cell is not None:
         print(f"c2rviz: cell {cell}: {', '.join(m.name for m in members)}", flush=True)
@@ -140,18 +152,26 @@ async def serve(settings: Settings, members: Sequence[Member], cell: str | None 
         _banner(member, settings.host, world.state(member.name).port, cell is not None)
     if scene.url:
         print(f"c2rviz: viewer at {scene.url}", flush=True)
-    for what, address in (("command server", settings.host), ("viewer", settings.viewer_host)):
-        if not _is_loopback(address) and (what == "command server" or settings.viewer):
-            print(
-                f"c2rviz: warning: the {what} listens on {address}: anyone who can reach it "
-                "can move the robot and stop the program",
-                file=sys.stderr,
-                flush=True,
-            )
+    if not _is_loopback(settings.host):
+        print(
+            f"c2rviz: warning: the command server listens on {settings.host}: anyone who can "
+            "reach it can move the robot and stop the program",
+            file=sys.stderr,
+            flush=True,
+        )
+    if settings.viewer and not _is_loopback(settings.viewer_host):
+        made = " (generated for this run; --viewer-token sets one)"
+        print(
+            f"c2rviz: warning: the viewer listens on {settings.viewer_host}: anyone who can "
+            "reach it and has its URL with the token can move the robot"
+            f"{made if settings.viewer_token is None else ''}",
+            file=sys.stderr,
+            flush=True,
+        )
     try:
         await stop.wait()
     finally:
-        for sig in (signal.SIGINT, signal.SIGTERM):
+        for sig in _STOP_SIGNALS:
             loop.remove_signal_handler(sig)
         for server in servers:
             await server.stop()

@@ -300,3 +300,85 @@ def test_the_page_follows_commands_and_commands_the_robot(
         assert changed(home, cleared) < 20
     finally:
         tcp.close()
+
+
+TRY_WEBSOCKET = """([url, protocol]) => new Promise((resolve) => {
+    const ws = new WebSocket(url, protocol);
+    ws.onopen = () => { ws.close(); resolve("open"); };
+    ws.onerror = () => resolve("refused");
+})"""
+
+
+@pytest.fixture
+def other_origin() -> Iterator[str]:
+    """A tiny page served from another local port: another origin, as any site is."""
+    import http.server
+    import threading
+
+    class Page(http.server.BaseHTTPRequestHandler):
+        def do_GET(self) -> None:  # noqa: N802 (http.server's name)
+            body = b"<!doctype html><title>elsewhere</title><p>another site</p>"
+            self.send_response(200)
+            self.send_header("Content-Type", "text/html")
+            self.send_header("Content-Length", str(len(body)))
+            self.end_headers()
+            self.wfile.write(body)
+
+        def log_message(self, *args: Any) -> None:
+            pass
+
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Page)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{server.server_address[1]}"
+    finally:
+        server.shutdown()
+        server.server_close()
+        thread.join(timeout=10)
+
+
+def test_a_page_from_another_origin_cannot_reach_the_viewer(
+    browser: Any, c2rviz_process: Callable[..., Any], other_origin: str
+) -> None:
+    """Any site the user visits could open the viewer's websocket; the door refuses it.
+    The viewer's own page, titled by the robot, still connects and works."""
+    import viser
+
+    proc = c2rviz_process("--viser-port", "0")
+    socket_url = proc.viewer_url.replace("http://", "ws://") + "/"
+    protocol = f"viser-v{viser.__version__}"
+    elsewhere = browser.new_page()
+    elsewhere.goto(other_origin)
+    assert elsewhere.evaluate(TRY_WEBSOCKET, [socket_url, protocol]) == "refused"
+    elsewhere.close()
+    page = open_page(browser, proc.viewer_url)
+    assert page.title() == "c2rviz — motoman_sia20d"
+    assert page.evaluate(TRY_WEBSOCKET, [socket_url, protocol]) == "open"  # same script, own page
+    wait_for_robot(page)
+    box = slider_input(page, "joint_e")
+    box.fill("30")
+    box.press("Enter")
+    tcp = Tcp(proc.port)
+    try:
+        assert tcp.ask("degrees") == "ok"
+        wait_for(lambda: tcp.ask("where").split(",")[2] == "30")
+    finally:
+        tcp.close()
+
+
+def test_long_joint_names_stay_on_one_line(
+    browser: Any, c2rviz_process: Callable[..., Any]
+) -> None:
+    """ur5's joints are named like shoulder_pan_joint: each label fits on one line."""
+    ARTIFACTS.mkdir(exist_ok=True)
+    proc = c2rviz_process("--robot", "ur5", "--viser-port", "0")
+    page = browser.new_page(viewport=VIEWPORT)
+    page.goto(proc.viewer_url + "/?fixedDpr=1")
+    page.get_by_text("Speed %").first.wait_for(timeout=30_000)
+    assert page.title() == "c2rviz — ur5"
+    heights = {}
+    for label in ("Speed %", "shoulder_pan", "shoulder_lift", "elbow", "wrist_1"):
+        heights[label] = page.locator("label", has_text=label).first.bounding_box()["height"]
+    page.screenshot(path=str(ARTIFACTS / "ur5-panel.png"))
+    assert len(set(heights.values())) == 1, heights  # as high as a one-line label

@@ -196,3 +196,35 @@ def test_a_missing_ini_package_path_names_the_ini_key(tmp_path, capsys, entry, f
     assert main(["--config", str(ini), "--no-viewer"]) == 2
     err = capsys.readouterr().err
     assert err == f"c2rviz: {expected}\n" and "--package-path" not in err
+
+
+def test_the_viewers_door_settings_come_from_the_ini_and_the_flags(tmp_path):
+    ini = tmp_path / "door.ini"
+    ini.write_text(
+        "[options]\nviewer_origins = https://a.example http://b.example:8080\n"
+        "viewer_token = abc\nmax_viewers = 3\n"
+    )
+    settings = load_settings(ini, {"urdf": tmp_path / "x.urdf"})
+    assert settings.viewer_origins == ("https://a.example", "http://b.example:8080")
+    assert settings.viewer_token == "abc" and settings.max_viewers == 3
+    flags = {"urdf": tmp_path / "x.urdf", "viewer_origins": ["https://c.example"]}
+    assert load_settings(ini, {**flags, "max_viewers": 5}).viewer_origins == ("https://c.example",)
+    with pytest.raises(ConfigError, match="--max-viewers 0 is outside 1..1024"):
+        load_settings(ini, {**flags, "max_viewers": 0})
+    ini.write_text("[options]\nmax_viewers = 2000\n")
+    with pytest.raises(ConfigError, match=r"\[options\] max_viewers = 2000 is outside 1..1024"):
+        load_settings(ini, {"urdf": tmp_path / "x.urdf"})
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--viewer-origin", "evil"], "viewer origin 'evil' is not scheme://host[:port]"),
+        (["--viewer-token", "t\u00e9"], "is not printable ASCII"),
+    ],
+    ids=["origin", "token"],
+)
+def test_a_bad_door_setting_exits_2_with_one_sentence(argv, message, capsys):
+    assert main([*argv, "--viser-port", "0", "--port", "0"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert message in err and err.count("\n") == 0, err

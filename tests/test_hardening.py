@@ -27,6 +27,7 @@ from c2rviz import cli, config, replies
 from c2rviz.commands import _MAX_INDEX_DIGITS
 from c2rviz.errors import LineTooLong
 from c2rviz.server import _BATCH_BYTES, _LINGER_S, CommandServer
+from c2rviz.view.policy import DoorPolicy
 
 # A state away from home (so a stray home or joints shows) with long `where` replies.
 START_Q = (0.123456789, -0.234567891, 0.345678912, -0.456789123, 0.567891234, -0.678912345, 0.0)
@@ -490,3 +491,30 @@ def test_the_limits_table_matches_the_code():
     assert f"| {grace:g} s | `CommandServer.stop(grace_s)` |" in text
     assert "| Command server | `127.0.0.1` | `--host` | `host` |" in text
     assert config.Settings().host == config.Settings().viewer_host == "127.0.0.1"
+
+
+def test_the_viewer_limits_in_the_docs_match_the_code():
+    """docs/limits.md: the viewer's limits and settings are the ones the code uses."""
+    text = (Path(__file__).parent.parent / "docs" / "limits.md").read_text()
+    table = text.split("| When refused |")[1].split("\n\n")[0]
+    rows = [[c.strip() for c in row.strip("|").split("|")] for row in table.splitlines()[2:]]
+    flags = {a.option_strings[0]: a.dest for a in cli.build_parser()._actions if a.option_strings}
+    settings = config.Settings()
+    assert rows
+    for _limit, default, flag, key, allowed, past in rows:
+        field, kind, low, high = config._OPTIONS[key.strip("`")]
+        assert flags[flag.strip("`")] == field
+        assert kind(default) == getattr(settings, field)
+        assert [float(v) for v in allowed.split("..")] == [low, high]
+        assert f"{default} tabs open" in past
+    assert settings.max_viewers == DoorPolicy().max_clients  # the door's own default
+    policy = DoorPolicy()
+    assert f"| {policy.max_frame_bytes} | `DoorPolicy.max_frame_bytes` |" in text
+    assert f"| {policy.max_queued_frames} | `DoorPolicy.max_queued_frames` |" in text
+    from c2rviz.view.viser_scene import STOP_TIMEOUT_S
+
+    assert f"| {STOP_TIMEOUT_S:g} s | `viser_scene.STOP_TIMEOUT_S` |" in text
+    for flag, key in (("--viewer-origin", "viewer_origins"), ("--viewer-token", "viewer_token")):
+        assert flags[flag] == key
+        assert f"`{flag}`" in text and f"`{key}`" in text
+        assert key in config._TEXT_OPTIONS

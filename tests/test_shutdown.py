@@ -176,3 +176,40 @@ def test_a_stop_mid_flood_answers_what_was_read_in_order(start_server):
     assert replies_seen[:answered] == [HOME] * answered  # ... in order: answers, then ...
     assert set(replies_seen[answered:]) == {replies.SHUTTING_DOWN}  # ... the rest
     print(f"stop mid-flood: {answered} answered, {len(replies_seen) - answered} shutting down")
+
+
+@pytest.mark.parametrize("how", ["quit", "SIGINT", "SIGTERM", "SIGHUP"])
+def test_every_way_to_stop_answers_and_exits_with_a_tab_that_never_reads(c2rviz_process, how):
+    """With the viewer on: a tab that never reads (its TCP window shut after a flood of
+    markers) holds nothing up; every line already read is answered; exit status 0."""
+    from test_view_adapter import never_reading_tab
+
+    proc = c2rviz_process("--viser-port", "0")
+    viewer_port = int(proc.viewer_url.rsplit(":", 1)[1])
+    tab = never_reading_tab(viewer_port)
+    flooder = socket.create_connection(("127.0.0.1", proc.port), timeout=30)
+    marks = "".join(f"mark {i % 1000},{i // 1000},0,0,0,0\n" for i in range(60_000))
+    flooder.sendall(marks.encode())  # ~100 frames of 1000 markers for the tab not to read
+    with flooder.makefile("rb") as replies_seen:
+        assert [replies_seen.readline() for _ in range(60_000)][-1] == b"ok\n"
+    sleeper = socket.create_connection(("127.0.0.1", proc.port), timeout=30)
+    sleeper.sendall(b"where\n")
+    assert sleeper.recv(100) == (HOME + "\n").encode()
+    sleeper.sendall(b"sleep 30\nwhere\nmove 0 1\n")
+    time.sleep(0.3)  # let the server read them
+    start = time.monotonic()
+    if how == "quit":
+        quitter = socket.create_connection(("127.0.0.1", proc.port), timeout=30)
+        quitter.sendall(b"where\nquit\nwhere\n")
+        assert read_all(quitter) == [HOME, "ok", replies.SHUTTING_DOWN]
+        quitter.close()
+    else:
+        proc.popen.send_signal(getattr(signal, how))
+    assert proc.wait(timeout=30) == 0
+    print(f"{how}: exited {time.monotonic() - start:.2f} s after, a tab never reading")
+    assert read_all(sleeper) == [replies.SHUTTING_DOWN] * 3
+    for sock in (sleeper, flooder, tab):
+        sock.close()
+    assert port_is_free(proc.port) and port_is_free(viewer_port)
+    rest = proc.popen.stdout.read()
+    assert "c2rviz: stopped" in rest and "Traceback" not in rest

@@ -2,64 +2,34 @@
 
 Each test runs a real ``ViserScene`` on a free port, bound to a real ``World``
 on an asyncio loop driven from the test's thread (the loop only runs inside
-``run``, like the program's loop between commands).
+``run``, like the program's loop between commands). Page input comes over a
+real websocket (``viewer_tabs.Tab``), as a page sends it.
 """
 
 from __future__ import annotations
 
-import asyncio
 import io
 import logging
 import socket
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from types import SimpleNamespace
 from typing import Any
 
-import msgspec
 import numpy as np
 import pinocchio as pin
 import pytest
 import trimesh
-import viser
 import yourdfpy
 from conftest import ROBOTS, load_robot
-from websockets.sync.client import connect
+from viewer_tabs import Harness
 
 from c2rviz.robot import Robot
 from c2rviz.scene import Marker
+from c2rviz.view import adapter
 from c2rviz.viewer import RECENT_COMMANDS, ViserScene
 from c2rviz.visuals import load_link_geometry
 from c2rviz.world import World
-
-
-class Harness:
-    """A scene, its world and the loop they share."""
-
-    def __init__(self, robot: Robot, hz: float = 100.0, port: int = 0) -> None:
-        self.robot = robot
-        self.loop = asyncio.new_event_loop()
-        self.scene = ViserScene(robot, "127.0.0.1", port, hz)
-        self.world = World(robot, self.scene, np.random.default_rng(7))
-        self.scene.start(self.world, self.loop)
-        self.run(0.0)
-
-    def run(self, seconds: float) -> None:
-        """Let the loop run for ``seconds`` (its due sends go out)."""
-        self.loop.run_until_complete(asyncio.sleep(seconds))
-
-    def call(self, fn: Callable[[], Any]) -> Any:
-        """Run ``fn`` on the loop, as the world's callers do."""
-
-        async def on_loop() -> Any:
-            return fn()
-
-        return self.loop.run_until_complete(on_loop())
-
-    def close(self) -> None:
-        self.scene.stop()
-        self.loop.close()
 
 
 @pytest.fixture
@@ -67,7 +37,8 @@ def harness() -> Iterator[Callable[..., Harness]]:
     made: list[Harness] = []
 
     def make(robot: str | Robot = "motoman_sia20d", **kwargs: Any) -> Harness:
-        h = Harness(load_robot(robot) if isinstance(robot, str) else robot, **kwargs)
+        chosen = load_robot(robot) if isinstance(robot, str) else robot
+        h = Harness(World(chosen, None, np.random.default_rng(7)), **kwargs)
         made.append(h)
         return h
 
@@ -176,14 +147,18 @@ def test_sliders_follow_the_world_without_commanding_it(
     set_q_calls: list[tuple[float, ...]] = []
     original = h.world.set_q
     monkeypatch.setattr(
-        h.world, "set_q", lambda q, robot=None: (set_q_calls.append(tuple(q)), original(q, robot))
+        h.world, "set_q", lambda q, *args: (set_q_calls.append(tuple(q)), original(q, *args))
     )
+    tab = h.tab()
     q = [0.5, -0.3, 1.0, 0.2, -1.5, 0.7, 2.0]
     h.call(lambda: h.world.set_q(q))
-    h.run(0.1)  # viser runs the sliders' update callbacks on its own loop
-    sliders = h.scene._sliders
+    h.run(0.1)
+    sliders = h.panel.sliders
     assert [s.value for s in sliders] == pytest.approx(np.degrees(q).tolist())
     assert [s.label for s in sliders] == list(h.robot.joint_names)
+    tab.wait(lambda: tab.values(sliders[4]) != [], "the tab to be sent the sliders")
+    assert tab.values(sliders[4])[-1] == pytest.approx(np.degrees(-1.5))
+    h.run(0.1)
     assert set_q_calls == [tuple(q)]  # the programmatic slider updates did not re-command
 
 
@@ -191,71 +166,79 @@ def test_a_slider_from_the_page_commands_the_world_through_the_session(
     harness: Callable[..., Harness],
 ) -> None:
     h = harness()
-    h.call(lambda: h.scene._slider_moved(1, 30.0, 0))
-    assert h.world.q[1] == pytest.approx(np.radians(30.0))
-    h.call(lambda: h.scene._slider_moved(1, 500.0, 0))  # beyond joint_l's 1.91 rad: refused
+    tab, other = h.tab(), h.tab()
+    slider = h.panel.sliders[1]
+    tab.set(slider, 30.0)
+    h.until(lambda: h.world.q[1] == pytest.approx(np.radians(30.0)), "the page's move")
+    assert ("move 1 30.0", True) in h.scene._commands  # through the page's session
+    other.wait(lambda: 30.0 in other.values(slider), "the other tab to see the value")
+    tab.set(slider, 500.0)  # beyond joint_l's 1.91 rad: refused
+    h.until(lambda: h.scene.page_input.refused == 1, "the refusal")
     assert h.world.q[1] == pytest.approx(np.radians(30.0))
     assert h.world.q[0] == 0.0
+    tab.wait(lambda: tab.values(slider)[-1:] == [30.0], "the true value back")
 
 
-CAMERA = {
-    "type": "ViewerCameraMessage",
-    "wxyz": (1.0, 0.0, 0.0, 0.0),
-    "position": (3.0, 0.0, 1.0),
-    "fov": 1.0,
-    "near": 0.01,
-    "far": 100.0,
-    "image_height": 480,
-    "image_width": 640,
-    "look_at": (0.0, 0.0, 0.5),
-    "up_direction": (0.0, 0.0, 1.0),
-}
-
-
-@pytest.mark.parametrize("bad", [500.0, float("nan")], ids=["over", "nan"])
+@pytest.mark.parametrize("bad", [500.0, float("nan"), "ninety"], ids=["over", "nan", "text"])
 def test_a_bad_slider_value_over_the_websocket_changes_nothing_and_snaps_back(
     harness: Callable[..., Harness], bad: object
 ) -> None:
-    """The page is a source like any other: its value goes through the session's checks;
-    a refused one leaves the world as it was and the slider shows the true value again."""
+    """The page is a source like any other: its value goes through the session's checks
+    (a NaN or a word does not even get past the door); a refused one leaves the world as
+    it was and the slider shows the true value again."""
     h = harness()
     h.call(lambda: h.world.set_q([0.0, 0.5, 0, 0, 0, 0, 0]))
     h.run(0.05)
     before = h.world.q
-    slider = h.scene._sliders[1]
-    ws_url = h.scene.url.replace("http://", "ws://")
-    with connect(ws_url, subprotocols=[f"viser-v{viser.__version__}"]) as ws:  # type: ignore[list-item]
-        ws.send(msgspec.msgpack.encode(CAMERA))  # viser counts a tab in after its first camera
-        update = {"type": "GuiUpdateMessage", "uuid": slider._impl.uuid, "updates": {"value": bad}}
-        ws.send(msgspec.msgpack.encode(update))
-        deadline = time.monotonic() + 60  # a generous bound: we wait for the refusal itself
-        while not any("[refused]" in line for line in h.scene._commands):
-            assert time.monotonic() < deadline, "the page's value never reached the session"
-            h.run(0.02)
+    slider = h.panel.sliders[1]
+    door = adapter.door(h.scene.server)
+    tab = h.tab()
+    tab.set(slider, bad)
+    h.until(
+        lambda: h.scene.page_input.refused + door.refused["input"] == 1,
+        "the page's value to be refused",
+    )
     h.run(0.05)
     assert h.world.q == before
     assert slider.value == pytest.approx(np.degrees(0.5))
+    if isinstance(bad, float) and bad == 500.0:  # the session refused it: sent back
+        assert ("move 1 500.0", False) in h.scene._commands
+        tab.wait(lambda: tab.values(slider)[-1:] == [slider.value], "the true value back")
+    where = h.call(lambda: h.scene.sessions[h.world.default].run("where"))
+    assert [float(v) for v in where.removeprefix("ok ").split(",")] == pytest.approx(
+        np.degrees(before).tolist()
+    )
 
 
 def test_the_buttons_and_the_collision_checkbox(harness: Callable[..., Harness]) -> None:
     h = harness()
-    click = SimpleNamespace(client=object(), target=SimpleNamespace(value=True))
-    asyncio.run(h.scene._button_callback("rand")(click))  # as on viser's loop
-    h.run(0.01)
-    assert h.world.q != h.robot.home
-    asyncio.run(h.scene._button_callback("home")(click))
-    h.run(0.01)
-    assert h.world.q == h.robot.home
-    collisions = [n for n in h.scene.server.scene._handle_from_node_name if "/collision_" in n]
-    assert collisions and not any(
-        h.scene.server.scene._handle_from_node_name[n].visible for n in collisions
-    )
-    asyncio.run(h.scene._collision_callback(click))
-    assert all(h.scene.server.scene._handle_from_node_name[n].visible for n in collisions)
+    tab, other = h.tab(), h.tab()
+    buttons = h.panel.buttons
+    tab.set(buttons["rand"], True)
+    h.until(lambda: h.world.q != h.robot.home, "Random")
+    tab.set(buttons["home"], True)
+    h.until(lambda: h.world.q == h.robot.home, "Home")
+    nodes = h.scene.server.scene._handle_from_node_name
+    collisions = [n for n in nodes if "/collision_" in n]
+    assert collisions and not any(nodes[n].visible for n in collisions)
+    checkbox = h.scene.state_panel.collision
+    tab.set(checkbox, True)
+    h.until(lambda: all(nodes[n].visible for n in collisions), "the collision geometry")
+    other.wait(lambda: other.values(checkbox) == [True], "the other tab's checkbox")
+    assert checkbox.value is True
+
+
+def drawn_markers(h: Harness) -> dict[str, np.ndarray]:
+    """The positions of the markers drawn, by shape (what every tab is sent)."""
+    return {
+        shape: np.asarray(node.batched_positions) if node.visible else np.zeros((0, 3))
+        for (_, shape), node in h.scene.markers.nodes.items()
+    }
 
 
 def test_markers_are_drawn_and_cleared(harness: Callable[..., Harness]) -> None:
     h = harness()
+    tab = h.tab()
     shapes = ("sphere", "cube", "arrow", "cylinder")
     for i, shape in enumerate(shapes):
         h.call(
@@ -264,28 +247,38 @@ def test_markers_are_drawn_and_cleared(harness: Callable[..., Harness]) -> None:
             )
         )
     h.run(0.05)
-    nodes = h.scene.server.scene._handle_from_node_name
-    drawn = sorted(n for n in nodes if n.startswith("/markers/"))
-    assert len(drawn) == len(shapes) == h.scene.marker_count
-    np.testing.assert_allclose(nodes[drawn[1]].position, [0.1, 0.0, 0.5])
+    drawn = drawn_markers(h)
+    assert sum(len(p) for p in drawn.values()) == len(shapes) == h.scene.marker_count
+    assert sorted(drawn) == sorted(shapes)
+    np.testing.assert_allclose(drawn["cube"], [[0.1, 0.0, 0.5]], atol=1e-6)
+    np.testing.assert_allclose(drawn["cylinder"], [[0.3, 0.0, 0.5]], atol=1e-6)
+    cube = h.scene.markers.nodes[h.world.default, "cube"]
+    assert tuple(cube.batched_colors[0]) == (255, 0, 0)
+    tab.wait(
+        lambda: len([m for m in tab.received if m["type"] == "BatchedMeshesMessage"]) == 4,
+        "the tab to be sent one node per shape",
+    )
     h.call(h.world.clear)
     h.run(0.05)
-    assert not [n for n in nodes if n.startswith("/markers/")]
+    assert sum(len(p) for p in drawn_markers(h).values()) == 0
     assert h.scene.marker_count == 0
+    assert not any(node.visible for node in h.scene.markers.nodes.values())
 
 
 def test_a_marker_flood_keeps_the_newest(harness: Callable[..., Harness]) -> None:
     h = harness()
-    marker = Marker((0.0, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0), "sphere")
     cap = 1000
 
     def flood() -> None:
-        for _ in range(cap + 500):
+        for i in range(cap + 500):
+            marker = Marker((float(i), 0.0, 0.0), (1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0), "sphere")
             h.scene.on_marker(h.robot.name, marker)
 
     h.call(flood)
     h.run(0.05)
     assert h.scene.marker_count == cap
+    xs = sorted(drawn_markers(h)["sphere"][:, 0])
+    assert xs == list(range(500, cap + 500))  # the newest 1000, each once
 
 
 def test_the_panel_shows_clients_commands_and_the_pose(harness: Callable[..., Harness]) -> None:
@@ -296,12 +289,16 @@ def test_the_panel_shows_clients_commands_and_the_pose(harness: Callable[..., Ha
         h.world.set_client_count(3)
         for line in lines:
             h.world.note("tcp", line, True)
+        h.world.note("tcp", "jump 3", False)
 
     h.call(talk)
     h.run(0.05)
-    assert h.scene._clients.value == "3"
-    assert h.scene._recent.value.splitlines() == lines[-RECENT_COMMANDS:]
-    assert "z +1.500 m" in h.scene._ee_pose.value  # the motoman's link_t at home
+    state = h.scene.state_panel
+    assert state.clients.value == "3"
+    newest_first = ["jump 3  [rejected]", *lines[::-1]]
+    assert state.recent.value.splitlines() == newest_first[:RECENT_COMMANDS]
+    assert "z +1.500 m" in h.panel.pose.value  # the motoman's link_t at home
+    assert h.panel.motion.value == "idle"
 
 
 def test_no_share_button_and_a_share_request_is_refused(
@@ -319,23 +316,15 @@ def test_no_share_button_and_a_share_request_is_refused(
     assert themes and not themes[-1].show_share_button
     opened: list[str] = []
     monkeypatch.setattr(server, "request_share_url", lambda *a, **k: opened.append("tunnel"))
-    ws_url = h.scene.url.replace("http://", "ws://")
-    with (
-        caplog.at_level(logging.WARNING, logger="c2rviz.viewer"),
-        connect(
-            ws_url,
-            subprotocols=[f"viser-v{viser.__version__}"],  # type: ignore[list-item]
-        ) as ws,
-    ):
-        ws.send(msgspec.msgpack.encode({"type": "ShareUrlRequest"}))
-        deadline = time.monotonic() + 60
-        while h.scene.refused_share_requests == 0 and time.monotonic() < deadline:
-            time.sleep(0.02)
-    assert h.scene.refused_share_requests == 1
+    door = adapter.door(server)
+    with caplog.at_level(logging.WARNING, logger="c2rviz.view"):
+        tab = h.tab()
+        tab.send({"type": "ShareUrlRequest"})
+        h.until(lambda: door.refused["share"] == 1, "the share request's refusal")
     time.sleep(0.2)  # the thread pool would have called it by now
     assert opened == []
     assert server._share_tunnel is None
-    assert "refused a share-link request" in caplog.text
+    assert "share-link request" in caplog.text
 
 
 def _port_is_free(port: int) -> bool:
@@ -348,7 +337,7 @@ def _port_is_free(port: int) -> bool:
 
 
 def test_stop_frees_the_port() -> None:
-    scene = ViserScene(load_robot(), "127.0.0.1", 0, 100.0)
+    scene = ViserScene(World(load_robot()), "127.0.0.1", 0, 100.0)
     port = int(scene.url.rsplit(":", 1)[1])
     assert not _port_is_free(port)
     scene.stop()
@@ -363,7 +352,7 @@ def test_url_reports_the_port_bound_when_the_asked_one_is_busy(
         busy.bind(("127.0.0.1", 0))
         busy.listen()
         taken = busy.getsockname()[1]
-        scene = ViserScene(load_robot(), "127.0.0.1", taken, 100.0)
+        scene = ViserScene(World(load_robot()), "127.0.0.1", taken, 100.0)
         try:
             bound = int(scene.url.rsplit(":", 1)[1])
             assert scene.url.startswith("http://127.0.0.1:")
@@ -375,11 +364,11 @@ def test_url_reports_the_port_bound_when_the_asked_one_is_busy(
 
 def test_a_host_that_cannot_be_bound_fails_at_once() -> None:
     with pytest.raises(OSError):
-        ViserScene(load_robot(), "192.0.2.1", 0, 100.0)  # TEST-NET-1: not ours
+        ViserScene(World(load_robot()), "192.0.2.1", 0, 100.0)  # TEST-NET-1: not ours
 
 
 def test_no_banner_on_stdout(capsys: pytest.CaptureFixture[str]) -> None:
-    scene = ViserScene(load_robot(), "127.0.0.1", 0, 100.0)
+    scene = ViserScene(World(load_robot()), "127.0.0.1", 0, 100.0)
     scene.stop()
     assert capsys.readouterr().out == ""
 
@@ -429,9 +418,9 @@ def test_missing_meshes_warn_and_fall_back(
     assert "link hand is drawn with a placeholder box" in text
     assert "arm.stl" not in text  # found next to the URDF
     nodes = h.scene.server.scene._handle_from_node_name
-    assert "/robot/base/visual_0" in nodes  # the collision box stands in
-    assert "/robot/arm/visual_0" in nodes
-    assert "/robot/hand/visual_0" in nodes  # the placeholder
+    assert "/robots/meshy/links/base/visual_0" in nodes  # the collision box stands in
+    assert "/robots/meshy/links/arm/visual_0" in nodes
+    assert "/robots/meshy/links/hand/visual_0" in nodes  # the placeholder
     arm = load_link_geometry(robot.source)["arm"].visual[0]
     assert arm.mesh is not None and arm.rgba == (0.0, 0.0, 1.0, 1.0)
     np.testing.assert_allclose(arm.mesh.extents, [0.1, 0.1, 0.3])  # scale 2 applied
@@ -457,4 +446,5 @@ def test_a_urdf_material_wins_over_the_mesh_files_own_colour(
     assert base.rgba == pytest.approx((1.0, 0.423529411765, 0.0392156862745, 1.0))
     assert tip.rgba is None  # no URDF material: the file's colour is kept
     nodes = harness(robot).scene.server.scene._handle_from_node_name
-    assert tuple(nodes["/robot/base/visual_0"].color) == pytest.approx((255, 108, 10), abs=1)
+    base = nodes[f"/robots/{robot.name}/links/base/visual_0"]
+    assert tuple(base.color) == pytest.approx((255, 108, 10), abs=1)

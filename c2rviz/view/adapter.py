@@ -216,20 +216,24 @@ def queue_pose(handle: Any, position: np.ndarray, wxyz: np.ndarray) -> None:
         )
 
 
-def set_gui_value(handle: Any, value: float | bool, exclude_client: int | None = None) -> bool:
+def set_gui_value(
+    handle: Any, value: float | bool, exclude_client: int | None = None, force: bool = False
+) -> bool:
     """``handle.value = value`` without calling the handle's own update callbacks.
 
     Args:
         handle: A viser GUI input handle on the server's panel.
         value: Its new value (cast to the handle's type).
         exclude_client: A viser client id not to send it to (the tab that set it).
+        force: Send it even if it is the value held: a tab shows another one (a
+            page value that was refused, which the server never applied).
 
     Returns:
-        Whether the value changed (and was sent).
+        Whether the value was sent.
     """
     state = handle._impl
     value = type(state.value)(value)
-    if state.value == value:
+    if state.value == value and not force:
         return False
     message = _messages.GuiUpdateMessage(state.uuid, {"value": value})
     if exclude_client is not None:
@@ -345,7 +349,7 @@ def _serve_through(door: Door) -> Iterator[list[int]]:
             refused = door.process_request(connection, request)
             if refused is not None or viser_request is None:
                 return refused
-            return viser_request(connection, request)
+            return door.retitle(request, viser_request(connection, request))
 
         async def guarded(connection: Any) -> None:
             await door.handle(connection, handler)

@@ -9,6 +9,8 @@ adapter (``view.adapter``) puts a ``Door`` in front of viser's websocket server:
   the viewer's origins (``policy.DoorPolicy.origins``); a request without
   ``Origin`` is not from a browser and is let on. With a token set, the
   websocket and the page both need ``?token=...``. Refused: HTTP 403.
+* the page itself (``retitle``): viser's page is titled "Viser"; with
+  ``page_title`` set, the page is served under that title instead.
 * the connection (``handle``): the page's viser version, and at most
   ``max_clients`` tabs (one more is closed with code 1013 and a reason).
 * each frame (``screen``), already bounded in size by the server
@@ -23,6 +25,8 @@ API and viser's wire format, nothing private.
 
 from __future__ import annotations
 
+import gzip
+import html
 import logging
 import math
 import time
@@ -127,6 +131,8 @@ class Door:
         clients: The admitted websockets, each with the door's own number.
         identify: Maps an admitted websocket to the client id handed to input
             callbacks; the adapter sets it to viser's client id.
+        page_title: The page's title (its ``<title>``, the browser tab's
+            name); None keeps viser's.
     """
 
     def __init__(
@@ -146,6 +152,8 @@ class Door:
         self._inputs: dict[str, _Input] = {}
         self.host = host
         self._log = RateLimitedLog(log, policy.log_interval_s, clock)
+        self.page_title: str | None = None
+        self._retitled: dict[tuple[str, bytes, str], bytes] = {}
 
     # what the viewer registers
 
@@ -186,6 +194,35 @@ class Door:
             self.refuse("token", "websocket", "refused a viewer websocket without the token")
             return connection.respond(HTTPStatus.FORBIDDEN, "token required\n")
         return None
+
+    def retitle(self, request: Request, response: Response | None) -> Response | None:
+        """viser's ``response`` to ``request``, under ``page_title`` if it is the page."""
+        title = self.page_title
+        if (
+            title is None
+            or response is None
+            or response.status_code != HTTPStatus.OK
+            or not _is_page(request.path)
+        ):
+            return response
+        encoding = response.headers.get("Content-Encoding", "identity")
+        key = (title, bytes(response.body or b""), encoding)
+        body = self._retitled.get(key)
+        if body is None:
+            text = gzip.decompress(key[1]) if encoding == "gzip" else key[1]
+            start, end = text.find(b"<title>"), text.find(b"</title>")
+            if start < 0 or end < start:
+                return response
+            named = f"<title>{html.escape(title)}</title>".encode()
+            text = text[:start] + named + text[end + len(b"</title>") :]
+            body = gzip.compress(text) if encoding == "gzip" else text
+            self._retitled.clear()  # one page, one title: nothing to keep
+            self._retitled[key] = body
+        headers = response.headers.copy()
+        if "Content-Length" in headers:  # websockets' Headers holds every value set
+            del headers["Content-Length"]
+        headers["Content-Length"] = str(len(body))
+        return Response(response.status_code, response.reason_phrase, headers, body)
 
     # the connection (viser's event loop)
 

@@ -1,0 +1,146 @@
+"""Markers in the page: one batched node per robot and shape, rebuilt once per frame.
+
+A marker costs O(1) where the command runs: ``add`` writes it into its
+robot's ring of ``MAX_MARKERS`` slots (the oldest is overwritten), and
+``clear`` forgets them all. Once per frame the send calls ``draw``, which
+hands each changed robot's markers, shape by shape, to one viser batched-mesh
+node (``/markers/<robot>/<shape>``) as new instance arrays. The node's state
+is replaced, never removed and added again, so viser's buffer holds one
+update per node whatever the number of markers sent.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import trimesh
+import viser
+
+from ..commands import MARKER_SHAPES
+from ..scene import MAX_MARKERS, Marker
+from .robot_view import node_name
+
+__all__ = ["MARKER_SIZE_M", "MarkerLayer", "marker_mesh"]
+
+MARKER_SIZE_M = 0.03
+
+
+def marker_mesh(shape: str, size: float = MARKER_SIZE_M) -> trimesh.Trimesh:
+    """The mesh of one marker of ``shape`` (``commands.MARKER_SHAPES``), centred.
+
+    A sphere of diameter ``size``, a cube of edge ``size``, a cylinder of
+    height ``size`` along z, an arrow of length 1.7 ``size`` along x (as RViz).
+    """
+    if shape == "cube":
+        return trimesh.creation.box(extents=(size, size, size))
+    if shape == "cylinder":
+        return trimesh.creation.cylinder(radius=size / 3, height=size, sections=24)
+    if shape == "arrow":
+        head = size / 2
+        shaft_length = 1.7 * size - head
+        shaft = trimesh.creation.cylinder(radius=size / 8, height=shaft_length, sections=16)
+        shaft.apply_translation((0.0, 0.0, shaft_length / 2))
+        cone = trimesh.creation.cone(radius=size / 3, height=head, sections=16)
+        cone.apply_translation((0.0, 0.0, shaft_length))
+        arrow = trimesh.util.concatenate([shaft, cone])
+        assert isinstance(arrow, trimesh.Trimesh)
+        arrow.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (0, 1, 0)))
+        return arrow
+    return trimesh.creation.icosphere(subdivisions=2, radius=size / 2)
+
+
+class _Ring:
+    """One robot's newest ``MAX_MARKERS`` markers, as arrays (slot order, not age)."""
+
+    def __init__(self) -> None:
+        self.positions = np.zeros((MAX_MARKERS, 3), dtype=np.float32)
+        self.wxyzs = np.zeros((MAX_MARKERS, 4), dtype=np.float32)
+        self.colors = np.zeros((MAX_MARKERS, 3), dtype=np.uint8)
+        self.shapes = np.zeros(MAX_MARKERS, dtype=np.int8)
+        self.count = 0
+        self.next = 0
+        self.dirty = False
+
+
+class MarkerLayer:
+    """Every robot's markers, drawn as batched meshes; see the module docstring.
+
+    Attributes:
+        nodes: The batched-mesh node of each (robot, shape) drawn so far.
+    """
+
+    def __init__(self, server: viser.ViserServer, segments: dict[str, str]) -> None:
+        """Draw in ``server``'s scene; ``segments`` names each robot's node segment."""
+        self._scene = server.scene
+        self._segments = segments
+        self._rings: dict[str, _Ring] = {}
+        self._shape_index = {shape: k for k, shape in enumerate(MARKER_SHAPES)}
+        self._meshes = {shape: marker_mesh(shape) for shape in MARKER_SHAPES}
+        self.nodes: dict[tuple[str, str], Any] = {}
+        self.dirty = False
+
+    def add(self, robot: str, marker: Marker) -> None:
+        """One more marker of ``robot`` (past ``MAX_MARKERS`` its oldest goes)."""
+        ring = self._rings.get(robot)
+        if ring is None:
+            ring = self._rings[robot] = _Ring()
+        slot = ring.next
+        ring.positions[slot] = marker.position
+        ring.wxyzs[slot] = marker.wxyz
+        ring.colors[slot] = [round(c * 255.0) for c in marker.rgb]
+        ring.shapes[slot] = self._shape_index.get(marker.shape, 0)
+        ring.next = (slot + 1) % MAX_MARKERS
+        ring.count = min(ring.count + 1, MAX_MARKERS)
+        ring.dirty = self.dirty = True
+
+    def clear(self, robot: str) -> None:
+        """Every marker of ``robot`` is gone."""
+        ring = self._rings.get(robot)
+        if ring is not None and ring.count:
+            ring.count = ring.next = 0
+            ring.dirty = self.dirty = True
+
+    def count(self, robot: str | None = None) -> int:
+        """Markers held for ``robot`` (None: for every robot)."""
+        rings = self._rings.values() if robot is None else [self._rings.get(robot)]
+        return sum(ring.count for ring in rings if ring is not None)
+
+    def draw(self) -> None:
+        """Hand each changed robot's markers to its nodes (once per frame, in a send)."""
+        if not self.dirty:
+            return
+        self.dirty = False
+        for robot, ring in self._rings.items():
+            if not ring.dirty:
+                continue
+            ring.dirty = False
+            shapes = ring.shapes[: ring.count]
+            for shape, k in self._shape_index.items():
+                chosen = np.flatnonzero(shapes == k)
+                self._show(robot, shape, ring, chosen)
+
+    def _show(self, robot: str, shape: str, ring: _Ring, chosen: np.ndarray) -> None:
+        node = self.nodes.get((robot, shape))
+        if node is None and not len(chosen):
+            return
+        positions = ring.positions[chosen]
+        wxyzs = ring.wxyzs[chosen]
+        colors = ring.colors[chosen]
+        if node is None:
+            mesh = self._meshes[shape]
+            self.nodes[robot, shape] = self._scene.add_batched_meshes_simple(
+                f"/markers/{self._segments.get(robot) or node_name(robot)}/{shape}",
+                mesh.vertices,
+                mesh.faces,
+                batched_wxyzs=wxyzs,
+                batched_positions=positions,
+                batched_colors=colors,
+                lod="off",
+                cast_shadow=False,
+            )
+            return
+        node.batched_positions = positions
+        node.batched_wxyzs = wxyzs
+        node.batched_colors = colors
+        node.visible = bool(len(chosen))

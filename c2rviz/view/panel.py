@@ -1,0 +1,180 @@
+"""The page's side panel: a folder per robot, and the program's state below them.
+
+Each robot's folder (headed by its name in the world) holds a slider per
+joint (degrees, metres for a prismatic joint), a speed slider for the page's
+own moves, Home / Random / Stop buttons, the end effector's pose and the
+motion status. The ``State`` folder shows the TCP client count and the last
+commands, newest first, a refused one marked so; a checkbox shows the
+collision geometry.
+
+Controls only show values here: what the page does with them is
+``page_input``'s. Values go out with ``adapter.set_gui_value`` (no callbacks,
+only on change); ``force`` sends the true value back to a tab that shows
+another one (a refused page value).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Sequence
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+import viser
+
+from ..world import RobotState
+from . import adapter
+
+__all__ = ["MAX_LABEL_CHARS", "RECENT_COMMANDS", "RobotPanel", "StatePanel", "short_label"]
+
+RECENT_COMMANDS = 8  # lines kept for the 'last commands' readout
+SHOWN_LINE_CHARS = 80
+MAX_LABEL_CHARS = 13  # what fits on one line beside a slider in a folder
+REJECTED = "  [rejected]"
+_AFFIXES = ("_joint", "joint_", "_jnt")
+
+
+def short_label(name: str, limit: int = MAX_LABEL_CHARS) -> str:
+    """``name`` short enough for one line of a slider label (the hint keeps it whole)."""
+    if len(name) <= limit:
+        return name
+    for affix in _AFFIXES:
+        name = name.removesuffix(affix) if affix.startswith("_") else name.removeprefix(affix)
+    return name if len(name) <= limit else name[: limit - 1] + "…"
+
+
+class RobotPanel:
+    """One robot's folder; see the module docstring.
+
+    Attributes:
+        name: The robot's name in the world (the folder's heading).
+        sliders: A slider per joint of the chain, in chain order.
+        speed: The page's speed slider [% of the limits].
+        buttons: ``home``, ``rand`` and ``stop``, by the line each runs.
+        pose: The end-effector readout (in the base frame).
+        motion: ``idle`` or ``moving, 1.20 s left``.
+    """
+
+    def __init__(self, gui: viser.GuiApi, state: RobotState, speed: float) -> None:
+        robot = state.robot
+        self.name = state.name
+        self.robot = robot
+        self.ranges: list[tuple[float, float]] = []
+        self.sliders: list[Any] = []
+        with gui.add_folder(state.name):
+            for i, joint in enumerate(robot.joints):
+                if joint.prismatic:
+                    low, high, step, unit = joint.lower, joint.upper, 0.001, "m"
+                elif joint.continuous:
+                    low, high, step, unit = -180.0, 180.0, 0.1, "deg"
+                else:
+                    low, high = math.degrees(joint.lower), math.degrees(joint.upper)
+                    step, unit = 0.1, "deg"
+                # Round the ends inward to a step: "-180.000421" reads badly, and the
+                # slider cannot pass a limit (values shown are clamped to the ends).
+                low = round(math.ceil(low / step - 1e-9) * step, 6)
+                high = round(math.floor(high / step + 1e-9) * step, 6)
+                self.ranges.append((low, high))
+                self.sliders.append(
+                    gui.add_slider(
+                        short_label(joint.name),
+                        min=low,
+                        max=high,
+                        step=step,
+                        initial_value=self.to_slider(i, state.target[i]),
+                        hint=f"joint {i}: {joint.name} [{unit}]",
+                    )
+                )
+            self.speed: Any = gui.add_slider(
+                "Speed %",
+                min=1.0,
+                max=100.0,
+                step=1.0,
+                initial_value=speed,
+                hint="speed of the page's own moves, % of the joints' limits",
+            )
+            self.buttons = {
+                "home": gui.add_button("Home", hint="all joints to zero (home)"),
+                "rand": gui.add_button("Random", hint="every joint to a random value"),
+                "stop": gui.add_button("Stop", hint="stop the arm where it is"),
+            }
+            # Typed Any: mypy reads viser's GuiTextHandle.value as read-only, though it is not.
+            self.pose: Any = gui.add_text(
+                "End effector",
+                "",
+                multiline=True,
+                disabled=True,
+                hint=f"{robot.eelink} in the {robot.base} frame",
+            )
+            self.motion: Any = gui.add_text("Motion", "idle", disabled=True)
+
+    def to_slider(self, index: int, value: float) -> float:
+        """Joint value [rad or m] in slider units (deg or m), within the slider's range."""
+        joint = self.robot.joints[index]
+        shown = float(value) if joint.prismatic else math.degrees(value)
+        if joint.continuous:
+            shown = (shown + 180.0) % 360.0 - 180.0
+        if index < len(self.ranges):
+            low, high = self.ranges[index]
+            shown = min(max(shown, low), high)
+        return round(shown, 6)  # 30, not 29.999999999999996 (which the page shows as "30.0")
+
+    def show_joints(self, target: Sequence[float], busy: Callable[[Any], bool]) -> None:
+        """Every slider to the commanded value, but those the page is moving (``busy``)."""
+        for i, (slider, value) in enumerate(zip(self.sliders, target)):
+            if not busy(slider):
+                adapter.set_gui_value(slider, self.to_slider(i, value))
+
+    def answer(self, index: int, sent: float, value: float, client: int, force: bool) -> None:
+        """After the page set slider ``index`` to ``sent``: show the true ``value`` [rad or
+        m] on every tab; the tab that sent it is skipped if it already shows it."""
+        shown = self.to_slider(index, value)
+        if shown == sent and not force:
+            adapter.set_gui_value(self.sliders[index], shown, exclude_client=client)
+        else:
+            adapter.set_gui_value(self.sliders[index], shown, force=True)
+
+    def show_pose(self, ee: pin.SE3) -> None:
+        """The end effector's placement in the base frame, in mm-rounded metres and degrees."""
+        # round() then + 0.0: no "-0.0" in the readout
+        x, y, z = (round(float(v), 3) + 0.0 for v in ee.translation)
+        roll, pitch, yaw = (
+            round(float(v), 1) + 0.0 for v in np.degrees(pin.rpy.matrixToRpy(ee.rotation))
+        )
+        self.pose.value = (
+            f"x {x:+.3f}  y {y:+.3f}  z {z:+.3f} m\nR {roll:+.1f}  P {pitch:+.1f}  Y {yaw:+.1f} deg"
+        )
+
+    def show_motion(self, moving: bool, seconds_left: float) -> None:
+        self.motion.value = f"moving, {seconds_left:.1f} s left" if moving else "idle"
+
+
+class StatePanel:
+    """The program's state: TCP clients, last commands, the collision checkbox."""
+
+    def __init__(self, gui: viser.GuiApi) -> None:
+        self.collision: Any = gui.add_checkbox(
+            "Collision", False, hint="show each link's collision geometry"
+        )
+        with gui.add_folder("State"):
+            self.clients: Any = gui.add_text("TCP clients", "0", disabled=True)
+            self.recent: Any = gui.add_text(
+                "Last commands",
+                "",
+                multiline=True,
+                disabled=True,
+                hint=f"the last {RECENT_COMMANDS}, newest first",
+            )
+
+    def show(self, clients: int, commands: Iterable[tuple[str, bool]]) -> None:
+        """``clients`` TCP clients; ``commands`` (line, accepted), newest first."""
+        self.clients.value = str(clients)
+        self.recent.value = "\n".join(
+            _shown(line) + ("" if accepted else REJECTED) for line, accepted in commands
+        )
+
+
+def _shown(line: str) -> str:
+    line = line.replace("\r", " ").replace("\t", " ").replace("\n", " ")
+    return line if len(line) <= SHOWN_LINE_CHARS else line[: SHOWN_LINE_CHARS - 3] + "..."

@@ -1,0 +1,209 @@
+"""One robot drawn in the page: a root node at its place in the world, a frame per link.
+
+Like viser's ``ViserUrdf``, a ``RobotView`` is one object per robot, under a
+root node of its own (``/robots/<name>``) placed at the robot's origin in the
+world frame, so a cell of several robots, the same model twice included,
+draws in one scene. Below the root, each link's frame is posed by Pinocchio
+forward kinematics on the view's own ``Data`` (Pinocchio is the one source of
+kinematic truth): a link's pose in the world is ``origin * oMf``. Each link's
+URDF geometry hangs below its frame at its URDF origin.
+
+While the robot travels, a translucent copy of the arm (the target ghost,
+``/robots/<name>/target``) stands where the move ends.
+"""
+
+from __future__ import annotations
+
+import re
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+import trimesh
+import viser
+
+from ..robot import Robot
+from ..visuals import LinkGeometry, Shape
+from . import adapter
+
+__all__ = ["GHOST_OPACITY", "RobotView", "node_name", "wxyz"]
+
+GHOST_OPACITY = 0.3
+GHOST_GREY = (0.7, 0.7, 0.72)  # for a mesh that brings colours of its own
+
+
+def wxyz(rotation: np.ndarray) -> np.ndarray:
+    """A rotation matrix as a unit quaternion (w, x, y, z)."""
+    x, y, z, w = pin.Quaternion(rotation).coeffs()
+    return np.array([w, x, y, z])
+
+
+def node_name(text: str) -> str:
+    """``text`` as one segment of a viser node name."""
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", text) or "_"
+
+
+class RobotView:
+    """One robot's nodes in the scene; see the module docstring.
+
+    Attributes:
+        name: The robot's name in the world.
+        robot: Its model and chain.
+        root: The root node, at the robot's origin in the world frame.
+        link_frames: Each link's frame node (Pinocchio body frame), by link name,
+            posed in the root's frame.
+        target_frames: The ghost's link frames, by link name.
+        collision_nodes: The collision geometry (hidden until asked for).
+        sent_q: The chain values [rad or m] drawn last.
+        sent_target: The target [rad or m] the ghost shows (None: hidden).
+    """
+
+    def __init__(
+        self,
+        server: viser.ViserServer,
+        name: str,
+        robot: Robot,
+        origin: pin.SE3,
+        geometry: dict[str, LinkGeometry],
+        segment: str,
+    ) -> None:
+        """Add the robot's nodes under ``/robots/<segment>``.
+
+        Args:
+            server: The viser server.
+            name: The robot's name in the world.
+            robot: Its model and chain.
+            origin: Where its model's root stands in the world frame.
+            geometry: Its links' shapes (``visuals.load_link_geometry``).
+            segment: Its node name segment (unique in the scene).
+        """
+        self.name = name
+        self.robot = robot
+        self.origin = origin
+        self._data = robot.model.createData()  # the world's robot.data is not ours
+        self._scene = server.scene
+        self.prefix = f"/robots/{segment}"
+        self.root = self._scene.add_frame(
+            self.prefix, show_axes=False, position=origin.translation, wxyz=wxyz(origin.rotation)
+        )
+        base = robot.base_placement
+        self._scene.add_frame(
+            f"{self.prefix}/base",
+            axes_length=0.25,
+            axes_radius=0.008,
+            position=base.translation,
+            wxyz=wxyz(base.rotation),
+        )
+        self.collision_nodes: list[Any] = []
+        self.link_frames: dict[str, Any] = {}
+        self.target_frames: dict[str, Any] = {}
+        self._frames: list[tuple[int, Any]] = []
+        self._target_frames: list[tuple[int, Any]] = []
+        self.target_root: Any = None  # the ghost is built at the first move
+        self._geometry = geometry
+        for link in robot.link_names():
+            frame_id = robot.model.getFrameId(link, pin.BODY)
+            shapes = geometry.get(link)
+            node = f"{self.prefix}/links/{node_name(link)}"
+            handle = self._scene.add_frame(node, show_axes=False)
+            self._frames.append((frame_id, handle))
+            self.link_frames[link] = handle
+            if shapes is None:
+                continue
+            for k, shape in enumerate(shapes.visual):
+                self._add_shape(f"{node}/visual_{k}", shape, visible=True)
+            for k, shape in enumerate(shapes.collision):
+                self.collision_nodes.append(
+                    self._add_shape(f"{node}/collision_{k}", shape, visible=False)
+                )
+        self._scene.add_frame(
+            f"{self.prefix}/links/{node_name(robot.eelink)}/ee", axes_length=0.12, axes_radius=0.005
+        )
+        self.sent_q: tuple[float, ...] | None = None
+        self.sent_target: tuple[float, ...] | None = None
+
+    def draw(self, q: tuple[float, ...]) -> pin.SE3:
+        """Pose every link frame for chain values ``q`` [rad or m].
+
+        Returns:
+            The end effector's placement in the base frame.
+        """
+        data = self._data
+        self._pose(self._frames, q)
+        self.sent_q = q
+        return self.robot.base_placement.actInv(data.oMf[self.robot.ee_frame])
+
+    def show_target(self, target: tuple[float, ...] | None) -> None:
+        """Stand the ghost at ``target`` [rad or m]; None hides it."""
+        if target == self.sent_target:
+            return
+        if target is None:
+            self.target_root.visible = False
+        else:
+            if self.target_root is None:
+                self._build_ghost()
+            self._pose(self._target_frames, target)
+            if self.sent_target is None:
+                self.target_root.visible = True
+        self.sent_target = target
+
+    def _build_ghost(self) -> None:
+        """The ghost's nodes: each link's visual geometry again, translucent."""
+        self.target_root = self._scene.add_frame(
+            f"{self.prefix}/target", show_axes=False, visible=False
+        )
+        for link in self.robot.link_names():
+            node = f"{self.prefix}/target/{node_name(link)}"
+            handle = self._scene.add_frame(node, show_axes=False)
+            self._target_frames.append((self.robot.model.getFrameId(link, pin.BODY), handle))
+            self.target_frames[link] = handle
+            shapes = self._geometry.get(link)
+            for k, shape in enumerate(shapes.visual if shapes is not None else ()):
+                self._add_shape(f"{node}/visual_{k}", shape, visible=True, ghost=True)
+
+    def show_collision(self, shown: bool) -> None:
+        for node in self.collision_nodes:
+            node.visible = shown
+
+    def reach(self) -> float:
+        """The farthest frame from the root at the neutral pose [m] (for the camera)."""
+        pin.framesForwardKinematics(self.robot.model, self._data, self.robot.neutral)
+        return max((float(np.linalg.norm(f.translation)) for f in self._data.oMf), default=1.0)
+
+    def _pose(self, frames: list[tuple[int, Any]], q: tuple[float, ...]) -> None:
+        model, data = self.robot.model, self._data
+        pin.forwardKinematics(model, data, self.robot.configuration(q))
+        pin.updateFramePlacements(model, data)
+        for frame_id, handle in frames:
+            placement = data.oMf[frame_id]
+            adapter.queue_pose(handle, placement.translation, wxyz(placement.rotation))
+
+    def _add_shape(self, name: str, shape: Shape, visible: bool, ghost: bool = False) -> Any:
+        scene = self._scene
+        common: dict[str, Any] = {
+            "position": shape.origin[:3, 3],
+            "wxyz": wxyz(shape.origin[:3, :3]),
+            "visible": visible,
+        }
+        if shape.rgba is None:  # a mesh with colours of its own
+            assert shape.mesh is not None
+            if not ghost:
+                return scene.add_mesh_trimesh(name, shape.mesh, **common)
+            rgb, alpha = GHOST_GREY, 1.0
+        else:
+            rgb, alpha = shape.rgba[:3], shape.rgba[3]
+        if ghost:
+            alpha = min(alpha, 1.0) * GHOST_OPACITY
+            common["cast_shadow"] = False
+        common["opacity"] = None if alpha >= 1.0 else alpha
+        if shape.kind == "box":
+            sx, sy, sz = shape.size
+            return scene.add_box(name, color=rgb, dimensions=(sx, sy, sz), **common)
+        if shape.kind == "cylinder":
+            radius, length = shape.size
+            return scene.add_cylinder(name, radius=radius, height=length, color=rgb, **common)
+        if shape.kind == "sphere":
+            return scene.add_icosphere(name, radius=shape.size[0], color=rgb, **common)
+        mesh = shape.mesh
+        assert isinstance(mesh, trimesh.Trimesh)
+        return scene.add_mesh_simple(name, mesh.vertices, mesh.faces, color=rgb, **common)

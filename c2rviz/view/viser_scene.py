@@ -1,0 +1,256 @@
+"""The browser view: every robot of the world, their markers and a side panel, in viser.
+
+``ViserScene`` implements ``scene.Scene`` by composing the parts of the page,
+each in its own module: a ``RobotView`` per robot (``robot_view``), the
+``MarkerLayer`` (``markers``), the panel (``panel``), the page's input
+(``page_input``) and the ``SendScheduler`` (``scheduler``). viser runs behind
+the door of ``adapter`` (origins, token, client and frame limits; all use of
+viser's internals is there).
+
+The world calls the scene on every accepted change, possibly hundreds of
+thousands of times a second; each call only records what changed and asks
+for a send. A send, at most one per frame (``1/hz``), draws the latest state:
+each changed robot's links (Pinocchio FK), its target ghost while it moves,
+its panel, the markers, in one atomic batch.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import socket
+from collections import deque
+from collections.abc import Sequence
+
+import numpy as np
+
+from ..scene import Marker, Scene
+from ..session import Session
+from ..visuals import LinkGeometry, load_link_geometry
+from ..world import World
+from . import adapter
+from .markers import MarkerLayer
+from .page_input import PageInput
+from .panel import RECENT_COMMANDS, RobotPanel, StatePanel
+from .policy import DoorPolicy
+from .robot_view import RobotView, node_name
+from .scheduler import SendScheduler
+
+__all__ = ["RECENT_COMMANDS", "STOP_TIMEOUT_S", "ViserScene"]
+
+log = logging.getLogger("c2rviz.view")
+
+STOP_TIMEOUT_S = 0.5  # longest wait for viser to stop [s]; it goes on stopping after
+
+
+class ViserScene(Scene):
+    """The viser implementation of ``scene.Scene``; see the module docstring.
+
+    Attributes:
+        world: The world shown.
+        url: Where the page is served (with the token, if one is needed).
+        port: The port actually bound.
+        title: The page's title and panel label, ``c2rviz — <name>``.
+        server: The viser server.
+        views: A ``RobotView`` per robot, by the robot's name in the world.
+        panels: A ``RobotPanel`` per robot, by name.
+        sessions: The page's ``Session`` per robot, by name (source ``page``).
+        markers: Every robot's markers.
+        state_panel: TCP clients, last commands, the collision checkbox.
+        page_input: What the page's controls run.
+        scheduler: When sends go out.
+    """
+
+    def __init__(
+        self,
+        world: World,
+        host: str,
+        port: int,
+        hz: float,
+        *,
+        policy: DoorPolicy | None = None,
+        title: str | None = None,
+    ) -> None:
+        """Start the viser server on ``host:port`` (0 picks a free port) and draw ``world``.
+
+        Args:
+            world: The world to show (all of its robots).
+            host: Address to serve the page on.
+            port: TCP port; when it is busy viser takes the next free one.
+            hz: Most sends per second [1/s].
+            policy: Who may open the page and what it may send.
+            title: The cell's or robot's name (default: the robots' names).
+
+        Raises:
+            OSError: ``host`` cannot be listened on.
+            adapter.ViserInternalsError: the installed viser lacks what the adapter uses.
+        """
+        _check_host(host)
+        self.world = world
+        self.policy = policy if policy is not None else DoorPolicy()
+        self.title = f"c2rviz — {title or ', '.join(world.robots)}"
+        self.server = adapter.start(host, port, label=self.title, policy=self.policy)
+        adapter.door(self.server).page_title = self.title
+        self.port = self.server.get_port()
+        if port not in (0, self.port):
+            log.warning("viewer port %d is busy; serving on %d instead", port, self.port)
+        shown_host = "localhost" if host in ("0.0.0.0", "::", "") else host
+        shown_host = f"[{shown_host}]" if ":" in shown_host else shown_host
+        self.url = self.policy.page_url(f"http://{shown_host}:{self.port}")
+        self._stopped = False
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._dirty: set[str] = set(world.robots)
+        self._commands: deque[tuple[str, bool]] = deque(maxlen=RECENT_COMMANDS)  # newest first
+        self._client_count = world.client_count
+        self._state_dirty = True
+        self.scheduler = SendScheduler(1.0 / hz, self._send)
+        self._build()
+
+    def _build(self) -> None:
+        server, world = self.server, self.world
+        server.gui.configure_theme(show_share_button=False, control_width="medium")
+        server.scene.add_grid("/grid", width=4.0, height=4.0, cell_size=0.25, section_size=1.0)
+        geometry: dict[int, dict[str, LinkGeometry]] = {}
+        segments: dict[str, str] = {}
+        self.views: dict[str, RobotView] = {}
+        for name, state in world.robots.items():
+            segment = node_name(name)
+            while segment in segments.values():  # "a b" and "a_b" draw apart
+                segment += "_"
+            segments[name] = segment
+            shapes = geometry.setdefault(id(state.robot), load_link_geometry(state.robot.source))
+            self.views[name] = RobotView(server, name, state.robot, state.origin, shapes, segment)
+        self.markers = MarkerLayer(server, segments)
+        self._frame_camera()
+        self.page_input = PageInput(server)
+        self.panels: dict[str, RobotPanel] = {}
+        self.sessions: dict[str, Session] = {}
+        for name, state in world.robots.items():
+            session = Session(world, source="page", robot=name)
+            session.set_degrees(True)
+            session.motion = "off" if world.defaults.motion == "off" else "follow"
+            self.sessions[name] = session
+            self.panels[name] = RobotPanel(server.gui, state, session.speed)
+            self.page_input.add_robot(self.panels[name], session)
+        self.state_panel = StatePanel(server.gui)
+        self.page_input.add_toggle(self.state_panel.collision, self._show_collision)
+        for name, state in world.robots.items():
+            for marker in state.markers:
+                self.markers.add(name, marker)
+        self._send()
+
+    def _frame_camera(self) -> None:
+        """Aim new tabs' camera at the robots from the front right, a little above."""
+        centre = np.mean([v.origin.translation for v in self.views.values()], axis=0)
+        reach = max(
+            float(np.linalg.norm(v.origin.translation - centre)) + v.reach()
+            for v in self.views.values()
+        )
+        reach = max(reach, 0.5)
+        look_at = centre + np.array([0.0, 0.0, 0.4 * reach])
+        self.server.initial_camera.look_at = look_at
+        self.server.initial_camera.position = look_at + reach * np.array([1.15, 0.9, 0.45])
+
+    # the Observer protocol (asyncio thread, returns at once)
+
+    def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
+        self._dirty.add(robot)
+        self.scheduler.request()
+
+    def on_marker(self, robot: str, marker: Marker) -> None:
+        self.markers.add(robot, marker)
+        self.scheduler.request()
+
+    def on_clear_markers(self, robot: str) -> None:
+        self.markers.clear(robot)
+        self.scheduler.request()
+
+    def on_clients(self, count: int) -> None:
+        self._client_count = count
+        self._state_dirty = True
+        self.scheduler.request()
+
+    def on_command(self, source: str, line: str, accepted: bool) -> None:
+        self._commands.appendleft((line, accepted))
+        self._state_dirty = True
+        self.scheduler.request()
+
+    # lifecycle
+
+    def start(self, world: World, loop: asyncio.AbstractEventLoop) -> None:
+        """Show ``world`` (the one given at construction); page input runs on ``loop``."""
+        if world is not self.world:
+            raise ValueError("a ViserScene shows the world it was made with")
+        self._loop = loop
+        self.page_input.start(loop)
+        self._dirty.update(world.robots)
+        self.scheduler.start(loop)
+
+    def stop(self) -> None:
+        """Stop the server and free its port, within ``STOP_TIMEOUT_S``; later calls do nothing."""
+        if self._stopped:
+            return
+        self._stopped = True
+        self.scheduler.stop()
+        self.page_input.stop()
+        adapter.stop(self.server, timeout_s=STOP_TIMEOUT_S)
+
+    # what tests and benchmarks read
+
+    @property
+    def sends(self) -> int:
+        """Sends so far (a send draws the latest state)."""
+        return self.scheduler.sends
+
+    @property
+    def sent_q(self) -> tuple[float, ...] | None:
+        """The default robot's chain values [rad or m] at the latest send."""
+        return self.views[self.world.default].sent_q
+
+    @property
+    def link_frames(self) -> dict[str, object]:
+        """The default robot's link frames, by link name (posed in its root's frame)."""
+        return self.views[self.world.default].link_frames
+
+    @property
+    def marker_count(self) -> int:
+        """Markers held for every robot (drawn at the next send)."""
+        return self.markers.count()
+
+    # sending
+
+    def _send(self) -> None:
+        """Draw whatever changed since the last send, in one atomic batch."""
+        if self._stopped:
+            return
+        world, busy = self.world, self.page_input.busy
+        with self.server.atomic():
+            for name in self._dirty:
+                state = world.robots.get(name)
+                if state is None:
+                    continue
+                view, panel = self.views[name], self.panels[name]
+                panel.show_pose(view.draw(state.q))
+                moving = state.travel.active
+                view.show_target(state.target if moving else None)
+                panel.show_joints(state.target, busy)
+                panel.show_motion(moving, world.travels.seconds_left(state))
+            self._dirty.clear()
+            self.markers.draw()
+            if self._state_dirty:
+                self._state_dirty = False
+                self.state_panel.show(self._client_count, self._commands)
+        self.server.flush()
+
+    def _show_collision(self, shown: bool) -> None:
+        for view in self.views.values():
+            view.show_collision(shown)
+        self.server.flush()
+
+
+def _check_host(host: str) -> None:
+    """Raise OSError now if ``host`` cannot be bound (viser would wait forever)."""
+    for family, kind, proto, _, address in socket.getaddrinfo(host, 0, type=socket.SOCK_STREAM):
+        with socket.socket(family, kind, proto) as probe:
+            probe.bind(address)
+        return
