@@ -354,6 +354,7 @@ def test_a_flood_from_one_client_leaves_a_bystander_right_and_in_order(flood: st
             lambda: tab.values(slider)[-1:] == [pytest.approx(np.degrees(final[6]))],
             "the page to show the bystander's last pose",
         )
+        answers.close()
         bystander.close()
         flooder.close()
     finally:
@@ -440,6 +441,7 @@ def test_a_viewer_beyond_loopback_gets_a_token_and_says_so(c2rviz_process: Any) 
     port = int(proc.viewer_url.split("/?")[0].rsplit(":", 1)[1])
     with pytest.raises(urllib.error.HTTPError) as refused:
         urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=10)
+    refused.value.close()
     assert refused.value.code == 403
     with pytest.raises(InvalidStatus):
         Tab(f"http://127.0.0.1:{port}/")

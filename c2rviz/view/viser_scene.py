@@ -104,7 +104,11 @@ class ViserScene(Scene):
         self._client_count = world.client_count
         self._state_dirty = True
         self.scheduler = SendScheduler(1.0 / hz, self._send)
-        self._build()
+        try:
+            self._build()
+        except BaseException:
+            adapter.stop(self.server, timeout_s=STOP_TIMEOUT_S)
+            raise
 
     def _build(self) -> None:
         server, world = self.server, self.world
@@ -118,7 +122,9 @@ class ViserScene(Scene):
             while segment in segments.values():  # "a b" and "a_b" draw apart
                 segment += "_"
             segments[name] = segment
-            shapes = geometry.setdefault(id(state.robot), load_link_geometry(state.robot.source))
+            if id(state.robot) not in geometry:  # the same model twice is read once
+                geometry[id(state.robot)] = load_link_geometry(state.robot.source)
+            shapes = geometry[id(state.robot)]
             self.views[name] = RobotView(server, name, state.robot, state.origin, shapes, segment)
         self.markers = MarkerLayer(server, segments)
         self._frame_camera()
