@@ -39,7 +39,8 @@ from .client import (
 from .commands import USAGE, Joints, Sleep, parse_line
 from .errors import BadArguments, C2rvizError, JointCountError, JointLimitError
 from .lang.record import Watch
-from .player import Progress, check_robot, load_script, play, robot_mismatch
+from .player import Progress, play
+from .script import check_robot, load_script, robot_mismatch
 from .tolerance import within_limit
 
 __all__ = ["LOCAL_USAGE", "Repl", "build_parser", "main", "watch_lines"]
