@@ -13,7 +13,10 @@ module plays.
 
 ``sleep S`` lines are sent to the server as ``sleep S/speed``: the server
 holds that connection's later lines until the pause is over and then replies
-``ok``, so timing stays right even when lines are pipelined.
+``ok``, so timing stays right even when lines are pipelined. Moves with
+``motion on`` (from ``--motion on`` or the file's own line) are answered on
+arrival, and the lines behind them wait the same way; on a terminal the
+progress line says ``-> moving`` meanwhile.
 
 Exit status: 0 every line got ``ok``; 1 a line got an error, or the server
 could not be reached or went away; 2 the file or the options are wrong
@@ -23,7 +26,6 @@ could not be reached or went away; 2 the file or the options are wrong
 from __future__ import annotations
 
 import argparse
-import shutil
 import sys
 import time
 from collections.abc import Sequence
@@ -39,7 +41,17 @@ from .client import (
 )
 from .commands import Bye, Quit, Sleep
 from .errors import C2rvizError
-from .script import Script, ScriptLine, check_robot, load_script, robot_mismatch
+from .lang.motion import MOTION_MODES, MotionMode
+from .progress import Progress
+from .script import (
+    Script,
+    ScriptLine,
+    check_robot,
+    load_script,
+    motion_after,
+    robot_mismatch,
+    waits_for_the_arm,
+)
 
 __all__ = [
     "Progress",
@@ -51,45 +63,8 @@ __all__ = [
     "main",
     "play",
     "robot_mismatch",
+    "waits_for_the_arm",
 ]
-
-
-class Progress:
-    """Shows each played line and its reply.
-
-    On a terminal (``in_place``) one status line is rewritten in place; replies
-    that carry data and every error stay on screen. Otherwise one plain line
-    per command.
-    """
-
-    def __init__(self, out: TextIO, err: TextIO, in_place: bool | None = None) -> None:
-        self.out = out
-        self.err = err
-        self.in_place = out.isatty() if in_place is None else in_place
-        self._dirty = False
-
-    def step(self, label: str, text: str, reply: str) -> None:
-        message = f"{label} {text} -> {reply}"
-        if not self.in_place:
-            print(message, file=self.out, flush=True)
-            return
-        keep = reply not in ("ok", "ok bye") and not reply.startswith("error")
-        width = shutil.get_terminal_size().columns - 1
-        shown = message if keep or len(message) <= width else message[: width - 3] + "..."
-        self.out.write("\r\x1b[K" + shown + ("\n" if keep else ""))
-        self.out.flush()
-        self._dirty = not keep
-
-    def error(self, message: str) -> None:
-        self.end_line()
-        print(message, file=self.err, flush=True)
-
-    def end_line(self) -> None:
-        """Finish the in-place line so the next output starts on its own line."""
-        if self._dirty:
-            self.out.write("\n")
-            self.out.flush()
-            self._dirty = False
 
 
 def _wire(line: ScriptLine, speed: float) -> str:
@@ -107,6 +82,7 @@ def play(
     keep_going: bool = False,
     window: int = 1,
     prefix: str = "",
+    motion: str | None = None,
 ) -> int:
     """Send every line of ``script`` and show its reply; return how many got an error.
 
@@ -119,6 +95,9 @@ def play(
         window: Lines sent ahead of their replies (1: wait for each reply).
             After an error, lines already sent have run; their replies are shown.
         prefix: Put before each ``k/n`` label (the loop number).
+        motion: The connection's motion mode as the play starts (None: unknown,
+            taken as ``off``); the file's own ``motion`` lines change it. While a
+            line waits for the arm, ``show`` says so (``-> moving``).
 
     Raises:
         ConnectionLost: the server went away (already reported through ``show``).
@@ -129,15 +108,21 @@ def play(
     width = len(str(n))
     sent = done = errors = 0
     stop = n
+    mode = motion or "off"
     try:
         while done < stop:
             while sent < stop and sent - done < window:
                 client.send(_wire(lines[sent], speed))
                 sent += 1
-            reply = client.read_reply()
             line = lines[done]
+            label = f"[{prefix}{done + 1:>{width}}/{n}]"
+            if waits_for_the_arm(line.command, mode):
+                show.waiting(label, line.wire, "moving")
+            reply = client.read_reply()
             done += 1
-            show.step(f"[{prefix}{done:>{width}}/{n}]", line.wire, reply)
+            show.step(label, line.wire, reply)
+            if isinstance(line.command, MotionMode) and line.command.mode and reply == "ok":
+                mode = line.command.mode
             if not reply.startswith("ok"):
                 errors += 1
                 show.error(f"{script.name}:{line.number}: {reply}")
@@ -172,6 +157,12 @@ def build_parser() -> argparse.ArgumentParser:
         default=1.0,
         metavar="X",
         help="divide every sleep by X (default 1)",
+    )
+    add(
+        "--motion",
+        choices=MOTION_MODES,
+        help="send 'motion off|on|follow' before the first line: with 'on' each move's "
+        "reply comes when the arm arrives (default: the server's mode)",
     )
     add("--loop", type=int, default=1, metavar="N", help="play N times; 0: until Ctrl-C")
     add("--keep-going", action="store_true", help="go on after an error reply")
@@ -254,6 +245,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         problems = check_robot(script, client.robot or "?", names)
         if problems:
             return _fail(problems, f"{script.name} (robot {client.robot})", err)
+        motion = args.motion
+        if motion is not None:
+            reply = client.ask(f"motion {motion}")
+            if not reply.startswith("ok"):  # a server from before motion
+                return _fail([f"--motion {motion}: the server replied {reply!r}"], script.name, err)
+        elif show.in_place:
+            motion = client.motion()  # only to show "-> moving"; None: no motion there
         loop = 0
         while args.loop == 0 or loop < args.loop:
             loop += 1
@@ -266,7 +264,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                 keep_going=args.keep_going,
                 window=args.window,
                 prefix=prefix,
+                motion=motion,
             )
+            motion = motion_after(script, motion)
             played += 1
             if errors and not args.keep_going:
                 break

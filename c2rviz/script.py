@@ -4,7 +4,8 @@
 on line 40 is reported as ``file:40: error: ...`` while the robot is still where
 it was; ``check_robot`` then checks ``joints`` counts and ``move`` indices
 against the server's robot, and ``robot_mismatch`` compares the file's
-``# robot: NAME`` line with it. Pure: no sockets, nothing printed.
+``# robot: NAME`` line with it. ``waits_for_the_arm`` and ``motion_after`` say
+which lines are answered on arrival. Pure: no sockets, nothing printed.
 """
 
 from __future__ import annotations
@@ -14,10 +15,24 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .commands import Bye, Command, Joints, Move, Quit, parse_line
+from .commands import Bye, Clear, Command, Home, Joints, Move, Quit, Rand, parse_line
 from .errors import C2rvizError, JointCountError, JointIndexError
+from .lang.cartesian import MoveL, MoveTo
+from .lang.motion import MotionMode, Stop, Wait
 
-__all__ = ["Script", "ScriptLine", "check_robot", "load_script", "robot_mismatch"]
+__all__ = [
+    "Script",
+    "ScriptLine",
+    "check_robot",
+    "load_script",
+    "motion_after",
+    "robot_mismatch",
+    "waits_for_the_arm",
+]
+
+_MOVES = (Joints, Move, Home, Rand, Clear, MoveTo, MoveL)
+"""Commands whose reply comes on arrival with ``motion on``."""
+
 
 _ROBOT_HEADER = re.compile(r"#\s*robot:\s*([A-Za-z0-9_.-]+)\s*", re.IGNORECASE)
 
@@ -117,3 +132,18 @@ def robot_mismatch(script: Script, robot: str, joint_names: Sequence[str]) -> st
         f"{script.name} is written for robot {script.robot} (its '# robot:' line), "
         f"but the server runs {robot} ({len(joint_names)} joints)"
     )
+
+
+def waits_for_the_arm(command: Command, motion: str) -> bool:
+    """Whether ``command``'s reply waits for the arm, in motion mode ``motion``:
+    a move with ``motion on`` (the reply comes on arrival), ``wait`` and ``stop``
+    (at rest)."""
+    if isinstance(command, (Wait, Stop)):
+        return True
+    return motion == "on" and isinstance(command, _MOVES)
+
+
+def motion_after(script: Script, motion: str | None) -> str | None:
+    """The motion mode after a play of ``script`` that began in ``motion``."""
+    modes = [line.command.mode for line in script.lines if isinstance(line.command, MotionMode)]
+    return next((mode for mode in reversed(modes) if mode is not None), motion)
