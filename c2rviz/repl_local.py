@@ -16,11 +16,11 @@ from typing import TextIO
 
 from .client import Client, ConnectionLost, find_script
 from .commands import Joints, Sleep, parse_line
-from .errors import BadArguments, C2rvizError, JointCountError, JointLimitError
+from .errors import BadArguments, C2rvizError
+from .goto import step, target_problem, travel
 from .lang.record import Watch
 from .player import Progress, play
 from .script import check_robot, load_script, robot_mismatch
-from .tolerance import within_limit
 from .watch_client import watch_lines
 
 __all__ = ["DEFAULT_STEP_DEG", "LOCAL_USAGE", "LocalCommands"]
@@ -29,7 +29,11 @@ LOCAL_USAGE = {
     "file": ("file NAME [speed=X]", "play a command file (here, else commands/); X divides sleeps"),
     "sleep": ("sleep S", "wait S seconds here"),
     "where": ("where", "joint names and values, in this connection's units"),
-    "goto": ("goto v0,...,vn-1 [step=S] [rate=HZ]", "move there smoothly in small joints steps"),
+    "goto": (
+        "goto v0,...,vn-1 [step=S] [rate=HZ]",
+        "move there with the server's motion (ok on arrival; Ctrl-C stops the arm); "
+        "step=/rate=: only for a server without motion, which gets small joints steps",
+    ),
     "watch": ("watch [HZ]", "print the server's state and event lines until Ctrl-C"),
     "help": ("help", "this list"),
     "q": ("q", "leave (the server keeps running)"),
@@ -171,34 +175,37 @@ class LocalCommands:
         assert isinstance(command, Joints)
         target = list(command.values)
         client = self.client
-        n = len(client.joint_names())
-        if len(target) != n:
-            raise BadArguments("goto", str(JointCountError(n, len(target))), usage)
-        names = client.joint_names()
-        for i, (value, (lower, upper, unit)) in enumerate(zip(target, client.limits())):
-            if not within_limit(value, lower, upper):  # refuse before the first step
-                raise BadArguments(
-                    "goto", str(JointLimitError(names[i], i, value, lower, upper, unit)), usage
-                )
-        current = client.where()
+        problem = target_problem(client, target)  # refuse before anything moves
+        if problem is not None:
+            raise BadArguments("goto", problem, usage)
+        mode = client.motion()
+        if mode is None:  # a server from before motion: step there
+            return self._step(target, options)
+        arrival = travel(client, target, mode)
+        if arrival.interrupted:
+            self.show(f"goto: interrupted, the arm stopped: {arrival.reply}")
+        elif arrival.reply.startswith("ok"):
+            self.show(f"ok (goto: arrived in {arrival.seconds:.2f} s)")
+        else:
+            self.errors += 1
+            self.show(f"goto: {arrival.reply}")
+        if arrival.restored and not arrival.restored.startswith("ok"):
+            self.errors += 1
+            self.show(f"goto: putting back 'motion {mode}': {arrival.restored}")
+        return True
+
+    def _step(self, target: list[float], options: dict[str, float]) -> bool:
+        """``goto`` on a server without motion: ``joints`` lines a step apart."""
+        client = self.client
         default_step = DEFAULT_STEP_DEG if client.degrees else math.radians(DEFAULT_STEP_DEG)
-        step = options.get("step", self.step or default_step)
+        step_size = options.get("step", self.step or default_step)
         period_s = 1.0 / options.get("rate", self.rate_hz)
-        distance = max(abs(t - c) for t, c in zip(target, current))
-        steps = max(1, math.ceil(distance / step - 1e-9))
-        start = time.monotonic()
-        for k in range(1, steps + 1):
-            if k > 1:
-                time.sleep(max(0.0, start + (k - 1) * period_s - time.monotonic()))
-            values = (
-                target if k == steps else [c + (t - c) * k / steps for t, c in zip(target, current)]
-            )
-            reply = client.ask("joints " + ",".join(map(repr, values)))
-            if not reply.startswith("ok"):
-                self.errors += 1
-                self.show(f"goto: stopped at step {k}/{steps}: {reply}")
-                return True
-        self.show(f"ok (goto: {steps} steps in {time.monotonic() - start:.2f} s)")
+        stepped = step(client, client.where(), target, step_size, period_s)
+        if not stepped.reply.startswith("ok"):
+            self.errors += 1
+            self.show(f"goto: stopped at step {stepped.done + 1}/{stepped.steps}: {stepped.reply}")
+        else:
+            self.show(f"ok (goto: {stepped.steps} steps in {stepped.seconds:.2f} s)")
         return True
 
     def _watch(self, words: list[str]) -> bool:
