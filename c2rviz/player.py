@@ -19,8 +19,8 @@ arrival, and the lines behind them wait the same way; on a terminal the
 progress line says ``-> moving`` meanwhile.
 
 Exit status: 0 every line got ``ok``; 1 a line got an error, or the server
-could not be reached or went away; 2 the file or the options are wrong
-(nothing was sent); 130 interrupted.
+could not be reached or went away; 2 the file or the options are wrong, or
+the server refused ``--motion`` (nothing was sent); 130 interrupted.
 """
 
 from __future__ import annotations
@@ -144,7 +144,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Check a c2rviz command file with the server's parser, then play it: "
         "each line is sent, its reply shown; the first error stops the play.",
         epilog="Exit status: 0 all lines ok; 1 a line got an error or no server; "
-        "2 the file does not check (nothing was sent). FILE is looked for here, "
+        "2 the file or an option does not check, or the server refused --motion "
+        "(nothing was sent). FILE is looked for here, "
         "then in the project's commands/. A '# robot: NAME' line in the file's "
         "opening comments names the robot it is for.",
     )

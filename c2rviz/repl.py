@@ -173,9 +173,16 @@ def build_parser() -> argparse.ArgumentParser:
         "--step",
         type=float,
         metavar="S",
-        help="largest goto step, in the connection's units (default 2 degrees)",
+        help="largest goto step on a server without motion, in the connection's units "
+        "(default 2 degrees)",
     )
-    add("--rate", type=float, default=50.0, metavar="HZ", help="goto steps per second (50)")
+    add(
+        "--rate",
+        type=float,
+        default=50.0,
+        metavar="HZ",
+        help="goto steps per second on a server without motion (50)",
+    )
     add("--speed", type=float, default=1.0, metavar="X", help="file: divide sleeps by X (1)")
     add(
         "--watch",

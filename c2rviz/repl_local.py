@@ -4,7 +4,7 @@
 are answered here (some by asking the server); every other line is sent as
 typed by the loop in ``repl``. ``LocalCommands`` holds what they share: the
 connection, where output goes, the options, and the count of lines that got
-an ``error:``.
+an ``error:``. How ``goto`` moves (the server's motion, or steps) is ``goto``'s.
 """
 
 from __future__ import annotations
