@@ -1,26 +1,33 @@
 """The controller side of the wire, shared by the REPL and the player.
 
 A ``Client`` is one TCP connection to the command server: it connects with
-retries (the server may not be up yet, or may be restarting), sends one line
-and reads its one reply, and remembers the connection's unit mode so that it
-can be restored after a reconnect. It imports the parser and the settings
+retries (``dial``: the server may not be up yet, or may be restarting), sends
+one line and reads its one reply, and remembers the connection's unit mode and
+chosen robot so that they are restored after a reconnect. It imports the parser and the settings
 reader only: never Pinocchio or viser, so the clients start in a blink.
+Where the server is (flags, ini) and where command files are found is in
+``client_options``, re-exported here.
 """
 
 from __future__ import annotations
 
-import argparse
 import select
 import socket
-import time
 from collections import deque
 from collections.abc import Callable
-from pathlib import Path
-from typing import BinaryIO
 
+from .client_options import (
+    COMMANDS_DIR,
+    add_connection_args,
+    default_address,
+    find_script,
+    server_address,
+)
 from .commands import Units, Where, parse_line
-from .config import Settings, find_ini, load_settings
+from .dial import ServerUnavailable, dial
 from .errors import C2rvizError
+from .lang.cell import RobotChoice
+from .lang.motion import MOTION_MODES
 
 __all__ = [
     "COMMANDS_DIR",
@@ -30,28 +37,13 @@ __all__ = [
     "add_connection_args",
     "default_address",
     "find_script",
+    "motion_of",
     "server_address",
 ]
 
-COMMANDS_DIR = Path(__file__).resolve().parent.parent / "commands"
-"""The project's bundled command files."""
-
 _FIRST_DELAY_S = 0.05
+_UNKNOWN_COMMAND = "error: unknown command"
 _MAX_DELAY_S = 1.0
-
-
-class ServerUnavailable(C2rvizError):
-    """No server answered at ``host:port`` within the retry time."""
-
-    def __init__(self, host: str, port: int, waited_s: float, reason: str) -> None:
-        self.host = host
-        self.port = port
-        self.waited_s = waited_s
-        self.reason = reason
-        super().__init__(
-            f"no c2rviz server at {host}:{port} after {waited_s:.1f} s ({reason}); "
-            "start one with `c2rviz`, or give --host/--port"
-        )
 
 
 class ConnectionLost(C2rvizError):
@@ -63,79 +55,26 @@ class ConnectionLost(C2rvizError):
         super().__init__(f"connection to {host}:{port} lost (the server stopped or restarted)")
 
 
-def add_connection_args(parser: argparse.ArgumentParser) -> None:
-    """The flags every client shares: where the server is and how long to retry."""
-    add = parser.add_argument
-    add("--host", help="command server (default from cmdinterpreter.ini: 127.0.0.1)")
-    add("--port", type=int, help="command port (default from cmdinterpreter.ini: 31000)")
-    add("--config", metavar="PATH", help="ini file for host and port")
-    add(
-        "--timeout",
-        type=float,
-        default=10.0,
-        metavar="S",
-        help="keep retrying the connection for S seconds, then give up (default 10)",
-    )
-
-
-def default_address(config: str | Path | None = None) -> tuple[str, int]:
-    """Host and port from cmdinterpreter.ini (``[options] host/port``), else 127.0.0.1:31000.
-
-    An unspecified bind address (``0.0.0.0``, ``::``) in the ini means "this machine"
-    to a client, so it becomes the loopback address.
-
-    Raises:
-        ConfigError: ``config`` does not exist, or the ini has a bad value.
-    """
-    ini = find_ini(config)
-    settings = Settings()
-    if ini is not None:
-        # A client needs no robot: naming a URDF skips the robot-section lookup.
-        settings = load_settings(ini, {"urdf": ini})
-    host = settings.host
-    if host in ("", "0.0.0.0"):
-        host = "127.0.0.1"
-    elif host == "::":
-        host = "::1"
-    return host, settings.port
-
-
-def server_address(
-    host: str | None, port: int | None, config: str | Path | None = None
-) -> tuple[str, int]:
-    """Where to connect: ``--host``/``--port`` where given, the rest from the ini.
+def motion_of(reply: str) -> str | None:
+    """The connection's motion mode from the reply to a bare ``motion``.
 
     Args:
-        host: The ``--host`` flag (None: not given).
-        port: The ``--port`` flag (None: not given; 0 is a port).
-        config: The ``--config`` flag (None: the usual ini search).
+        reply: The server's reply: ``ok off|on|follow``, or an older server's
+            ``error: unknown command 'motion' ...``.
+
+    Returns:
+        ``off``, ``on`` or ``follow``; None when the server has no motion.
 
     Raises:
-        ConfigError: the ini is needed and ``config`` does not exist or has a bad value.
+        C2rvizError: any other reply.
     """
-    if host is not None and port is not None:
-        return host, port
-    ini_host, ini_port = default_address(config)
-    return host or ini_host, ini_port if port is None else port
-
-
-def find_script(name: str | Path) -> Path:
-    """A command file: ``name`` relative to the working directory, else in ``commands/``.
-
-    Raises:
-        FileNotFoundError: in neither place (the message names both).
-    """
-    path = Path(name)
-    if path.is_file():
-        return path
-    bundled = COMMANDS_DIR / path
-    if not path.is_absolute() and bundled.is_file():
-        return bundled
-    raise FileNotFoundError(f"no command file {str(name)!r} here or in {COMMANDS_DIR}")
-
-
-def _reason(exc: OSError) -> str:
-    return exc.strerror or str(exc) or type(exc).__name__
+    if reply.startswith("ok "):
+        mode = reply[3:].strip()
+        if mode in MOTION_MODES:
+            return mode
+    elif reply.startswith(_UNKNOWN_COMMAND):
+        return None
+    raise C2rvizError(f"unexpected reply to 'motion': {reply!r}")
 
 
 class Client:
@@ -145,11 +84,14 @@ class Client:
     matched to lines by order, so several lines may be sent before their
     replies are read (pipelining). An interrupted read or write leaves the
     stream out of step, so the connection is closed; the next ``send``
-    reconnects and restores the unit mode.
+    reconnects and restores the unit mode and the robot chosen.
 
     Attributes:
         degrees: The connection's angle unit as last confirmed by the server.
-        robot, joint_names: From ``names``, once ``joint_names()`` has asked.
+        chosen_robot: The robot a ``robot NAME`` line chose (the server said ``ok``);
+            None: the port's own robot.
+        robot, joint_names: From ``names``, once ``joint_names()`` has asked (asked
+            again after ``robot NAME``).
     """
 
     def __init__(
@@ -170,11 +112,12 @@ class Client:
         self.retry_s = retry_s
         self.notify = notify
         self.degrees = False
+        self.chosen_robot: str | None = None
         self.robot: str | None = None
         self._names: tuple[str, ...] | None = None
         self._sock: socket.socket | None = None
-        self._reader: BinaryIO | None = None
-        self._sent: deque[Units | None] = deque()  # one per reply still to read
+        self._received = bytearray()  # read from the socket, not yet a whole reply
+        self._sent: deque[Units | RobotChoice | None] = deque()  # one per reply to read
 
     @property
     def is_open(self) -> bool:
@@ -193,35 +136,15 @@ class Client:
         """
         if self._sock is not None:
             return
-        start = time.monotonic()
-        deadline = start + self.retry_s
-        delay = _FIRST_DELAY_S
-        told = False
-        while True:
-            try:
-                sock = socket.create_connection((self.host, self.port), timeout=5.0)
-                break
-            except socket.gaierror as exc:  # a bad host name does not get better
-                raise ServerUnavailable(self.host, self.port, 0.0, _reason(exc)) from None
-            except OSError as exc:
-                left = deadline - time.monotonic()
-                if left <= 0:
-                    waited = time.monotonic() - start
-                    raise ServerUnavailable(self.host, self.port, waited, _reason(exc)) from None
-                if not told and self.notify is not None:
-                    self.notify(
-                        f"no server at {self.host}:{self.port} yet ({_reason(exc)}); "
-                        f"retrying for up to {self.retry_s:g} s"
-                    )
-                    told = True
-                time.sleep(min(delay, left))
-                delay = min(delay * 2, _MAX_DELAY_S)
-        sock.settimeout(None)  # a reply may follow a long server-side sleep
-        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        sock = dial(self.host, self.port, self.retry_s, self.notify)
         self._sock = sock
-        self._reader = sock.makefile("rb")
+        self._received.clear()
         self._sent.clear()
         self._names = None
+        if self.chosen_robot is not None:
+            reply = self.ask(f"robot {self.chosen_robot}")
+            if not reply.startswith("ok"):  # the restarted server has no such robot
+                self.chosen_robot = None
         if self.degrees:
             reply = self.ask("degrees")
             if not reply.startswith("ok"):  # pragma: no cover - the server always accepts it
@@ -249,9 +172,7 @@ class Client:
         """Close the connection (a later ``send`` reconnects)."""
         sock, self._sock = self._sock, None
         self._sent.clear()
-        if self._reader is not None:
-            self._reader.close()
-            self._reader = None
+        self._received.clear()
         if sock is not None:
             sock.close()
 
@@ -278,32 +199,63 @@ class Client:
         except BaseException:  # interrupted mid-line: the stream is out of step
             self.close()
             raise
-        self._sent.append(command if isinstance(command, Units) else None)
+        self._sent.append(command if isinstance(command, (Units, RobotChoice)) else None)
         return True
 
-    def read_reply(self) -> str:
+    def read_reply(self, *, interruptible: bool = False) -> str:
         """The reply to the oldest unanswered line, without its newline.
+
+        Args:
+            interruptible: Ctrl-C while waiting leaves the connection open and the
+                reply still due (the caller reads it later, e.g. after sending
+                ``stop`` on another connection). By default the connection is
+                closed, since the reply would otherwise arrive late.
 
         Raises:
             ConnectionLost: the server closed the connection first.
         """
-        if not self._sent or self._reader is None:
+        if not self._sent or self._sock is None:
             raise RuntimeError("read_reply() with no line waiting for its reply")
         try:
-            raw = self._reader.readline()
+            raw = self._read_line()
         except OSError:
             raw = b""
-        except BaseException:  # Ctrl-C while waiting: the reply would arrive late
-            self.close()
+        except BaseException:  # Ctrl-C while waiting: what arrived stays in the buffer
+            if not interruptible:
+                self.close()
             raise
         if not raw.endswith(b"\n"):
             self.close()
             raise ConnectionLost(self.host, self.port)
-        units = self._sent.popleft()
+        tracked = self._sent.popleft()
         reply = raw.decode("utf-8", "replace").rstrip("\r\n")
-        if units is not None and reply.startswith("ok"):
-            self.degrees = units.degrees
+        if reply.startswith("ok"):
+            if isinstance(tracked, Units):
+                self.degrees = tracked.degrees
+            elif isinstance(tracked, RobotChoice) and tracked.name is not None:
+                self.chosen_robot = tracked.name
+                self._names = None  # another robot: other joints
         return reply
+
+    def _read_line(self) -> bytes:
+        """The next line from the server with its newline; at EOF what came (maybe b"").
+
+        An interrupted wait loses nothing: what has arrived stays in the buffer.
+        """
+        assert self._sock is not None
+        received = self._received
+        searched = 0
+        while (end := received.find(b"\n", searched)) < 0:
+            searched = len(received)
+            chunk = self._sock.recv(65536)
+            if not chunk:
+                line = bytes(received)
+                received.clear()
+                return line
+            received += chunk
+        line = bytes(received[: end + 1])
+        del received[: end + 1]
+        return line
 
     def ask(self, line: str) -> str:
         """Send ``line`` and return its reply (every earlier reply must have been read)."""
@@ -350,3 +302,12 @@ class Client:
         if not reply.startswith("ok "):
             raise C2rvizError(f"unexpected reply to 'where': {reply!r}")
         return [float(v) for v in reply[3:].split(",")]
+
+    def motion(self) -> str | None:
+        """The connection's motion mode (``off``, ``on``, ``follow``); None when the
+        server has no motion (it predates the ``motion`` verb).
+
+        Raises:
+            C2rvizError: the server answered ``motion`` with something else.
+        """
+        return motion_of(self.ask("motion"))

@@ -8,27 +8,27 @@ robot (``names``), again before the first line is sent; a file that declares
 its robot in its opening comments (a ``# robot: NAME`` line) and finds another
 one at the server is warned about, or refused with ``--strict``. Then every command
 line is sent and its reply shown; the first ``error:`` reply stops the play
-(unless ``--keep-going``).
+(unless ``--keep-going``). The reading and checking is ``script``'s; this
+module plays.
 
 ``sleep S`` lines are sent to the server as ``sleep S/speed``: the server
 holds that connection's later lines until the pause is over and then replies
-``ok``, so timing stays right even when lines are pipelined.
+``ok``, so timing stays right even when lines are pipelined. Moves with
+``motion on`` (from ``--motion on`` or the file's own line) are answered on
+arrival, and the lines behind them wait the same way; on a terminal the
+progress line says ``-> moving`` meanwhile.
 
 Exit status: 0 every line got ``ok``; 1 a line got an error, or the server
-could not be reached or went away; 2 the file or the options are wrong
-(nothing was sent); 130 interrupted.
+could not be reached or went away; 2 the file or the options are wrong, or
+the server refused ``--motion`` (nothing was sent); 130 interrupted.
 """
 
 from __future__ import annotations
 
 import argparse
-import re
-import shutil
 import sys
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from pathlib import Path
 from typing import TextIO
 
 from .client import (
@@ -39,156 +39,32 @@ from .client import (
     find_script,
     server_address,
 )
-from .commands import Bye, Command, Joints, Move, Quit, Sleep, parse_line
-from .errors import C2rvizError, JointCountError, JointIndexError
+from .commands import Bye, Quit, Sleep
+from .errors import C2rvizError
+from .lang.motion import MOTION_MODES, MotionMode
+from .progress import Progress
+from .script import (
+    Script,
+    ScriptLine,
+    check_robot,
+    load_script,
+    motion_after,
+    robot_mismatch,
+    waits_for_the_arm,
+)
 
 __all__ = [
     "Progress",
     "Script",
     "ScriptLine",
     "build_parser",
+    "check_robot",
     "load_script",
     "main",
     "play",
     "robot_mismatch",
+    "waits_for_the_arm",
 ]
-
-_ROBOT_HEADER = re.compile(r"#\s*robot:\s*([A-Za-z0-9_.-]+)\s*", re.IGNORECASE)
-
-
-@dataclass(frozen=True, slots=True)
-class ScriptLine:
-    """One command line of a file."""
-
-    number: int
-    """Line number in the file, from 1."""
-    text: str
-    """The line as written (without its newline)."""
-    command: Command
-    wire: str
-    """What is sent: the line without its comment and outer spaces."""
-
-
-@dataclass
-class Script:
-    """A parsed command file: its command lines and every line that did not parse."""
-
-    name: str
-    lines: list[ScriptLine] = field(default_factory=list)
-    problems: list[str] = field(default_factory=list)
-    """``name:line: error: ...`` for each line the parser rejected."""
-    robot: str | None = None
-    """The robot the file is written for: its ``# robot: NAME`` line, if it has one."""
-
-    def problem(self, number: int, message: object) -> str:
-        return f"{self.name}:{number}: error: {message}"
-
-
-def load_script(path: Path, name: str | None = None) -> Script:
-    """Read and parse a command file (comments and blank lines are dropped).
-
-    The first ``# robot: NAME`` line among the comments that open the file (before
-    its first command) names the robot it is written for (``Script.robot``).
-
-    Args:
-        path: The file.
-        name: How messages name it (default: ``path`` as given).
-
-    Raises:
-        OSError: the file cannot be read.
-    """
-    script = Script(str(path) if name is None else name)
-    text = path.read_bytes().decode("utf-8-sig", "replace")
-    closed_at: ScriptLine | None = None
-    for number, raw in enumerate(text.split("\n"), start=1):
-        raw = raw.rstrip("\r")
-        try:
-            command = parse_line(raw)
-        except C2rvizError as exc:
-            script.problems.append(script.problem(number, exc))
-            continue
-        if command is None:
-            header = _ROBOT_HEADER.fullmatch(raw.strip())
-            if header and script.robot is None and not script.lines and not script.problems:
-                script.robot = header.group(1)
-            continue
-        if closed_at is not None:
-            verb = closed_at.wire.split()[0]
-            script.problems.append(
-                script.problem(
-                    number,
-                    f"line {closed_at.number} ({verb!r}) closes the connection, "
-                    "so this line would never run",
-                )
-            )
-        line = ScriptLine(number, raw, command, raw.split("#", 1)[0].strip())
-        if isinstance(command, (Bye, Quit)) and closed_at is None:
-            closed_at = line
-        script.lines.append(line)
-    return script
-
-
-def check_robot(script: Script, robot: str, joint_names: Sequence[str]) -> list[str]:
-    """Problems with ``joints`` counts and ``move`` indices for this robot's chain."""
-    n = len(joint_names)
-    problems = []
-    for line in script.lines:
-        command = line.command
-        if isinstance(command, Joints) and len(command.values) != n:
-            problems.append(script.problem(line.number, JointCountError(n, len(command.values))))
-        elif isinstance(command, Move):
-            bad = [i for i in command.indices if i >= n]
-            if bad:
-                problems.append(script.problem(line.number, JointIndexError(bad[0], robot, n)))
-    return problems
-
-
-def robot_mismatch(script: Script, robot: str, joint_names: Sequence[str]) -> str | None:
-    """What to say when ``script`` declares another robot than the server's, else None."""
-    if script.robot is None or script.robot == robot:
-        return None
-    return (
-        f"{script.name} is written for robot {script.robot} (its '# robot:' line), "
-        f"but the server runs {robot} ({len(joint_names)} joints)"
-    )
-
-
-class Progress:
-    """Shows each played line and its reply.
-
-    On a terminal (``in_place``) one status line is rewritten in place; replies
-    that carry data and every error stay on screen. Otherwise one plain line
-    per command.
-    """
-
-    def __init__(self, out: TextIO, err: TextIO, in_place: bool | None = None) -> None:
-        self.out = out
-        self.err = err
-        self.in_place = out.isatty() if in_place is None else in_place
-        self._dirty = False
-
-    def step(self, label: str, text: str, reply: str) -> None:
-        message = f"{label} {text} -> {reply}"
-        if not self.in_place:
-            print(message, file=self.out, flush=True)
-            return
-        keep = reply not in ("ok", "ok bye") and not reply.startswith("error")
-        width = shutil.get_terminal_size().columns - 1
-        shown = message if keep or len(message) <= width else message[: width - 3] + "..."
-        self.out.write("\r\x1b[K" + shown + ("\n" if keep else ""))
-        self.out.flush()
-        self._dirty = not keep
-
-    def error(self, message: str) -> None:
-        self.end_line()
-        print(message, file=self.err, flush=True)
-
-    def end_line(self) -> None:
-        """Finish the in-place line so the next output starts on its own line."""
-        if self._dirty:
-            self.out.write("\n")
-            self.out.flush()
-            self._dirty = False
 
 
 def _wire(line: ScriptLine, speed: float) -> str:
@@ -206,6 +82,7 @@ def play(
     keep_going: bool = False,
     window: int = 1,
     prefix: str = "",
+    motion: str | None = None,
 ) -> int:
     """Send every line of ``script`` and show its reply; return how many got an error.
 
@@ -218,6 +95,9 @@ def play(
         window: Lines sent ahead of their replies (1: wait for each reply).
             After an error, lines already sent have run; their replies are shown.
         prefix: Put before each ``k/n`` label (the loop number).
+        motion: The connection's motion mode as the play starts (None: unknown,
+            taken as ``off``); the file's own ``motion`` lines change it. While a
+            line waits for the arm, ``show`` says so (``-> moving``).
 
     Raises:
         ConnectionLost: the server went away (already reported through ``show``).
@@ -228,15 +108,21 @@ def play(
     width = len(str(n))
     sent = done = errors = 0
     stop = n
+    mode = motion or "off"
     try:
         while done < stop:
             while sent < stop and sent - done < window:
                 client.send(_wire(lines[sent], speed))
                 sent += 1
-            reply = client.read_reply()
             line = lines[done]
+            label = f"[{prefix}{done + 1:>{width}}/{n}]"
+            if waits_for_the_arm(line.command, mode):
+                show.waiting(label, line.wire, "moving")
+            reply = client.read_reply()
             done += 1
-            show.step(f"[{prefix}{done:>{width}}/{n}]", line.wire, reply)
+            show.step(label, line.wire, reply)
+            if isinstance(line.command, MotionMode) and line.command.mode and reply == "ok":
+                mode = line.command.mode
             if not reply.startswith("ok"):
                 errors += 1
                 show.error(f"{script.name}:{line.number}: {reply}")
@@ -258,7 +144,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Check a c2rviz command file with the server's parser, then play it: "
         "each line is sent, its reply shown; the first error stops the play.",
         epilog="Exit status: 0 all lines ok; 1 a line got an error or no server; "
-        "2 the file does not check (nothing was sent). FILE is looked for here, "
+        "2 the file or an option does not check, or the server refused --motion "
+        "(nothing was sent). FILE is looked for here, "
         "then in the project's commands/. A '# robot: NAME' line in the file's "
         "opening comments names the robot it is for.",
     )
@@ -271,6 +158,12 @@ def build_parser() -> argparse.ArgumentParser:
         default=1.0,
         metavar="X",
         help="divide every sleep by X (default 1)",
+    )
+    add(
+        "--motion",
+        choices=MOTION_MODES,
+        help="send 'motion off|on|follow' before the first line: with 'on' each move's "
+        "reply comes when the arm arrives (default: the server's mode)",
     )
     add("--loop", type=int, default=1, metavar="N", help="play N times; 0: until Ctrl-C")
     add("--keep-going", action="store_true", help="go on after an error reply")
@@ -353,6 +246,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         problems = check_robot(script, client.robot or "?", names)
         if problems:
             return _fail(problems, f"{script.name} (robot {client.robot})", err)
+        motion = args.motion
+        if motion is not None:
+            reply = client.ask(f"motion {motion}")
+            if not reply.startswith("ok"):  # a server from before motion
+                return _fail([f"--motion {motion}: the server replied {reply!r}"], script.name, err)
+        elif show.in_place:
+            motion = client.motion()  # only to show "-> moving"; None: no motion there
         loop = 0
         while args.loop == 0 or loop < args.loop:
             loop += 1
@@ -365,7 +265,9 @@ def main(argv: Sequence[str] | None = None) -> int:
                 keep_going=args.keep_going,
                 window=args.window,
                 prefix=prefix,
+                motion=motion,
             )
+            motion = motion_after(script, motion)
             played += 1
             if errors and not args.keep_going:
                 break

@@ -1,8 +1,8 @@
 """Where a robot description comes from: its URDF text and its mesh files.
 
-``load_source`` reads a URDF (expanding a ``.xacro`` first) into a
-``RobotSource``; the source resolves every mesh reference in it to a file on
-disk, the way ROS would but without ROS:
+``load_source`` reads a URDF (expanding a ``.xacro`` first, with
+``xacro_source``) into a ``RobotSource``; the source resolves every mesh
+reference in it to a file on disk, the way ROS would but without ROS:
 
 - ``package://NAME/rest`` looks for package NAME, in this order: in each
   ``--package-path`` entry (``NAME=DIR`` names the folder outright; a plain
@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import os
 import re
-import threading
 import xml.etree.ElementTree as ET
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
@@ -32,6 +31,7 @@ from pathlib import Path
 from urllib.parse import unquote
 
 from .errors import ConfigError, RobotError
+from .xacro_source import expand_xacro, parse_xacro_args
 
 __all__ = [
     "MissingMesh",
@@ -48,7 +48,6 @@ _PACKAGE_NAME = re.compile(r"[A-Za-z0-9_.-]+")
 _SCAN_DEPTH = 4  # how far below a package-path entry package.xml files are looked for
 _SCAN_MAX_DIRS = 5000  # and how many folders at most, so a too-wide entry stays quick
 _IGNORE_MARKERS = ("CATKIN_IGNORE", "COLCON_IGNORE", "AMENT_IGNORE")
-_xacro_lock = threading.Lock()  # xacro keeps module-level state
 # The first element of an XML text, past a BOM, the declaration, comments and a doctype.
 _ROOT_TAG = re.compile(
     r"\ufeff?\s*(?:(?:<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>]*>)\s*)*<([A-Za-z_][\w:.-]*)", re.DOTALL
@@ -226,77 +225,6 @@ def split_package_path(
     return None, (base / Path(text).expanduser()).resolve()
 
 
-def parse_xacro_args(args: Mapping[str, str] | Iterable[str]) -> dict[str, str]:
-    """``name:=value`` strings (or a mapping) as a dict for xacro.
-
-    Raises:
-        ConfigError: an entry that is not ``name:=value``.
-    """
-    if isinstance(args, Mapping):
-        return dict(args)
-    parsed = {}
-    for arg in args:
-        name, sep, value = arg.partition(":=")
-        if not sep or not name.strip():
-            raise ConfigError(f"--xacro-arg {arg!r} is not name:=value")
-        parsed[name.strip()] = value
-    return parsed
-
-
-def _expand_xacro(path: Path, args: dict[str, str], source: RobotSource) -> str:
-    """Run xacro on ``path``; ``$(find NAME)`` uses ``source``'s package search."""
-    try:
-        import xacro
-        from xacro import substitution_args
-    except ImportError as exc:  # pragma: no cover - xacro is a dependency
-        raise RobotError(f"{path} is a xacro file and xacro is not installed: {exc}") from exc
-
-    def find(name: str) -> str:
-        folder = source.find_package(name)
-        if folder is None:
-            raise substitution_args.SubstitutionException(
-                f"package {name!r} not found in --package-path, ROS_PACKAGE_PATH, "
-                f"AMENT_PREFIX_PATH or the folders above {path.parent} "
-                "(give the folder that holds it with --package-path DIR or NAME=DIR)"
-            )
-        return str(folder)
-
-    # xacro answers $(find NAME) through ROS's package index; swap in our search
-    # (these are xacro 2.x internals: without them, xacro's own lookup stays).
-    patch = hasattr(substitution_args, "_eval_find") and hasattr(substitution_args, "_eval_dict")
-    with _xacro_lock:
-        if patch:
-            saved = substitution_args._eval_find, substitution_args._eval_dict.get("find")
-            substitution_args._eval_find = find
-            substitution_args._eval_dict["find"] = find
-        try:
-            return xacro.process_file(str(path), mappings=args).toprettyxml(indent="  ")
-        except Exception as exc:  # xacro raises all sorts; each is a bad description
-            problem = _xacro_problem(exc)
-            if "argument" in problem.lower():
-                problem += " (give it with --xacro-arg name:=value)"
-            raise RobotError(f"cannot expand {path}: {problem}") from exc
-        finally:
-            if patch:
-                substitution_args._eval_find, substitution_args._eval_dict["find"] = saved
-
-
-def _xacro_problem(exc: Exception) -> str:
-    """What xacro raised, as one line without class names or repeats.
-
-    xacro wraps an error in a substitution such as ``$(find NAME)`` as
-    ``XacroException(f"{type(e)}: {e}", exc=e)``, whose text is then
-    ``<class '...'>: {e} {e}``; only ``{e}`` (and any suffix) is kept.
-    """
-    text = str(exc)
-    inner = getattr(exc, "exc", None)
-    if inner is not None:
-        wrapped = f"{type(inner)}: {inner}"
-        if text.startswith(wrapped):
-            text = text[len(wrapped) :]
-    return " ".join(text.split()) or type(exc).__name__
-
-
 def check_urdf_root(xml: str, where: Path) -> None:
     """Raise RobotError unless ``xml``'s root element is ``<robot>``.
 
@@ -356,9 +284,10 @@ def load_source(
             folders.append(folder)
         else:
             mapped.append((name, folder))
+    resolved = path.resolve()
     source = RobotSource(
         "",
-        path.resolve(),
+        resolved,
         tuple(folders),
         tuple(mapped),
         _split_env(env.get("ROS_PACKAGE_PATH")),
@@ -366,7 +295,7 @@ def load_source(
     )
     args = parse_xacro_args(xacro_args)
     if path.suffix == ".xacro":
-        xml = _expand_xacro(source.path, args, source)  # type: ignore[arg-type]
+        xml = expand_xacro(resolved, args, source.find_package)
     else:
         if args:
             raise ConfigError(f"--xacro-arg given, but {path} is not a .xacro file")

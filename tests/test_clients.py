@@ -23,9 +23,9 @@ from pathlib import Path
 import pytest
 
 from c2rviz import client as client_module
-from c2rviz import player, repl
-from c2rviz.client import Client, ServerUnavailable, default_address, server_address
-from c2rviz.errors import ConfigError
+from c2rviz import player, registry, repl
+from c2rviz.client import Client, ServerUnavailable, default_address, motion_of, server_address
+from c2rviz.errors import C2rvizError, ConfigError
 
 ROOT = Path(__file__).resolve().parent.parent
 MOTOMAN = str(ROOT / "commands" / "motoman.txt")
@@ -61,6 +61,23 @@ def run_repl(monkeypatch, text: str, *args: str) -> int:
 
 def env() -> dict[str, str]:
     return {**os.environ, "PYTHONUNBUFFERED": "1", "TERM": "dumb"}
+
+
+def joints_lines(server) -> list[str]:
+    """The ``joints`` lines the server has accepted, from every client."""
+    return [line for line in server.scene.commands if line.split()[0] in ("joints", "j")]
+
+
+@pytest.fixture
+def old_server(server, monkeypatch):
+    """The real server as it was before motion: ``motion`` is not one of its verbs.
+
+    It answers ``motion`` with ``error: unknown command 'motion' (try 'help')``, as
+    those servers did, because the verb is taken out of the real registry for the
+    test (the server runs in this process); everything else is the real server.
+    """
+    monkeypatch.delitem(registry.LOOKUP, "motion")
+    return server
 
 
 # --- the shared client -------------------------------------------------------------------
@@ -112,6 +129,45 @@ def test_client_gives_up_after_its_retry_time():
         client.open()
     assert 0.3 <= time.monotonic() - start < 10.0  # gave up, and not at once
     assert len(notes) == 1 and "retrying" in notes[0]
+
+
+def test_client_motion_reads_a_real_servers_reply(server, monkeypatch):
+    client = Client(server.host, server.port)
+    assert client.motion() == "off"
+    assert client.ask("motion follow") == "ok"
+    assert client.motion() == "follow"
+    monkeypatch.delitem(registry.LOOKUP, "motion")  # the same server, as before motion
+    reply = client.ask("motion")
+    assert reply == "error: unknown command 'motion' (try 'help')"
+    assert motion_of(reply) is None
+    for odd in ("ok sideways", "error: motion: unknown mode 'x'", "ok"):
+        with pytest.raises(C2rvizError, match="unexpected reply to 'motion'"):
+            motion_of(odd)
+    client.close()
+
+
+@pytest.fixture
+def cell():
+    """A real server with two robots, ``left`` (motoman) and ``right`` (kuka_lwr)."""
+    from conftest import ServerThread, load_robot
+
+    from c2rviz.config import ServerLimits
+
+    robots = {"left": load_robot("motoman_sia20d"), "right": load_robot("kuka_lwr")}
+    server = ServerThread(robots, ServerLimits()).start()  # type: ignore[arg-type]
+    yield server
+    server.stop()
+
+
+def test_client_restores_its_robot_after_a_reconnect(cell):
+    client = Client(cell.host, cell.port)
+    assert client.joint_names()[0] == "joint_s" and client.robot == "left"
+    assert client.ask("robot right") == "ok"
+    assert client.chosen_robot == "right"
+    assert client.joint_names()[0] == "lwr_0_joint" and client.robot == "right"  # asked again
+    client.close()
+    assert client.ask("robot") == "ok right"  # a new connection, the same robot
+    client.close()
 
 
 # --- the player ----------------------------------------------------------------------------
@@ -248,6 +304,79 @@ def test_pipelined_play_matches_replies_to_lines(server, connect, tmp_path, caps
     assert "[4/4] move 2 20 -> ok" in capsys.readouterr().out
 
 
+def test_the_player_plays_motoman_txt_with_motion_on(c2rviz_process, capsys):
+    # The real program, its arm given 20 rad/s so that the seven moves take a few seconds.
+    proc = c2rviz_process("--no-viewer", "--speed", "100", "--max-velocity", "20")
+    args = [MOTOMAN, "--port", str(proc.port), "--speed", "1000", "--motion", "on"]
+    assert player.main(args) == 0
+    out = capsys.readouterr().out
+    assert "[16/16] move 0,1 -90,-90 -> ok" in out and "16 commands, all ok" in out
+    client = Client("127.0.0.1", proc.port)
+    assert client.ask("degrees") == "ok"
+    assert client.ask("where") == SEED_END  # where motion off ends too
+    assert client.ask("status") == "ok idle"  # every move had arrived when its reply came
+    client.close()
+
+
+def test_the_player_sends_motion_before_the_first_line(server, tmp_path):
+    path = write(tmp_path, "two.txt", "# robot: motoman_sia20d\ndegrees\nmove 0 5\n")
+    assert player.main([path, "--port", str(server.port), "--motion", "on"]) == 0
+    assert server.scene.commands[-3:] == ["motion on", "degrees", "move 0 5"]
+    assert server.q[0] == pytest.approx(math.radians(5))
+
+
+def test_the_player_refuses_a_bad_motion_mode(capsys):
+    port = free_port()  # nothing listens: the option is refused before connecting
+    with pytest.raises(SystemExit) as exit_:
+        player.main([MOTOMAN, "--port", str(port), "--motion", "bogus"])
+    assert exit_.value.code == 2
+    assert "argument --motion: invalid choice: 'bogus'" in capsys.readouterr().err
+
+
+def test_the_player_says_when_the_server_has_no_motion(old_server, capsys):
+    before = old_server.q
+    args = [MOTOMAN, "--port", str(old_server.port), "--motion", "on"]
+    assert player.main(args) == 2
+    err = capsys.readouterr().err
+    assert "--motion on: the server replied \"error: unknown command 'motion'" in err
+    assert "nothing was sent" in err
+    assert old_server.q == before
+
+
+MOTION_SCRIPT = (
+    "# robot: motoman_sia20d\n"
+    "motion on\nspeed 100\ndegrees\n"
+    "move 0 10\nwhere\nmove 1 20\nj 0,0,0,0,0,0,0\nwhere\n"
+)
+
+
+@pytest.mark.parametrize("window", [1, 8])
+def test_a_file_that_says_motion_on_plays_in_order(server, tmp_path, capsys, window):
+    path = write(tmp_path, "motion.txt", MOTION_SCRIPT)
+    assert player.main([path, "--check"]) == 0  # the server's parser knows motion
+    assert player.main([path, "--port", str(server.port), "--window", str(window)]) == 0
+    out = capsys.readouterr().out
+    # Each `where` runs after the move before it has arrived, even when sent ahead.
+    assert "[5/8] where -> ok 10,0,0,0,0,0,0" in out
+    assert "[8/8] where -> ok 0,0,0,0,0,0,0" in out
+    assert len(joints_lines(server)) == 1
+
+
+def test_the_progress_shows_a_move_in_progress(server, tmp_path):
+    path = Path(write(tmp_path, "moving.txt", "motion on\nspeed 100\nmove 0 0.2\nwhere\n"))
+    out = io.StringIO()
+    client = Client(server.host, server.port)
+    try:
+        errors = player.play(client, player.load_script(path), player.Progress(out, out, True))
+    finally:
+        client.close()
+    assert errors == 0
+    shown = out.getvalue()
+    assert "\r\x1b[K[3/4] move 0 0.2 -> moving\r\x1b[K[3/4] move 0 0.2 -> ok" in shown
+    assert "[2/4] speed 100 -> moving" not in shown and "where -> moving" not in shown
+    assert "[4/4] where -> ok 0.2,0,0,0,0,0,0\n" in shown
+
+
 def test_loop_plays_the_file_n_times(server, tmp_path, capsys):
     path = write(tmp_path, "two.txt", "# two lines\nmove 0 0.1\n\nmove 0 0.2\n")
     assert player.main([path, "--port", str(server.port), "--loop", "3"]) == 0
@@ -291,6 +420,20 @@ def test_in_place_progress_on_a_terminal():
     )
 
 
+def test_progress_shows_a_reply_being_waited_for_only_on_a_terminal():
+    out = io.StringIO()
+    show = player.Progress(out, out, in_place=True)
+    show.waiting("[1/2]", "j 1,2", "moving")
+    show.step("[1/2]", "j 1,2", "ok")
+    show.end_line()
+    assert out.getvalue() == "\r\x1b[K[1/2] j 1,2 -> moving\r\x1b[K[1/2] j 1,2 -> ok\n"
+    plain = io.StringIO()
+    show = player.Progress(plain, plain, in_place=False)
+    show.waiting("[1/2]", "j 1,2", "moving")
+    show.step("[1/2]", "j 1,2", "ok")
+    assert plain.getvalue() == "[1/2] j 1,2 -> ok\n"
+
+
 def test_fileplayer_script_runs_as_a_process(server, connect):
     args = [PLAYER_SCRIPT, "commands/motoman.txt", "--port", str(server.port), "--speed", "1000"]
     done = subprocess.run(
@@ -308,7 +451,8 @@ def test_fileplayer_script_runs_as_a_process(server, connect):
 # --- the REPL, piped -----------------------------------------------------------------------
 
 
-def test_repl_piped(server, connect, monkeypatch, capsys):
+def test_repl_piped(old_server, connect, monkeypatch, capsys):
+    server = old_server  # goto steps there
     text = (
         "file motoman.txt speed=1000\n"
         "where\n"
@@ -373,7 +517,8 @@ def test_the_readmes_quick_start_runs_as_shown(server):
     assert "sudo apt-get install netcat-openbsd" in quick
 
 
-def test_repl_goto_in_radians_and_its_errors(server, monkeypatch, capsys):
+def test_repl_goto_in_radians_and_its_errors(old_server, monkeypatch, capsys):
+    server = old_server  # goto steps there: step= and rate= apply
     text = (
         "goto 0.5,0,0,0,0,0,0 rate=1000\n"  # default step: 2 degrees = 0.0349 rad
         "goto 1,2\n"
@@ -391,6 +536,50 @@ def test_repl_goto_in_radians_and_its_errors(server, monkeypatch, capsys):
     assert "file NAME [speed=X]" in out and "marker sphere|cube|arrow|cylinder" in out
     assert "ok (goto: 2 steps" in out  # the refused goto moved nothing: 1.91 rad to go
     assert server.q[:2] == pytest.approx((0.5, 1.91))
+    assert len(joints_lines(server)) == 15 + 2
+
+
+def test_repl_goto_uses_the_servers_motion(server, monkeypatch, capsys):
+    text = "degrees\nmotion follow\nspeed 100\ngoto 10,20,0,0,0,0,0 step=5\nmotion\n"
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[:3] == ["ok", "ok", "ok"]
+    assert out[3].startswith("ok (goto: arrived in ")
+    assert out[4] == "ok follow"  # the connection's mode is put back
+    assert joints_lines(server) == ["joints 10.0,20.0,0.0,0.0,0.0,0.0,0.0"]  # one line
+    assert server.q == pytest.approx((math.radians(10), math.radians(20), 0, 0, 0, 0, 0))
+
+
+def test_repl_goto_reports_a_preempted_move(server, connect):
+    """Another client's move ends the goto's: an error, and the mode is still put back."""
+    with subprocess.Popen(
+        [sys.executable, REPL_SCRIPT, "--port", str(server.port)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env(),
+    ) as proc:
+        try:
+            assert proc.stdin is not None
+            proc.stdin.write("speed 10\ngoto 2,0,0,0,0,0,0\nmotion\n")  # seconds at 10 %
+            proc.stdin.flush()
+            probe = connect(server)
+            deadline = time.monotonic() + 60
+            while not probe.ask("status").startswith("ok moving"):
+                assert time.monotonic() < deadline, "the goto did not start"
+                time.sleep(0.01)
+            assert probe.ask("j 0,0.1,0,0,0,0,0") == "ok"  # at once: it preempts the goto
+            out, err = proc.communicate("", timeout=60)
+        finally:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 1, err  # piped, a line got an error
+    lines = out.splitlines()
+    assert lines[0] == "ok"
+    assert lines[1].startswith("goto: error: preempted by tcp 127.0.0.1:")
+    assert lines[2] == "ok off"
+    assert server.q == pytest.approx((0, 0.1, 0, 0, 0, 0, 0))
 
 
 def test_repl_help_lists_each_command_once(server, monkeypatch, capsys):
@@ -585,7 +774,7 @@ def test_repl_on_a_terminal(server, connect, terminal, tmp_path):
     term.send("where\n")
     assert "1  joint_l  -90" in term.expect("joint_t")
     term.send("goto 0,0,0,0,0,0,0 rate=1000\n")
-    term.expect("ok (goto: 45 steps")
+    term.expect("ok (goto: arrived in")  # the server's motion: rate= does not apply
     term.send("bogus\n")
     term.expect("error: unknown command 'bogus'")
     term.send("sleep 30\n")
@@ -601,6 +790,34 @@ def test_repl_on_a_terminal(server, connect, terminal, tmp_path):
     assert where_degrees(server, connect) == "ok 0,0,0,0,0,0,0"  # the server is still up
     history = (tmp_path / "history").read_text()
     assert "file motoman.txt speed=1000" in history and "bogus" in history
+
+
+def test_ctrl_c_stops_a_goto_on_the_robot_the_repl_drives(cell, connect, terminal):
+    term = terminal("--port", str(cell.port))
+    term.expect("> ")
+    term.send("robot right\n")
+    term.expect("ok\n")
+    term.send("speed 10\n")
+    term.expect("ok\n")
+    term.send("goto 2,0,0,0,0,0,0\n")  # lwr_0_joint to 2 rad at 10 % of its limits: seconds
+    probe = connect(cell)
+    assert probe.ask("robot right") == "ok"
+    deadline = time.monotonic() + 60
+    while float(probe.ask("where")[3:].split(",")[0]) < 0.01:  # it has set off
+        assert time.monotonic() < deadline, "the goto did not start"
+        time.sleep(0.01)
+    term.send("\x03")  # Ctrl-C: stop, on another connection, for robot right
+    term.expect("goto: interrupted, the arm stopped: error: motion stopped by tcp 127.0.0.1:")
+    assert probe.ask("status") == "ok idle"
+    stopped = float(probe.ask("where")[3:].split(",")[0])
+    assert 0.01 < stopped < 2
+    term.send("motion\n")
+    term.expect("ok off")  # put back, on a connection still in step
+    term.send("where\n")
+    term.expect("lwr_6_joint")
+    term.send("q\n")
+    status, rest = term.finish()
+    assert status == 0 and "Traceback" not in rest
 
 
 @pytest.mark.parametrize("key", ["\x04", "\x03"], ids=["ctrl-d", "ctrl-c"])

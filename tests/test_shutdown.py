@@ -174,7 +174,9 @@ def test_a_stop_mid_flood_answers_what_was_read_in_order(start_server):
     answered = replies_seen.count(HOME)
     assert replies_seen  # without a reset (a reset raises in read_all), ...
     assert replies_seen[:answered] == [HOME] * answered  # ... in order: answers, then ...
-    assert set(replies_seen[answered:]) == {replies.SHUTTING_DOWN}  # ... the rest
+    # ... the rest read before the stop (none, when a fast server had run them all).
+    assert set(replies_seen[answered:]) <= {replies.SHUTTING_DOWN}
+    assert len(replies_seen) <= 100_000
     print(f"stop mid-flood: {answered} answered, {len(replies_seen) - answered} shutting down")
 
 

@@ -1,0 +1,60 @@
+"""How ``c2rviz-play`` (and the REPL's ``file``) shows each played line and its reply."""
+
+from __future__ import annotations
+
+import shutil
+from typing import TextIO
+
+__all__ = ["Progress"]
+
+
+class Progress:
+    """Shows each played line and its reply.
+
+    On a terminal (``in_place``) one status line is rewritten in place; replies
+    that carry data and every error stay on screen. Otherwise one plain line
+    per command.
+    """
+
+    def __init__(self, out: TextIO, err: TextIO, in_place: bool | None = None) -> None:
+        self.out = out
+        self.err = err
+        self.in_place = out.isatty() if in_place is None else in_place
+        self._dirty = False
+
+    def step(self, label: str, text: str, reply: str) -> None:
+        message = f"{label} {text} -> {reply}"
+        if not self.in_place:
+            print(message, file=self.out, flush=True)
+            return
+        keep = reply not in ("ok", "ok bye") and not reply.startswith("error")
+        shown = message if keep else self._fit(message)
+        self.out.write("\r\x1b[K" + shown + ("\n" if keep else ""))
+        self.out.flush()
+        self._dirty = not keep
+
+    def waiting(self, label: str, text: str, note: str) -> None:
+        """On a terminal, show that ``text``'s reply is awaited (``-> moving``); the
+        ``step`` that follows overwrites it. Elsewhere nothing: one line per command."""
+        if not self.in_place:
+            return
+        self.out.write("\r\x1b[K" + self._fit(f"{label} {text} -> {note}"))
+        self.out.flush()
+        self._dirty = True
+
+    def error(self, message: str) -> None:
+        self.end_line()
+        print(message, file=self.err, flush=True)
+
+    def end_line(self) -> None:
+        """Finish the in-place line so the next output starts on its own line."""
+        if self._dirty:
+            self.out.write("\n")
+            self.out.flush()
+            self._dirty = False
+
+    @staticmethod
+    def _fit(message: str) -> str:
+        """``message`` cut to the terminal's width, so rewriting it in place works."""
+        width = shutil.get_terminal_size().columns - 1
+        return message if len(message) <= width else message[: width - 3] + "..."
