@@ -45,21 +45,26 @@ JOINTS = ("joint_s", "joint_l", "joint_e", "joint_u", "joint_r", "joint_b", "joi
 DEADLINE_S = 180.0  # for any one wait; a healthy run takes a second or two per step
 
 # viser's end-to-end hooks (App.tsx puts them on window for Playwright): the one place
-# this file reads the page's internals. Robot links are /robot/LINK, their geometry
-# /robot/LINK/visual_K, markers /markers/mK (c2rviz/viewer.py).
+# this file reads the page's internals. Robot links are /robots/ROBOT/links/LINK, their geometry
+# /robots/ROBOT/links/LINK/visual_K, markers batched in /markers/ROBOT/SHAPE (c2rviz/view/).
 PAGE_STATE = """() => {
   const m = window.__viserMutable, t = window.__viserSceneTree, tp = window.__viserTestpoints;
   if (!m || !t || !tp) return null;
   const nodes = Object.keys(t.getState());
-  const visuals = nodes.filter((n) => /^\\/robot\\/[^/]+\\/visual_\\d+$/.test(n));
+  const visuals = nodes.filter((n) => /^\\/robots\\/[^/]+\\/links\\/[^/]+\\/visual_\\d+$/.test(n));
   const poses = {};
   for (const [n, p] of Object.entries(m.nodePoseData)) {
-    if (/^\\/robot\\/[^/]+$/.test(n)) poses[n] = [...p.wxyz, ...p.position];
+    if (/^\\/robots\\/[^/]+\\/links\\/[^/]+$/.test(n)) poses[n] = [...p.wxyz, ...p.position];
+  }
+  let markers = 0;  // one batched node per robot and shape: count its instances
+  for (const n of nodes.filter((n) => /^\\/markers\\//.test(n))) {
+    const at = t.getState()[n]?.message?.props?.batched_positions;
+    markers += at ? at.byteLength / 12 : 0;
   }
   return {
     visuals: visuals.length,
     mounted: visuals.filter((n) => m.nodeRefFromName[n]).length,
-    markers: nodes.filter((n) => /^\\/markers\\/[^/]+$/.test(n)).length,
+    markers,
     queued: m.messageQueue.length,
     frame: tp.rendererInfo.render.frame,
     poses,
@@ -287,6 +292,8 @@ def test_the_page_follows_commands_and_commands_the_robot(
         for line in ("rgb 255,0,0", "marker cube", "mark 0.5,-0.5,0.3,0,0,0", "mark"):
             assert tcp.ask(line) == "ok"
         wait_for_scene(page, "two markers", lambda state: state["markers"] == markers + 2)
+        # Batched markers reach the GPU a frame or two after their node's state.
+        wait_for(lambda: changed(before, scene_pixels(page)) > 20, "the markers drawn")
         marked = settle(page, "6-marks")
         assert changed(before, marked) > 20
         assert tcp.ask("clear") == "ok"
