@@ -67,6 +67,7 @@ class Recorded:
         started: When it began (UTC).
         sources: Who sent commands meanwhile.
         error: Why it stopped early, if it did.
+        html: NAME.html, the run as a page that plays in any browser.
     """
 
     name: str
@@ -78,6 +79,8 @@ class Recorded:
     started: datetime
     sources: tuple[str, ...]
     error: str | None = None
+    html: Path | None = None
+    """The self-contained page (``record_html``), once written."""
 
 
 def _numbers(values: Sequence[float]) -> str:

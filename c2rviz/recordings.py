@@ -8,13 +8,21 @@ when the files are complete (the command file is put together in a thread).
 from __future__ import annotations
 
 import asyncio
+import logging
 import weakref
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import pinocchio as pin
+
 from .errors import C2rvizError
+from .record_html import write_html
 from .recorder import Recorded, Recorder
+from .robot import Robot
 from .watch import WatchHub
+
+log = logging.getLogger("c2rviz.record")
 
 if TYPE_CHECKING:
     from .world import World
@@ -109,7 +117,9 @@ class Recordings:
             folder.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise RecordFolderError(folder, exc.strerror or str(exc)) from None
-        if not overwrite and any((folder / f"{name}{ext}").exists() for ext in (".txt", ".csv")):
+        if not overwrite and any(
+            (folder / f"{name}{ext}").exists() for ext in (".txt", ".csv", ".html")
+        ):
             raise RecordingExists(name, folder)
         try:
             recorder = Recorder(self.world, robot, name, folder, self._failed)
@@ -131,7 +141,10 @@ class Recordings:
             raise NotRecording()
         self._detach(recorder, why)
         recorder.stop()
-        future = asyncio.ensure_future(asyncio.to_thread(recorder.finish))
+        state = recorder.state
+        future = asyncio.ensure_future(
+            asyncio.to_thread(_finish, recorder, state.robot, state.origin)
+        )
         future.add_done_callback(self._finished)
         return future
 
@@ -152,3 +165,13 @@ class Recordings:
         if recorder in self.world.observers:
             self.world.remove_observer(recorder)
         WatchHub.of(self.world).event(f"record-stopped {recorder.name}: {why}")
+
+
+def _finish(recorder: Recorder, robot: Robot, origin: pin.SE3) -> Recorded:
+    """NAME.txt put together, then NAME.html from the frames (blocking: for a thread)."""
+    recorded = recorder.finish()
+    try:
+        return replace(recorded, html=write_html(recorded, robot, origin))
+    except Exception as exc:  # the txt and csv stand; the page is a bonus
+        log.warning("recording %s: no page written: %s", recorded.name, exc)
+        return recorded

@@ -64,7 +64,8 @@ def record_two_clients(server: ServerThread, connect, folder: Path) -> tuple[str
     final = boss.ask("where")
     reply = boss.ask("record stop")
     assert re.fullmatch(
-        r"ok recorded take: \d+ frames, \d+\.\d{3} s \(.*take\.txt, .*take\.csv\)", reply
+        r"ok recorded take: \d+ frames, \d+\.\d{3} s \(.*take\.txt, .*take\.csv, .*take\.html\)",
+        reply,
     )
     sources = [f"tcp 127.0.0.1:{c.sock.getsockname()[1]}" for c in (boss, mover, dropper)]
     return final, sources
@@ -84,7 +85,7 @@ def test_a_recorded_session_replays_to_the_same_states(
     recorded_markers = markers(first)
     assert len(recorded_markers) == 4
     txt, table = tmp_path / "take.txt", tmp_path / "take.csv"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["take.csv", "take.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["take.csv", "take.html", "take.txt"]
 
     # The command file: its header, then commands the player takes.
     text = txt.read_text()
@@ -179,7 +180,7 @@ def test_record_status_and_bad_names(server: ServerThread, connect, tmp_path: Pa
     )
     assert client.ask("record one overwrite").startswith("ok recording one")
     assert client.ask("record stop").startswith("ok recorded one: ")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["one.csv", "one.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["one.csv", "one.html", "one.txt"]
     assert not (tmp_path.parent / "x.txt").exists()
 
 
@@ -380,3 +381,38 @@ def test_record_flag_refuses_a_bad_name(tmp_path: Path, name: str, message: str)
     )
     assert done.returncode == 2 and message in done.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.browser
+def test_the_recorded_page_plays_in_a_browser_without_a_server(
+    start_server, connect, tmp_path: Path
+):
+    """NAME.html opens from a file:// URL in headless Chromium and the robot moves."""
+    from test_browser import ARGS, CHROMIUM, changed, wait_until
+
+    if not CHROMIUM.exists():
+        pytest.fail(f"{CHROMIUM} is missing: install Debian's chromium")
+    from PIL import Image
+    from playwright.sync_api import sync_playwright
+
+    record_two_clients(start_server(), connect, tmp_path)
+    page_file = tmp_path / "take.html"
+    text = page_file.read_text()
+    assert text.startswith("<!") and "ws://" not in text.split("<script", 1)[0]
+
+    def shot(page) -> np.ndarray:  # type: ignore[no-untyped-def]
+        import io
+
+        picture = Image.open(io.BytesIO(page.screenshot())).convert("RGB")
+        return np.asarray(picture, dtype=np.int16)[100:560, 200:800]
+
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=ARGS)
+        try:
+            page = browser.new_page(viewport={"width": 1000, "height": 700})
+            page.goto(page_file.as_uri())
+            first = shot(page)
+            # The recorded arm swings over about two seconds: the picture changes as it plays.
+            wait_until(lambda: (changed(first, shot(page)) > 500, None), "the recording playing")
+        finally:
+            browser.close()

@@ -68,5 +68,5 @@ async def _stopped(finished: asyncio.Future[Recorded]) -> str:
     return replies.ok(
         f"recorded {recorded.name}: {recorded.frames} frame{'s' * (recorded.frames != 1)}, "
         f"{recorded.duration_s:.3f} s "
-        f"({recorded.txt}, {recorded.csv})"
+        f"({', '.join(str(p) for p in (recorded.txt, recorded.csv, recorded.html) if p)})"
     )

@@ -89,8 +89,9 @@ class Trail:
     "record",
     "[NAME [overwrite]|stop]",
     "record what happens to this connection's robot, from every source, into NAME.txt "
-    "(a command file `c2rviz-play` replays) and NAME.csv (one row per frame) in the "
-    "recording folder; an existing NAME needs `overwrite`; `stop` ends it; alone, reply "
+    "(a command file `c2rviz-play` replays), NAME.csv (one row per frame) and NAME.html (a "
+    "page that plays it, no server needed) in the recording folder; an existing NAME "
+    "needs `overwrite`; `stop` ends it; alone, reply "
     "`ok recording NAME S` or `ok not recording`",
 )
 @dataclass(frozen=True, slots=True)
