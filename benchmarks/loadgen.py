@@ -292,6 +292,8 @@ class ViewerClient:
     frames: list[Frame] = field(default_factory=list)
     replay_done: asyncio.Event = field(default_factory=asyncio.Event)
     on_frame: Callable[[Frame], None] | None = None
+    on_messages: Callable[[float, list[dict[str, Any]]], None] | None = None
+    """Called with each frame's arrival time and its decoded messages (round 2 reads poses)."""
 
     async def run(self, ready: asyncio.Event | None = None) -> None:
         """Receive until cancelled or the server goes away."""
@@ -329,6 +331,8 @@ class ViewerClient:
                     self.replay_done.set()
                 if self.on_frame is not None:
                     self.on_frame(frame)
+                if self.on_messages is not None:
+                    self.on_messages(at, messages)
 
     def pose_frames_between(self, start: float, end: float) -> int:
         return sum(1 for f in self.frames if f.poses and start <= f.at <= end)
