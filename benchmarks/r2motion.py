@@ -82,7 +82,9 @@ class JointReader:
             for name in robot.link_names()
             if not np.allclose(rotations[0.0][name], rotations[0.1][name])
         )
-        self.node = "/robot/" + re.sub(r"[^A-Za-z0-9_.-]", "_", self.link)  # viewer's name
+        # The viewer's node: /robots/<robot name>/links/<link> (c2rviz/view/robot_view.py).
+        safe = re.sub(r"[^A-Za-z0-9_.-]", "_", self.link)
+        self.node = f"/robots/{robot.name}/links/{safe}"
         self.home = rotations[0.0][self.link]
         self.axis = pin.log3(rotations[0.1][self.link] @ self.home.T) / 0.1
 
