@@ -105,3 +105,20 @@ def test_the_trail_checkbox_runs_trail_on_and_the_node_holds_the_keepers_segment
     h.until(lambda: "arm" not in h.scene.trails.nodes, "the trail node to go")
     run(h, session, "trail on")
     h.until(lambda: panel.trail.value is True, "the checkbox to follow a typed trail on")
+
+
+def test_a_page_started_after_the_workcell_shows_its_objects_and_collisions() -> None:
+    world = World(load_robot(), None, np.random.default_rng(7))
+    session = Session(world, source="test")
+    session.set_degrees(True)
+    session.run("object table box 0.2,0.2,0.2 0,0.8,0.85,0,0,0")
+    world.set_q(tuple(np.radians([90.0, 60.0, 0, 0, 0, 0, 0])))
+    assert world.contacts.now(world.default)
+    h = Harness(world)
+    try:
+        layer = h.scene.workcells[world.default]
+        assert set(layer.objects) == {"table"}
+        assert "table" in layer.colliding
+        assert "~table" in h.scene.panels[world.default].collisions.value
+    finally:
+        h.close()

@@ -153,6 +153,9 @@ class ViserScene(Scene):
         for name, state in world.robots.items():
             for marker in state.markers:
                 self.markers.add(name, marker)
+        for name, model in world.contacts.models.items():  # a workcell set before the page
+            self._objects[name] = model.object_list()
+            self._collisions[name] = list(world.contacts.pairs.get(name, ()))
         self._send()
 
     def _frame_camera(self) -> None:
