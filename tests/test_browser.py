@@ -389,3 +389,43 @@ def test_long_joint_names_stay_on_one_line(
         heights[label] = page.locator("label", has_text=label).first.bounding_box()["height"]
     page.screenshot(path=str(ARTIFACTS / "ur5-panel.png"))
     assert len(set(heights.values())) == 1, heights  # as high as a one-line label
+
+
+def red_pixels(scene: np.ndarray) -> int:
+    """Pixels of the collision red (a colliding link's overlay, a hit object)."""
+    r, g, b = scene[..., 0], scene[..., 1], scene[..., 2]
+    return int(((r > 180) & (g < 90) & (b < 90)).sum())
+
+
+def test_an_object_is_drawn_and_a_link_in_it_turns_red(
+    browser: Any, c2rviz_process: Callable[..., Any]
+) -> None:
+    ARTIFACTS.mkdir(exist_ok=True)
+    proc = c2rviz_process("--viser-port", "0")
+    page = open_page(browser, proc.viewer_url)
+    wait_for_robot(page)
+    home = settle(page, "objects-1-home")
+    tcp = Tcp(proc.port)
+    try:
+        assert tcp.ask("object table box 0.2,0.2,0.2 0,0.8,0.85,0,0,0") == "ok"
+        has_object = (
+            "() => Object.keys(window.__viserSceneTree.getState())"
+            ".some((n) => n.endsWith('/objects/table'))"
+        )
+        wait_for(lambda: page.evaluate(has_object), "the object's node on the page")
+        wait_for(lambda: changed(home, scene_pixels(page)) > 50, "the object drawn")
+        with_object = settle(page, "objects-2-table")
+        assert red_pixels(with_object) < 50
+        assert tcp.ask("degrees") == "ok"
+        assert tcp.ask("j 90,60,0,0,0,0,0") == "ok"
+        wait_for(
+            lambda: "~table" in field(page, "Collisions").input_value(), "the collision listed"
+        )
+        wait_for(lambda: red_pixels(scene_pixels(page)) > 300, "the link and the object red")
+        red = red_pixels(settle(page, "objects-3-red"))
+        assert tcp.ask("home") == "ok"
+        wait_for(lambda: field(page, "Collisions").input_value() == "none", "no collision listed")
+        wait_for(lambda: red_pixels(scene_pixels(page)) < red // 10, "the red gone")
+        settle(page, "objects-4-home")
+    finally:
+        tcp.close()

@@ -3,7 +3,8 @@
 The page is a source of commands like any TCP client: a slider dragged to 30
 becomes ``move 1 30.0`` on that robot's page session (source ``page``,
 degrees mode), the Home / Random / Stop buttons ``home`` / ``rand`` /
-``stop``, the speed slider ``speed 40.0``. The session checks them; a refused
+``stop``, the speed slider ``speed 40.0``, the Trail checkbox ``trail on`` /
+``trail off``. The session checks them; a refused
 value is sent back to the tab as the true one.
 
 viser's door (``adapter.accept_input``) hands each value to a callback on
@@ -27,6 +28,7 @@ import viser
 
 from ..errors import C2rvizError
 from ..session import Session
+from ..trail import TrailKeeper
 from . import adapter
 from .panel import RobotPanel
 from .ratelog import RateLimitedLog
@@ -70,6 +72,7 @@ class PageInput:
         self._bind(panel.speed, functools.partial(self._speed, panel, session))
         for line, button in panel.buttons.items():
             self._bind(button, functools.partial(self._click, session, line))
+        self._bind(panel.trail, functools.partial(self._trail, panel, session))
 
     def add_toggle(self, checkbox: Any, on_change: Callable[[bool], None]) -> None:
         """Bind a checkbox: ``on_change(shown)``, then every tab shows the value."""
@@ -124,6 +127,11 @@ class PageInput:
     def _click(self, session: Session, line: str, client: int, value: Any) -> None:
         if value is True:
             self._line(session, line)
+
+    def _trail(self, panel: RobotPanel, session: Session, client: int, value: Any) -> None:
+        self._line(session, "trail on" if value is True else "trail off")
+        on = session.state.name in TrailKeeper.of(session.world).trails
+        adapter.set_gui_value(panel.trail, on, force=True)
 
     def _line(self, session: Session, line: str) -> bool:
         """Run ``line`` on ``session``; whether it was accepted."""

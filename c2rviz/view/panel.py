@@ -3,9 +3,9 @@
 Each robot's folder (headed by its name in the world) holds a slider per
 joint (degrees, metres for a prismatic joint), a speed slider for the page's
 own moves, Home / Random / Stop buttons, the end effector's pose and the
-motion status. The ``State`` folder shows the TCP client count and the last
-commands, newest first, a refused one marked so; a checkbox shows the
-collision geometry.
+motion status, a Trail checkbox and the colliding pairs. The ``State`` folder
+shows the TCP client count and the last commands, newest first, a refused
+one marked so; a checkbox shows the collision geometry.
 
 Controls only show values here: what the page does with them is
 ``page_input``'s. Values go out with ``adapter.set_gui_value`` (no callbacks,
@@ -54,6 +54,8 @@ class RobotPanel:
         buttons: ``home``, ``rand`` and ``stop``, by the line each runs.
         pose: The end-effector readout (in the base frame).
         motion: ``idle`` or ``moving, 1.20 s left``.
+        trail: The Trail checkbox (runs ``trail on`` / ``trail off``).
+        collisions: The colliding pairs readout.
     """
 
     def __init__(self, gui: viser.GuiApi, state: RobotState, speed: float) -> None:
@@ -108,6 +110,12 @@ class RobotPanel:
                 hint=f"{robot.eelink} in the {robot.base} frame",
             )
             self.motion: Any = gui.add_text("Motion", "idle", disabled=True)
+            self.trail: Any = gui.add_checkbox(
+                "Trail", False, hint="draw the end effector's path (trail on / trail off)"
+            )
+            self.collisions: Any = gui.add_text(
+                "Collisions", "none", disabled=True, hint="colliding pairs, link~object"
+            )
 
     def to_slider(self, index: int, value: float) -> float:
         """Joint value [rad or m] in slider units (deg or m), within the slider's range."""
@@ -148,6 +156,14 @@ class RobotPanel:
 
     def show_motion(self, moving: bool, seconds_left: float) -> None:
         self.motion.value = f"moving, {seconds_left:.1f} s left" if moving else "idle"
+
+    def show_collisions(self, pairs: Sequence[tuple[str, str]]) -> None:
+        """The colliding pairs, ``a~b, c~d``; ``none`` when there are none."""
+        self.collisions.value = ", ".join(f"{a}~{b}" for a, b in pairs) or "none"
+
+    def show_trail(self, on: bool) -> None:
+        """The Trail checkbox to ``on`` (set by a ``trail`` line from anywhere)."""
+        adapter.set_gui_value(self.trail, on)
 
 
 class StatePanel:

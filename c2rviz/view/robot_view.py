@@ -14,6 +14,7 @@ While the robot travels, a translucent copy of the arm (the target ghost,
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from typing import Any
 
@@ -160,6 +161,20 @@ class RobotView:
             shapes = self._geometry.get(link)
             for k, shape in enumerate(shapes.visual if shapes is not None else ()):
                 self._add_shape(f"{node}/visual_{k}", shape, visible=True, ghost=True)
+
+    def add_overlay(self, link: str, rgba: tuple[float, float, float, float]) -> list[Any]:
+        """A copy of ``link``'s visual geometry in ``rgba``, over the link (hidden).
+
+        Returns:
+            The copy's nodes (one per visual shape; none for a link without shapes).
+        """
+        node = f"{self.prefix}/links/{node_name(link)}"
+        shapes = self._geometry.get(link)
+        nodes = []
+        for k, shape in enumerate(shapes.visual if shapes is not None else ()):
+            tinted = dataclasses.replace(shape, rgba=rgba)
+            nodes.append(self._add_shape(f"{node}/overlay_{k}", tinted, visible=False))
+        return nodes
 
     def show_collision(self, shown: bool) -> None:
         for node in self.collision_nodes:

@@ -11,7 +11,8 @@ The world calls the scene on every accepted change, possibly hundreds of
 thousands of times a second; each call only records what changed and asks
 for a send. A send, at most one per frame (``1/hz``), draws the latest state:
 each changed robot's links (Pinocchio FK), its target ghost while it moves,
-its panel, the markers, in one atomic batch.
+its panel, the markers, the workcell objects and collisions, the trails
+(``workcell_layer``), in one atomic batch.
 """
 
 from __future__ import annotations
@@ -26,7 +27,9 @@ import numpy as np
 
 from ..scene import Marker, Scene
 from ..session import Session
+from ..trail import TrailKeeper
 from ..visuals import LinkGeometry, load_link_geometry
+from ..workcell import WorkcellObject
 from ..world import World
 from . import adapter
 from .markers import MarkerLayer
@@ -35,6 +38,7 @@ from .panel import RECENT_COMMANDS, RobotPanel, StatePanel
 from .policy import DoorPolicy
 from .robot_view import RobotView, node_name
 from .scheduler import SendScheduler
+from .workcell_layer import TrailLayer, WorkcellLayer
 
 __all__ = ["RECENT_COMMANDS", "STOP_TIMEOUT_S", "ViserScene"]
 
@@ -56,6 +60,8 @@ class ViserScene(Scene):
         panels: A ``RobotPanel`` per robot, by name.
         sessions: The page's ``Session`` per robot, by name (source ``page``).
         markers: Every robot's markers.
+        workcells: Each robot's workcell objects and red collisions, by name.
+        trails: Every robot's trail.
         state_panel: TCP clients, last commands, the collision checkbox.
         page_input: What the page's controls run.
         scheduler: When sends go out.
@@ -103,6 +109,8 @@ class ViserScene(Scene):
         self._commands: deque[tuple[str, bool]] = deque(maxlen=RECENT_COMMANDS)  # newest first
         self._client_count = world.client_count
         self._state_dirty = True
+        self._objects: dict[str, Sequence[WorkcellObject]] = {}  # to draw at the next send
+        self._collisions: dict[str, Sequence[tuple[str, str]]] = {}
         self.scheduler = SendScheduler(1.0 / hz, self._send)
         try:
             self._build()
@@ -127,6 +135,8 @@ class ViserScene(Scene):
             shapes = geometry[id(state.robot)]
             self.views[name] = RobotView(server, name, state.robot, state.origin, shapes, segment)
         self.markers = MarkerLayer(server, segments)
+        self.workcells = {name: WorkcellLayer(server, view) for name, view in self.views.items()}
+        self.trails = TrailLayer(server, segments)
         self._frame_camera()
         self.page_input = PageInput(server)
         self.panels: dict[str, RobotPanel] = {}
@@ -143,6 +153,9 @@ class ViserScene(Scene):
         for name, state in world.robots.items():
             for marker in state.markers:
                 self.markers.add(name, marker)
+        for name, model in world.contacts.models.items():  # a workcell set before the page
+            self._objects[name] = model.object_list()
+            self._collisions[name] = list(world.contacts.pairs.get(name, ()))
         self._send()
 
     def _frame_camera(self) -> None:
@@ -179,6 +192,14 @@ class ViserScene(Scene):
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         self._commands.appendleft((line, accepted))
         self._state_dirty = True
+        self.scheduler.request()
+
+    def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
+        self._objects[robot] = list(objects)
+        self.scheduler.request()
+
+    def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
+        self._collisions[robot] = list(pairs)
         self.scheduler.request()
 
     # lifecycle
@@ -243,10 +264,28 @@ class ViserScene(Scene):
                 panel.show_motion(moving, world.travels.seconds_left(state))
             self._dirty.clear()
             self.markers.draw()
+            self._draw_workcells()
             if self._state_dirty:
                 self._state_dirty = False
                 self.state_panel.show(self._client_count, self._commands)
         self.server.flush()
+
+    def _draw_workcells(self) -> None:
+        """The objects and collisions that changed, and the trails if they moved."""
+        for name, objects in self._objects.items():
+            if name in self.workcells:
+                self.workcells[name].show_objects(objects)
+        self._objects.clear()
+        for name, pairs in self._collisions.items():
+            if name in self.workcells:
+                self.workcells[name].show_collisions(pairs)
+                self.panels[name].show_collisions(pairs)
+        self._collisions.clear()
+        keeper = TrailKeeper.of(self.world)
+        if keeper.changed != self.trails.drawn:
+            for name, panel in self.panels.items():
+                panel.show_trail(name in keeper.trails)
+            self.trails.draw(keeper)
 
     def _show_collision(self, shown: bool) -> None:
         for view in self.views.values():
