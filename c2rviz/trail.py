@@ -1,8 +1,9 @@
 """The trail: the path of the tool point as the arm actually moves, kept for drawing.
 
 ``TrailKeeper`` is one per world (``TrailKeeper.of(world)``), an observer that keeps,
-for every robot whose trail is on, the tool point (``robot.ee_frame``'s origin) in the
-world frame [m] at most once per frame (``1/hz`` of the world's clock), so a flood of
+for every robot whose trail is on, the end-effector point (``robot.ee_frame``'s origin)
+in the robot's root frame [m] (the world frame for a robot at the world's origin; the
+page draws it under the robot's root) at most once per frame (``1/hz`` of the world's clock), so a flood of
 commands costs one forward kinematics per frame, not one per command, and a move in
 motion leaves its path at frame rate. The latest state of a frame is kept and added
 when the points are read or the next frame is due, so the trail always ends where the
@@ -64,7 +65,7 @@ class RobotTrail:
             self._pending = q
 
     def points(self) -> np.ndarray:
-        """The trail, shape (n, 3), world frame [m], oldest first (a copy)."""
+        """The trail, shape (n, 3), the robot's root frame [m], oldest first (a copy)."""
         self._take_pending()
         return self._points[: self._count].copy()
 
@@ -156,7 +157,7 @@ class TrailKeeper(Observer):
         return list(self.trails)
 
     def points(self, robot: str) -> np.ndarray:
-        """``robot``'s trail, shape (n, 3), world frame [m], oldest first; (0, 3) when off."""
+        """``robot``'s trail, shape (n, 3), its root frame [m], oldest first; (0, 3) when off."""
         trail = self.trails.get(robot)
         return trail.points() if trail is not None else np.empty((0, 3))
 
