@@ -3,11 +3,11 @@
 ``TrailKeeper`` is one per world (``TrailKeeper.of(world)``), an observer that keeps,
 for every robot whose trail is on, the end-effector point (``robot.ee_frame``'s origin)
 in the robot's root frame [m] (the world frame for a robot at the world's origin; the
-page draws it under the robot's root) at most once per frame (``1/hz`` of the world's clock), so a flood of
-commands costs one forward kinematics per frame, not one per command, and a move in
-motion leaves its path at frame rate. The latest state of a frame is kept and added
-when the points are read or the next frame is due, so the trail always ends where the
-arm is.
+page draws it under the robot's root) at most once per frame (``1/hz`` of the world's
+clock), so a flood of commands costs one forward kinematics per frame, not one per
+command, and a move in motion leaves its path at frame rate. The latest state of a frame
+is kept and added when the points are read or the next frame is due, so the trail always
+ends where the arm is.
 
 A trail is bounded: at ``cap`` points it thins its older half (every other point goes)
 instead of growing, so a long trail keeps its whole extent with the recent part dense.
