@@ -307,3 +307,39 @@ def test_a_cell_port_in_use_exits_2(tmp_path: Path, capsys: pytest.CaptureFixtur
         )
         assert main(["--cell", str(write_ini(tmp_path, text)), "--no-viewer"]) == 2
     assert f"cannot listen for commands on 127.0.0.1:{taken}" in capsys.readouterr().err
+
+
+def test_the_seeds_file_plays_on_one_robot_while_another_moves(cell: CellThread, capsys):
+    """The seed's motoman.txt through the player on the left port while a client of the
+    right robot sends `rand` in a loop: each ends where its own commands put it."""
+    from c2rviz import player
+
+    stop = threading.Event()
+    right_answers: list[str] = []
+
+    def busy() -> None:
+        client = Client("127.0.0.1", cell.ports["right"])
+        try:
+            while not stop.is_set():
+                right_answers.append(client.ask("rand"))
+            right_answers.append(client.ask("where"))
+        finally:
+            client.close()
+
+    mover = threading.Thread(target=busy)
+    mover.start()
+    try:
+        motoman = str(ROOT / "commands" / "motoman.txt")
+        assert player.main([motoman, "--port", str(cell.ports["left"]), "--speed", "1000"]) == 0
+    finally:
+        stop.set()
+        mover.join(timeout=60)
+    left = cell.client("left")
+    left.ask("degrees")
+    assert left.ask("where") == "ok -90,-90,0,0,0,0,0"  # the seed script's end pose
+    assert len(right_answers) > 1 and set(right_answers[:-1]) == {"ok"}
+    right_q = cell.call(lambda: cell.world.state("right").q)
+    assert right_answers[-1] == "ok " + ",".join(
+        f"{v:.10g}" if abs(v) > 1e-9 else "0" for v in right_q
+    )
+    assert right_q != load_robot("fanuc_lrmate200id").home
