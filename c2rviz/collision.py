@@ -22,6 +22,7 @@ from collections import Counter
 from collections.abc import Iterable, Sequence
 from itertools import combinations
 from pathlib import Path
+from typing import Any
 
 import coal
 import numpy as np
@@ -339,6 +340,20 @@ class CollisionModel:
             if self.is_free(q):
                 return q
         raise NoFreeConfiguration(self.robot.name, tries)
+
+    def link_shapes(self, q: Sequence[float]) -> list[tuple[str, Any, pin.SE3]]:
+        """Every collision shape of the robot at chain values ``q``: its link, its coal
+        geometry and its placement in the model's root frame (for checks against
+        another robot, ``between.py``)."""
+        geometry = self._geometry
+        data = geometry.createData()
+        pin.updateGeometryPlacements(
+            self.model, self.data, geometry, data, self.robot.configuration(q)
+        )
+        return [
+            (link, obj.geometry, data.oMg[k].copy())
+            for k, (link, obj) in enumerate(zip(self._link_of, geometry.geometryObjects))
+        ]
 
     def links_in(self, pairs: Iterable[Pair]) -> list[str]:
         """The robot links among ``pairs`` (to highlight), sorted."""

@@ -23,6 +23,8 @@ from . import (
     handlers,  # noqa: F401  (registers the handler of every verb)
     replies,
 )
+from .between import first_hit_between
+from .collision import segment
 from .commands import parse_line
 from .config import ServerLimits
 from .errors import C2rvizError, JointLimitError, PathCollides
@@ -129,21 +131,24 @@ class Session:
 
     def check_path(self, q: Sequence[float], path: Sequence[Sequence[float]] = ()) -> None:
         """Refuse ``q`` if it collides, or if any point of the way there does (``path``,
-        else the straight joint-space segment from where the arm is now).
+        else the straight joint-space segment from where the arm is now): with itself,
+        its objects, and the other robots of the world as they stand.
 
         Raises:
             PathCollides: naming the pair and how far along the move.
         """
         model = self.world.collision_model(self.state.name)
-        if self.motion == "off" and not path:
-            hit = None if model.is_free(q) else (1.0, model.colliding(q)[0])
-        elif path:
-            found = model.first_collision(path)
-            hit = None if found is None else (found[0] / max(len(path) - 1, 1), found[1])
+        at_target = self.motion == "off" and not path
+        if at_target:
+            points: Sequence[Sequence[float]] = [q]
         else:
-            hit = model.first_collision_on_segment(self.now(), q)
-        if hit is not None:
-            raise PathCollides(*hit[1], hit[0], self.motion == "off" and not path)
+            points = path or segment(self.robot, self.now(), q)
+        found = model.first_collision(points)
+        if found is None and len(self.world.robots) > 1:
+            found = first_hit_between(self.world, self.state.name, points)
+        if found is not None:
+            index, (first, second) = found
+            raise PathCollides(first, second, index / max(len(points) - 1, 1), at_target)
 
     def joints_run(self, texts: Sequence[str]) -> bool:
         """A run of ``joints`` lines (their value lists) checked as one: with ``motion off``

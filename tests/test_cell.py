@@ -343,3 +343,30 @@ def test_the_seeds_file_plays_on_one_robot_while_another_moves(cell: CellThread,
         f"{v:.10g}" if abs(v) > 1e-9 else "0" for v in right_q
     )
     assert right_q != load_robot("fanuc_lrmate200id").home
+
+
+def test_a_guarded_move_into_the_other_robot_is_refused() -> None:
+    """Two motomans 0.9 m apart: swinging one's arm out towards the other collides."""
+    cell = CellThread(
+        {"a": "motoman_sia20d", "b": "motoman_sia20d"},
+        {"a": se3(0, -0.45, 0, 0, 0, 0), "b": se3(0, 0.45, 0, 0, 0, 0)},
+    )
+    try:
+        a, b = cell.client("a"), cell.client("b")
+        for line in ("degrees", "guard on"):
+            assert a.ask(line) == "ok"
+        reply = a.ask("j 90,90,0,0,0,0,0")  # the arm held out level, towards b
+        assert re.fullmatch(r"error: link_\w+ would hit b/\w+ at the target", reply), reply
+        assert a.ask("where") == "ok 0,0,0,0,0,0,0"
+        assert a.ask("j -90,90,0,0,0,0,0") == "ok"  # away from b: free
+        a.ask("motion on")
+        a.ask("speed 100")
+        reply = a.ask("j 90,90,0,0,0,0,0")  # from -90 through 0 to +90: into b on the way
+        match = re.fullmatch(r"error: link_\w+ would hit b/\w+ at (\d+)% of the move", reply)
+        assert match and 50 <= int(match.group(1)) <= 100, reply
+        assert a.ask("status") == "ok idle"
+        assert b.ask("collisions") == "ok none"  # each robot alone is free
+        a.close()
+        b.close()
+    finally:
+        cell.stop()
