@@ -46,13 +46,21 @@ from viser import _messages
 from viser.infra import ClientId
 
 from ..errors import C2rvizError
-from .door import CAMERA_FIELDS, Door, GuardedConnection, InputCallback
+from .door import (
+    CAMERA_FIELDS,
+    Door,
+    GrabCallback,
+    GuardedConnection,
+    HandleCallback,
+    InputCallback,
+)
 from .policy import DoorPolicy
 
 __all__ = [
     "INTERNALS",
     "WRITTEN_FOR",
     "ViserInternalsError",
+    "accept_handle",
     "accept_input",
     "buffered_messages",
     "check",
@@ -72,7 +80,7 @@ WRITTEN_FOR = "1.1"  # viser versions 1.1.x
 # modules and classes; start() looks at the running server ("server...").
 INTERNALS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("viser._messages", ("SetPositionMessage", "SetOrientationMessage", "GuiUpdateMessage")),
-    ("viser._messages", ("ViewerCameraMessage",)),
+    ("viser._messages", ("ViewerCameraMessage", "TransformControlsUpdateMessage")),
     ("viser._messages.Message", ("excluded_self_client",)),
     ("viser._messages.SetPositionMessage", ("name", "position")),
     ("viser._messages.SetOrientationMessage", ("name", "wxyz")),
@@ -193,7 +201,24 @@ def accept_input(server: viser.ViserServer, handle: Any, callback: InputCallback
     door(server).accept_input(state.uuid, kind, callback)
 
 
-def queue_pose(handle: Any, position: np.ndarray, wxyz: np.ndarray) -> None:
+def accept_handle(
+    server: viser.ViserServer,
+    handle: Any,
+    callback: HandleCallback,
+    grab: GrabCallback | None = None,
+) -> None:
+    """Let the page drag ``handle`` (transform controls) through ``callback``.
+
+    The page's update goes to ``callback(client_id, wxyz, position)`` on
+    viser's thread and nowhere else: viser neither applies it nor shows it to
+    other tabs; a drag's start and end go to ``grab(client_id, held)``. The
+    caller decides where the handle truly stands and sends it with
+    ``queue_pose``.
+    """
+    door(server).accept_handle(handle._impl.name, callback, grab)
+
+
+def queue_pose(handle: Any, position: np.ndarray, wxyz: np.ndarray, force: bool = False) -> None:
     """``handle.position = position; handle.wxyz = wxyz`` for a scene node, cheaply.
 
     Sends only a part that changed, without viser's ``np.allclose`` per setter.
@@ -202,14 +227,16 @@ def queue_pose(handle: Any, position: np.ndarray, wxyz: np.ndarray) -> None:
         handle: A viser scene node handle.
         position: Its new position in its parent's frame [m], shape (3,).
         wxyz: Its new orientation, a unit quaternion (w, x, y, z), shape (4,).
+        force: Send both even if unchanged (a tab shows another pose: a drag
+            the server refused).
     """
     state = handle._impl
-    if (state.position != position).any():
+    if force or (state.position != position).any():
         state.position[:] = position
         state.api._queue_scene_message(
             _messages.SetPositionMessage(state.name, tuple(state.position.tolist()))
         )
-    if (state.wxyz != wxyz).any():
+    if force or (state.wxyz != wxyz).any():
         state.wxyz[:] = wxyz
         state.api._queue_scene_message(
             _messages.SetOrientationMessage(state.name, tuple(state.wxyz.tolist()))

@@ -16,7 +16,10 @@ adapter (``view.adapter``) puts a ``Door`` in front of viser's websocket server:
 * each frame (``screen``), already bounded in size by the server
   (``max_frame_bytes``): a camera update goes on to viser; ``{"value": v}`` for
   an input the viewer registered goes to the viewer's callback and never to
-  viser (which would apply and re-broadcast it); everything else is dropped.
+  viser (which would apply and re-broadcast it); so does a transform-controls
+  update (finite position, unit quaternion) for a handle the viewer
+  registered (its drag start and end are let go quietly); everything else is
+  dropped.
 
 Every refusal is counted in ``refused`` and logged on one line, at most once a
 minute per kind (per origin for origins). This module uses websockets' public
@@ -47,11 +50,22 @@ from ..errors import shown
 from .policy import DoorPolicy
 from .ratelog import RateLimitedLog
 
-__all__ = ["CAMERA_FIELDS", "Door", "GuardedConnection", "InputCallback"]
+__all__ = [
+    "CAMERA_FIELDS",
+    "Door",
+    "GuardedConnection",
+    "GrabCallback",
+    "HandleCallback",
+    "InputCallback",
+]
 
 log = logging.getLogger("c2rviz.view")
 
 InputCallback = Callable[[int, "bool | float"], None]
+HandleCallback = Callable[
+    [int, tuple[float, float, float, float], tuple[float, float, float]], None
+]
+GrabCallback = Callable[[int, bool], None]
 
 
 class _Envelope(msgspec.Struct):
@@ -66,6 +80,20 @@ class _GuiUpdate(msgspec.Struct, forbid_unknown_fields=True):
     type: str
     uuid: str
     updates: _Value
+
+
+class _HandleMove(msgspec.Struct, forbid_unknown_fields=True):
+    type: str
+    name: str
+    wxyz: tuple[float, float, float, float]
+    position: tuple[float, float, float]
+    owner: str = ""
+
+
+class _HandleGrab(msgspec.Struct, forbid_unknown_fields=True):
+    type: str
+    name: str
+    owner: str = ""
 
 
 class _Camera(msgspec.Struct, forbid_unknown_fields=True):
@@ -92,6 +120,10 @@ CAMERA_FIELDS = tuple(f for f in _Camera.__struct_fields__ if f != "type")
 _ENVELOPE = msgspec.msgpack.Decoder(_Envelope)
 _GUI_UPDATE = msgspec.msgpack.Decoder(_GuiUpdate)
 _CAMERA = msgspec.msgpack.Decoder(_Camera)
+_HANDLE_MOVE = msgspec.msgpack.Decoder(_HandleMove)
+_HANDLE_GRAB = msgspec.msgpack.Decoder(_HandleGrab)
+_GRABS = ("TransformControlsDragStartMessage", "TransformControlsDragEndMessage")
+UNIT_TOLERANCE = 1e-3  # how far a handle's quaternion's norm may be from 1
 
 
 def _is_page(path: str) -> bool:
@@ -126,7 +158,7 @@ class Door:
             (``viser-v<version>``); a page of another viser version is refused.
         refused: Refusals so far, by kind: ``origin``, ``token``, ``version``,
             ``full`` (handshakes); ``frame``, ``message``, ``share``, ``upload``,
-            ``input``, ``oversize`` (frames); ``handler``, ``lagging``.
+            ``input``, ``handle``, ``oversize`` (frames); ``handler``, ``lagging``.
         connections: Every websocket being handled, admitted or being refused.
         clients: The admitted websockets, each with the door's own number.
         identify: Maps an admitted websocket to the client id handed to input
@@ -150,6 +182,7 @@ class Door:
         self.identify: Callable[[ServerConnection], int] = lambda c: self.clients.get(c, -1)
         self._serial = 0
         self._inputs: dict[str, _Input] = {}
+        self._handles: dict[str, tuple[HandleCallback, GrabCallback | None]] = {}
         self.host = host
         self._log = RateLimitedLog(log, policy.log_interval_s, clock)
         self.page_title: str | None = None
@@ -170,6 +203,18 @@ class Door:
 
     def forget_input(self, uuid: str) -> None:
         self._inputs.pop(uuid, None)
+
+    def accept_handle(
+        self, name: str, callback: HandleCallback, grab: GrabCallback | None = None
+    ) -> None:
+        """Hand a transform-controls update of node ``name`` to ``callback``.
+
+        ``callback(client_id, wxyz, position)`` gets a unit quaternion and a
+        position [m] (finite), in the node's parent's frame; ``grab(client_id,
+        held)`` is told a drag's start (True) and end (False). Both run on
+        viser's thread and must return at once.
+        """
+        self._handles[name] = (callback, grab)
 
     # the opening handshake (viser's event loop)
 
@@ -284,6 +329,10 @@ class Door:
             return None
         if kind == "GuiUpdateMessage":
             self._input(connection, frame)
+        elif kind == "TransformControlsUpdateMessage":
+            self._handle(connection, frame)
+        elif kind in _GRABS:
+            self._grab(connection, frame)
         elif kind in _REFUSED:
             self._drop(*_REFUSED[kind])
         elif kind != "ViewerCameraMessage":
@@ -316,6 +365,45 @@ class Door:
         except Exception as error:
             self._log.warning("callback", f"viewer input callback failed: {error!r}")
             log.debug("viewer input callback", exc_info=True)
+
+    def _handle(self, connection: ServerConnection, frame: bytes) -> None:
+        try:
+            move = _HANDLE_MOVE.decode(frame)
+        except msgspec.MsgspecError:
+            self._drop("handle", "a malformed transform-controls update")
+            return
+        target = self._handles.get(move.name)
+        if target is None:
+            self._drop("handle", f"a drag of {shown(move.name)}, not one of the page's handles")
+            return
+        numbers = (*move.wxyz, *move.position)
+        if not all(map(math.isfinite, numbers)):
+            self._drop("handle", "a drag to a pose that is not finite")
+            return
+        if abs(math.sqrt(sum(c * c for c in move.wxyz)) - 1.0) > UNIT_TOLERANCE:
+            self._drop("handle", "a drag to an orientation that is not a unit quaternion")
+            return
+        self._call(target[0], self.identify(connection), move.wxyz, move.position)
+
+    def _grab(self, connection: ServerConnection, frame: bytes) -> None:
+        try:
+            grab = _HANDLE_GRAB.decode(frame)
+        except msgspec.MsgspecError:
+            self._drop("handle", "a malformed drag start or end")
+            return
+        target = self._handles.get(grab.name)
+        if target is None:
+            self._drop("handle", "a drag start or end that is not of one of the page's handles")
+        elif target[1] is not None:
+            held = grab.type == _GRABS[0]
+            self._call(target[1], self.identify(connection), held)
+
+    def _call(self, callback: Callable[..., None], *args: Any) -> None:
+        try:
+            callback(*args)
+        except Exception as error:
+            self._log.warning("callback", f"viewer handle callback failed: {error!r}")
+            log.debug("viewer handle callback", exc_info=True)
 
     def _drop(self, kind: str, what: str) -> None:
         self.refuse(kind, kind, f"dropped {what} from a viewer page")

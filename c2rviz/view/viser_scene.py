@@ -24,6 +24,7 @@ from collections import deque
 from collections.abc import Sequence
 
 import numpy as np
+import pinocchio as pin
 
 from ..scene import Marker, Scene
 from ..session import Session
@@ -32,6 +33,7 @@ from ..visuals import LinkGeometry, load_link_geometry
 from ..workcell import WorkcellObject
 from ..world import World
 from . import adapter
+from .handle import ToolHandles
 from .markers import MarkerLayer
 from .page_input import PageInput
 from .panel import RECENT_COMMANDS, RobotPanel, StatePanel
@@ -62,6 +64,7 @@ class ViserScene(Scene):
         markers: Every robot's markers.
         workcells: Each robot's workcell objects and red collisions, by name.
         trails: Every robot's trail.
+        handles: A draggable handle on each robot's tool point.
         state_panel: TCP clients, last commands, the collision checkbox.
         page_input: What the page's controls run.
         scheduler: When sends go out.
@@ -137,6 +140,7 @@ class ViserScene(Scene):
         self.markers = MarkerLayer(server, segments)
         self.workcells = {name: WorkcellLayer(server, view) for name, view in self.views.items()}
         self.trails = TrailLayer(server, segments)
+        self.handles = ToolHandles(server, segments, self.scheduler.request)
         self._frame_camera()
         self.page_input = PageInput(server)
         self.panels: dict[str, RobotPanel] = {}
@@ -148,6 +152,7 @@ class ViserScene(Scene):
             self.sessions[name] = session
             self.panels[name] = RobotPanel(server.gui, state, session.speed)
             self.page_input.add_robot(self.panels[name], session)
+            self.handles.bind(name, session)
         self.state_panel = StatePanel(server.gui)
         self.page_input.add_toggle(self.state_panel.collision, self._show_collision)
         for name, state in world.robots.items():
@@ -194,6 +199,10 @@ class ViserScene(Scene):
         self._state_dirty = True
         self.scheduler.request()
 
+    def on_tool(self, robot: str, tool: pin.SE3) -> None:
+        self._dirty.add(robot)
+        self.scheduler.request()
+
     def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
         self._objects[robot] = list(objects)
         self.scheduler.request()
@@ -210,6 +219,7 @@ class ViserScene(Scene):
             raise ValueError("a ViserScene shows the world it was made with")
         self._loop = loop
         self.page_input.start(loop)
+        self.handles.start(loop)
         self._dirty.update(world.robots)
         self.scheduler.start(loop)
 
@@ -220,6 +230,7 @@ class ViserScene(Scene):
         self._stopped = True
         self.scheduler.stop()
         self.page_input.stop()
+        self.handles.stop()
         adapter.stop(self.server, timeout_s=STOP_TIMEOUT_S)
 
     # what tests and benchmarks read
@@ -262,6 +273,9 @@ class ViserScene(Scene):
                 view.show_target(state.target if moving else None)
                 panel.show_joints(state.target, busy)
                 panel.show_motion(moving, world.travels.seconds_left(state))
+            for name in self._dirty | self.handles.due():
+                if name in world.robots:
+                    self.handles.draw(world.robots[name])
             self._dirty.clear()
             self.markers.draw()
             self._draw_workcells()
