@@ -46,20 +46,15 @@ from viser import _messages
 from viser.infra import ClientId
 
 from ..errors import C2rvizError
-from .door import (
-    CAMERA_FIELDS,
-    Door,
-    GrabCallback,
-    GuardedConnection,
-    HandleCallback,
-    InputCallback,
-)
+from .door import Door, GrabCallback, GuardedConnection, HandleCallback, InputCallback
+from .frames import CAMERA_FIELDS, Click
 from .policy import DoorPolicy
 
 __all__ = [
     "INTERNALS",
     "WRITTEN_FOR",
     "ViserInternalsError",
+    "accept_click",
     "accept_handle",
     "accept_input",
     "buffered_messages",
@@ -141,11 +136,13 @@ def missing_internals(server: viser.ViserServer | None = None) -> list[str]:
         for name in names
         if not _has(_resolve(where, server), name)
     ]
-    camera = _resolve("viser._messages.ViewerCameraMessage")
-    if dataclasses.is_dataclass(camera):
-        fields = {f.name for f in dataclasses.fields(camera) if f.init}
-        if fields != set(CAMERA_FIELDS):
-            missing.append(f"viser._messages.ViewerCameraMessage fields {sorted(CAMERA_FIELDS)}")
+    read = {"ViewerCameraMessage": CAMERA_FIELDS, "SceneNodeClickMessage": Click.__struct_fields__}
+    for name, fields in read.items():
+        message, expected = _resolve(f"viser._messages.{name}"), set(fields) - {"type"}
+        if dataclasses.is_dataclass(message) and expected != {
+            f.name for f in dataclasses.fields(message) if f.init
+        }:
+            missing.append(f"viser._messages.{name} fields {sorted(expected)}")
     return missing
 
 
@@ -216,6 +213,19 @@ def accept_handle(
     ``queue_pose``.
     """
     door(server).accept_handle(handle._impl.name, callback, grab)
+
+
+def accept_click(
+    server: viser.ViserServer, node: Any, callback: Callable[[int, int | None], None]
+) -> None:
+    """Let the page click ``node`` (a scene node): ``callback(client_id, instance_index)``.
+
+    The door lets a well-formed click on ``node`` on to viser, which calls
+    ``callback`` on its thread pool with viser's client id and the clicked
+    instance of a batched node (None for a plain node).
+    """
+    door(server).accept_click(node._impl.name)
+    node.on_click(lambda event: callback(int(event.client_id), event.instance_index))
 
 
 def queue_pose(handle: Any, position: np.ndarray, wxyz: np.ndarray, force: bool = False) -> None:

@@ -18,8 +18,9 @@ adapter (``view.adapter``) puts a ``Door`` in front of viser's websocket server:
   an input the viewer registered goes to the viewer's callback and never to
   viser (which would apply and re-broadcast it); so does a transform-controls
   update (finite position, unit quaternion) for a handle the viewer
-  registered (its drag start and end are let go quietly); everything else is
-  dropped.
+  registered (its drag start and end are let go quietly); a click (finite
+  ray) on a node the viewer made clickable goes on to viser, which calls the
+  node's click callback; everything else is dropped (``frames`` reads them).
 
 Every refusal is counted in ``refused`` and logged on one line, at most once a
 minute per kind (per origin for origins). This module uses websockets' public
@@ -40,18 +41,17 @@ from http import HTTPStatus
 from typing import Any
 from urllib.parse import unquote, urlsplit
 
-import msgspec
 from websockets.asyncio.server import ServerConnection
 from websockets.exceptions import ConnectionClosed
 from websockets.frames import CloseCode
 from websockets.http11 import Request, Response
 
 from ..errors import shown
+from . import frames
 from .policy import DoorPolicy
 from .ratelog import RateLimitedLog
 
 __all__ = [
-    "CAMERA_FIELDS",
     "Door",
     "GuardedConnection",
     "GrabCallback",
@@ -68,78 +68,11 @@ HandleCallback = Callable[
 GrabCallback = Callable[[int, bool], None]
 
 
-class _Envelope(msgspec.Struct):
-    type: str
-
-
-class _Value(msgspec.Struct, forbid_unknown_fields=True):
-    value: bool | float
-
-
-class _GuiUpdate(msgspec.Struct, forbid_unknown_fields=True):
-    type: str
-    uuid: str
-    updates: _Value
-
-
-class _HandleMove(msgspec.Struct, forbid_unknown_fields=True):
-    type: str
-    name: str
-    wxyz: tuple[float, float, float, float]
-    position: tuple[float, float, float]
-    owner: str = ""
-
-
-class _HandleGrab(msgspec.Struct, forbid_unknown_fields=True):
-    type: str
-    name: str
-    owner: str = ""
-
-
-class _Camera(msgspec.Struct, forbid_unknown_fields=True):
-    type: str
-    wxyz: tuple[float, float, float, float]
-    position: tuple[float, float, float]
-    fov: float
-    near: float
-    far: float
-    image_height: int
-    image_width: int
-    look_at: tuple[float, float, float]
-    up_direction: tuple[float, float, float]
-
-
-# Messages a page of this viser version sends but the viewer refuses: (kind, what).
-_REFUSED = {
-    "ShareUrlRequest": ("share", "a share-link request (the public tunnel is disabled)"),
-    "ShareUrlDisconnect": ("share", "a share-link request (the public tunnel is disabled)"),
-    "FileTransferStartUpload": ("upload", "a file upload (the viewer takes none)"),
-    "FileTransferPart": ("upload", "a file upload (the viewer takes none)"),
-}
-CAMERA_FIELDS = tuple(f for f in _Camera.__struct_fields__ if f != "type")
-_ENVELOPE = msgspec.msgpack.Decoder(_Envelope)
-_GUI_UPDATE = msgspec.msgpack.Decoder(_GuiUpdate)
-_CAMERA = msgspec.msgpack.Decoder(_Camera)
-_HANDLE_MOVE = msgspec.msgpack.Decoder(_HandleMove)
-_HANDLE_GRAB = msgspec.msgpack.Decoder(_HandleGrab)
-_GRABS = ("TransformControlsDragStartMessage", "TransformControlsDragEndMessage")
-UNIT_TOLERANCE = 1e-3  # how far a handle's quaternion's norm may be from 1
-
-
 def _is_page(path: str) -> bool:
     """Whether viser answers the request target ``path`` with the page (index.html)."""
     text = unquote(urlsplit(path).path).replace("\\", "/")
     segments = [s for s in text.split("/") if s and s != "."]
     return "/".join(segments) in ("", "index.html")
-
-
-def _camera_ok(frame: bytes) -> bool:
-    try:
-        c = _CAMERA.decode(frame)
-    except msgspec.MsgspecError:
-        return False
-    numbers = (*c.wxyz, *c.position, c.fov, c.near, c.far, *c.look_at, *c.up_direction)
-    return all(map(math.isfinite, numbers))
 
 
 @dataclass(frozen=True)
@@ -158,7 +91,7 @@ class Door:
             (``viser-v<version>``); a page of another viser version is refused.
         refused: Refusals so far, by kind: ``origin``, ``token``, ``version``,
             ``full`` (handshakes); ``frame``, ``message``, ``share``, ``upload``,
-            ``input``, ``handle``, ``oversize`` (frames); ``handler``, ``lagging``.
+            ``input``, ``handle``, ``click``, ``oversize`` (frames); ``handler``, ``lagging``.
         connections: Every websocket being handled, admitted or being refused.
         clients: The admitted websockets, each with the door's own number.
         identify: Maps an admitted websocket to the client id handed to input
@@ -183,6 +116,7 @@ class Door:
         self._serial = 0
         self._inputs: dict[str, _Input] = {}
         self._handles: dict[str, tuple[HandleCallback, GrabCallback | None]] = {}
+        self._clickable: set[str] = set()
         self.host = host
         self._log = RateLimitedLog(log, policy.log_interval_s, clock)
         self.page_title: str | None = None
@@ -215,6 +149,10 @@ class Door:
         viser's thread and must return at once.
         """
         self._handles[name] = (callback, grab)
+
+    def accept_click(self, name: str) -> None:
+        """Let a click on node ``name`` (finite, an instance index or none) on to viser."""
+        self._clickable.add(name)
 
     # the opening handshake (viser's event loop)
 
@@ -319,36 +257,33 @@ class Door:
 
     def screen(self, connection: ServerConnection, frame: str | bytes) -> bytes | None:
         """Return a frame viser may read, or None after handling or dropping it."""
-        if isinstance(frame, str):
-            self._drop("frame", "a text frame")
-            return None
         try:
-            kind = _ENVELOPE.decode(frame).type
-        except msgspec.MsgspecError:
-            self._drop("frame", "a frame that is not a viser message")
-            return None
-        if kind == "GuiUpdateMessage":
-            self._input(connection, frame)
-        elif kind == "TransformControlsUpdateMessage":
-            self._handle(connection, frame)
-        elif kind in _GRABS:
-            self._grab(connection, frame)
-        elif kind in _REFUSED:
-            self._drop(*_REFUSED[kind])
-        elif kind != "ViewerCameraMessage":
-            self._drop("message", f"a {shown(kind)} message (the viewer does not take it)")
-        elif _camera_ok(frame):
-            return frame
-        else:
-            self._drop("message", "a camera update that is malformed or not finite")
+            kind = frames.read_type(frame)
+            assert isinstance(frame, bytes)
+            if kind == "GuiUpdateMessage":
+                self._input(connection, frames.read_input(frame))
+            elif kind == "TransformControlsUpdateMessage":
+                self._handle(connection, frames.read_move(frame))
+            elif kind in frames.GRABS:
+                self._grab(connection, frames.read_grab(frame))
+            elif kind == frames.CLICK:
+                name = frames.read_click(frame).name
+                if name in self._clickable:
+                    return frame
+                self._drop("click", f"a click on {shown(name)}, not one the page may click")
+            elif kind in frames.REFUSED:
+                self._drop(*frames.REFUSED[kind])
+            elif kind != "ViewerCameraMessage":
+                self._drop("message", f"a {shown(kind)} message (the viewer does not take it)")
+            elif frames.camera_ok(frame):
+                return frame
+            else:
+                self._drop("message", "a camera update that is malformed or not finite")
+        except frames.Dropped as dropped:
+            self._drop(dropped.kind, dropped.what)
         return None
 
-    def _input(self, connection: ServerConnection, frame: bytes) -> None:
-        try:
-            update = _GUI_UPDATE.decode(frame)
-        except msgspec.MsgspecError:
-            self._drop("input", "an input update other than {'value': a number or true/false}")
-            return
+    def _input(self, connection: ServerConnection, update: frames.GuiUpdate) -> None:
         target = self._inputs.get(update.uuid)
         value = update.updates.value
         if target is None:
@@ -360,50 +295,29 @@ class Door:
         if target.kind is float and (isinstance(value, bool) or not math.isfinite(value)):
             self._drop("input", f"{value!r} for a slider (a finite number is needed)")
             return
-        try:
-            target.callback(self.identify(connection), value)
-        except Exception as error:
-            self._log.warning("callback", f"viewer input callback failed: {error!r}")
-            log.debug("viewer input callback", exc_info=True)
+        self._call(target.callback, self.identify(connection), value)
 
-    def _handle(self, connection: ServerConnection, frame: bytes) -> None:
-        try:
-            move = _HANDLE_MOVE.decode(frame)
-        except msgspec.MsgspecError:
-            self._drop("handle", "a malformed transform-controls update")
-            return
+    def _handle(self, connection: ServerConnection, move: frames.HandleMove) -> None:
         target = self._handles.get(move.name)
         if target is None:
             self._drop("handle", f"a drag of {shown(move.name)}, not one of the page's handles")
             return
-        numbers = (*move.wxyz, *move.position)
-        if not all(map(math.isfinite, numbers)):
-            self._drop("handle", "a drag to a pose that is not finite")
-            return
-        if abs(math.sqrt(sum(c * c for c in move.wxyz)) - 1.0) > UNIT_TOLERANCE:
-            self._drop("handle", "a drag to an orientation that is not a unit quaternion")
-            return
         self._call(target[0], self.identify(connection), move.wxyz, move.position)
 
-    def _grab(self, connection: ServerConnection, frame: bytes) -> None:
-        try:
-            grab = _HANDLE_GRAB.decode(frame)
-        except msgspec.MsgspecError:
-            self._drop("handle", "a malformed drag start or end")
-            return
+    def _grab(self, connection: ServerConnection, grab: frames.HandleGrab) -> None:
         target = self._handles.get(grab.name)
         if target is None:
             self._drop("handle", "a drag start or end that is not of one of the page's handles")
         elif target[1] is not None:
-            held = grab.type == _GRABS[0]
+            held = grab.type == frames.GRABS[0]
             self._call(target[1], self.identify(connection), held)
 
     def _call(self, callback: Callable[..., None], *args: Any) -> None:
         try:
             callback(*args)
         except Exception as error:
-            self._log.warning("callback", f"viewer handle callback failed: {error!r}")
-            log.debug("viewer handle callback", exc_info=True)
+            self._log.warning("callback", f"viewer callback failed: {error!r}")
+            log.debug("viewer callback", exc_info=True)
 
     def _drop(self, kind: str, what: str) -> None:
         self.refuse(kind, kind, f"dropped {what} from a viewer page")
