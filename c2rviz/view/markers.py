@@ -11,6 +11,8 @@ update per node whatever the number of markers sent.
 
 from __future__ import annotations
 
+import functools
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -19,6 +21,7 @@ import viser
 
 from ..commands import MARKER_SHAPES
 from ..scene import MAX_MARKERS, Marker
+from . import adapter
 from .robot_view import node_name
 
 __all__ = ["MARKER_SIZE_M", "MarkerLayer", "marker_mesh"]
@@ -58,6 +61,7 @@ class _Ring:
         self.wxyzs = np.zeros((MAX_MARKERS, 4), dtype=np.float32)
         self.colors = np.zeros((MAX_MARKERS, 3), dtype=np.uint8)
         self.shapes = np.zeros(MAX_MARKERS, dtype=np.int8)
+        self.markers: list[Marker | None] = [None] * MAX_MARKERS
         self.count = 0
         self.next = 0
         self.dirty = False
@@ -70,10 +74,22 @@ class MarkerLayer:
         nodes: The batched-mesh node of each (robot, shape) drawn so far.
     """
 
-    def __init__(self, server: viser.ViserServer, segments: dict[str, str]) -> None:
-        """Draw in ``server``'s scene; ``segments`` names each robot's node segment."""
+    def __init__(
+        self,
+        server: viser.ViserServer,
+        segments: dict[str, str],
+        pick: Callable[[str, str, int], None] | None = None,
+    ) -> None:
+        """Draw in ``server``'s scene; ``segments`` names each robot's node segment.
+
+        ``pick(robot, shape, instance)`` is told of a click on a marker, on
+        viser's thread (``marker_at`` finds it, on the asyncio thread).
+        """
+        self._server = server
         self._scene = server.scene
         self._segments = segments
+        self._pick = pick
+        self._instances: dict[tuple[str, str], np.ndarray] = {}  # slot of each drawn instance
         self._rings: dict[str, _Ring] = {}
         self._shape_index = {shape: k for k, shape in enumerate(MARKER_SHAPES)}
         self._meshes = {shape: marker_mesh(shape) for shape in MARKER_SHAPES}
@@ -90,6 +106,7 @@ class MarkerLayer:
         ring.wxyzs[slot] = marker.wxyz
         ring.colors[slot] = [round(c * 255.0) for c in marker.rgb]
         ring.shapes[slot] = self._shape_index.get(marker.shape, 0)
+        ring.markers[slot] = marker
         ring.next = (slot + 1) % MAX_MARKERS
         ring.count = min(ring.count + 1, MAX_MARKERS)
         ring.dirty = self.dirty = True
@@ -99,12 +116,21 @@ class MarkerLayer:
         ring = self._rings.get(robot)
         if ring is not None and ring.count:
             ring.count = ring.next = 0
+            ring.markers = [None] * MAX_MARKERS
             ring.dirty = self.dirty = True
 
     def count(self, robot: str | None = None) -> int:
         """Markers held for ``robot`` (None: for every robot)."""
         rings = self._rings.values() if robot is None else [self._rings.get(robot)]
         return sum(ring.count for ring in rings if ring is not None)
+
+    def marker_at(self, robot: str, shape: str, instance: int) -> Marker | None:
+        """The marker drawn as ``instance`` of ``robot``'s ``shape`` node, if it is still held."""
+        slots = self._instances.get((robot, shape))
+        ring = self._rings.get(robot)
+        if slots is None or ring is None or not 0 <= instance < len(slots):
+            return None
+        return ring.markers[int(slots[instance])]
 
     def draw(self) -> None:
         """Hand each changed robot's markers to its nodes (once per frame, in a send)."""
@@ -127,6 +153,7 @@ class MarkerLayer:
         positions = ring.positions[chosen]
         wxyzs = ring.wxyzs[chosen]
         colors = ring.colors[chosen]
+        self._instances[robot, shape] = chosen
         if node is None:
             mesh = self._meshes[shape]
             self.nodes[robot, shape] = self._scene.add_batched_meshes_simple(
@@ -139,8 +166,15 @@ class MarkerLayer:
                 lod="off",
                 cast_shadow=False,
             )
+            if self._pick is not None:
+                clicked = functools.partial(self._clicked, robot, shape)
+                adapter.accept_click(self._server, self.nodes[robot, shape], clicked)
             return
         node.batched_positions = positions
         node.batched_wxyzs = wxyzs
         node.batched_colors = colors
         node.visible = bool(len(chosen))
+
+    def _clicked(self, robot: str, shape: str, client: int, instance: int | None) -> None:
+        if instance is not None and self._pick is not None:
+            self._pick(robot, shape, instance)

@@ -5,13 +5,16 @@ becomes ``move 1 30.0`` on that robot's page session (source ``page``,
 degrees mode), the Home / Random / Stop buttons ``home`` / ``rand`` /
 ``stop``, the speed slider ``speed 40.0``, the Trail checkbox ``trail on`` /
 ``trail off``. The session checks them; a refused
-value is sent back to the tab as the true one.
+value is sent back to the tab as the true one. A click on a marker chooses it
+in its robot's folder; "Go to marker" then runs ``moveto marker N`` (N: where
+the chosen marker stands now among the robot's markers).
 
 viser's door (``adapter.accept_input``) hands each value to a callback on
 viser's thread and nowhere else. Here the callback only records the newest
 value of its control and, if none was waiting, asks the asyncio loop to run
 it: however fast a page sends, a control costs the loop at most one command
 per loop turn (the latest value wins; a click while one waits adds nothing).
+Marker clicks come the same way, one per robot per loop turn.
 """
 
 from __future__ import annotations
@@ -21,15 +24,16 @@ import contextlib
 import functools
 import logging
 import threading
-from collections.abc import Callable
+from collections.abc import Awaitable, Callable
 from typing import Any
 
 import viser
 
-from ..errors import C2rvizError
+from ..errors import C2rvizError, MotionInterrupted
 from ..session import Session
 from ..trail import TrailKeeper
 from . import adapter
+from .markers import MarkerLayer
 from .panel import RobotPanel
 from .ratelog import RateLimitedLog
 
@@ -38,6 +42,7 @@ __all__ = ["PageInput"]
 log = logging.getLogger("c2rviz.view")
 
 Apply = Callable[[int, Any], None]
+GONE = "the chosen marker is gone (cleared, or past the newest markers kept)"
 
 
 class PageInput:
@@ -45,15 +50,19 @@ class PageInput:
 
     Attributes:
         refused: Page commands the sessions refused so far.
+        picks: Marker clicks run so far (clicks that came while one waited count once).
     """
 
-    def __init__(self, server: viser.ViserServer) -> None:
+    def __init__(self, server: viser.ViserServer, markers: MarkerLayer) -> None:
         self._server = server
+        self._markers = markers
+        self._panels: dict[str, RobotPanel] = {}
         self._loop: asyncio.AbstractEventLoop | None = None
         self._lock = threading.Lock()
-        self._pending: dict[int, tuple[Apply, int, Any]] = {}
+        self._pending: dict[Any, tuple[Apply, int, Any]] = {}
         self._log = RateLimitedLog(log)
         self.refused = 0
+        self.picks = 0
 
     def start(self, loop: asyncio.AbstractEventLoop) -> None:
         """Run page input on ``loop`` from now on (earlier input is dropped)."""
@@ -73,6 +82,8 @@ class PageInput:
         for line, button in panel.buttons.items():
             self._bind(button, functools.partial(self._click, session, line))
         self._bind(panel.trail, functools.partial(self._trail, panel, session))
+        self._bind(panel.goto, functools.partial(self._goto, panel, session))
+        self._panels[session.state.name] = panel
 
     def add_toggle(self, checkbox: Any, on_change: Callable[[bool], None]) -> None:
         """Bind a checkbox: ``on_change(shown)``, then every tab shows the value."""
@@ -89,25 +100,28 @@ class PageInput:
 
     # viser's thread: record, and wake the loop once
 
+    def pick(self, robot: str, shape: str, instance: int) -> None:
+        """A click on ``instance`` of ``robot``'s ``shape`` markers (``MarkerLayer``'s pick)."""
+        self._arrived(("pick", robot), self._picked, 0, (robot, shape, instance))
+
     def _bind(self, handle: Any, apply: Apply) -> None:
-        key = id(handle)
-
-        def arrived(client: int, value: bool | float) -> None:
-            loop = self._loop
-            if loop is None:
-                return
-            with self._lock:
-                first = key not in self._pending
-                self._pending[key] = (apply, client, value)
-            if first:
-                with contextlib.suppress(RuntimeError):  # the loop is closed: we stop
-                    loop.call_soon_threadsafe(self._run, key)
-
+        arrived = functools.partial(self._arrived, id(handle), apply)
         adapter.accept_input(self._server, handle, arrived)
+
+    def _arrived(self, key: Any, apply: Apply, client: int, value: Any) -> None:
+        loop = self._loop
+        if loop is None:
+            return
+        with self._lock:
+            first = key not in self._pending
+            self._pending[key] = (apply, client, value)
+        if first:
+            with contextlib.suppress(RuntimeError):  # the loop is closed: we stop
+                loop.call_soon_threadsafe(self._run, key)
 
     # the asyncio thread
 
-    def _run(self, key: int) -> None:
+    def _run(self, key: Any) -> None:
         with self._lock:
             apply, client, value = self._pending.pop(key)
         if self._loop is not None:
@@ -128,24 +142,53 @@ class PageInput:
         if value is True:
             self._line(session, line)
 
+    def _picked(self, client: int, where: tuple[str, str, int]) -> None:
+        robot, shape, instance = where
+        self.picks += 1
+        marker = self._markers.marker_at(robot, shape, instance)
+        panel = self._panels.get(robot)
+        if marker is not None and panel is not None:
+            panel.choose(marker)
+            self._server.flush()
+
+    def _goto(self, panel: RobotPanel, session: Session, client: int, value: Any) -> None:
+        chosen = panel.chosen
+        if value is not True or chosen is None:
+            return
+        markers = session.state.markers
+        number = next((n for n, m in enumerate(markers, start=1) if m is chosen), None)
+        if number is None:
+            self._refuse("Go to marker", C2rvizError(GONE))
+            panel.choose(None)
+            return
+        self._line(session, f"moveto marker {number}")
+
     def _trail(self, panel: RobotPanel, session: Session, client: int, value: Any) -> None:
         self._line(session, "trail on" if value is True else "trail off")
         on = session.state.name in TrailKeeper.of(session.world).trails
         adapter.set_gui_value(panel.trail, on, force=True)
 
     def _line(self, session: Session, line: str) -> bool:
-        """Run ``line`` on ``session``; whether it was accepted."""
+        """Run ``line`` on ``session``; whether it was accepted (a later reply: so far)."""
         try:
             reply = session.run(line)
         except C2rvizError as exc:
-            self.refused += 1
-            self._log.warning("refused", f"refused from the page: {line}: {exc}")
+            self._refuse(line, exc)
             return False
-        if asyncio.isfuture(reply):  # a reply that comes later: the page does not wait
-            reply.add_done_callback(_consume)
+        if isinstance(reply, Awaitable):  # a reply that comes later: the page does not wait
+            future = asyncio.ensure_future(reply)
+            future.add_done_callback(functools.partial(self._answered, line))
         return True
 
+    def _answered(self, line: str, future: asyncio.Future[Any]) -> None:
+        error = None if future.cancelled() else future.exception()
+        if isinstance(error, MotionInterrupted):
+            return  # a newer move took over, or a stop: the page's moves replace each other
+        if isinstance(error, C2rvizError):
+            self._refuse(line, error)
+        elif error is not None:
+            self._log.warning("failed", f"a page command failed: {line}: {error!r}")
 
-def _consume(future: asyncio.Future[Any]) -> None:
-    if not future.cancelled():
-        future.exception()  # retrieved: no "exception never retrieved" at exit
+    def _refuse(self, line: str, error: C2rvizError) -> None:
+        self.refused += 1
+        self._log.warning("refused", f"refused from the page: {line}: {error}")

@@ -3,7 +3,8 @@
 Each robot's folder (headed by its name in the world) holds a slider per
 joint (degrees, metres for a prismatic joint), a speed slider for the page's
 own moves, Home / Random / Stop buttons, the end effector's pose and the
-motion status, a Trail checkbox and the colliding pairs. The ``State`` folder
+motion status, a Trail checkbox, the colliding pairs, and the marker last
+clicked in the scene with a "Go to marker" button. The ``State`` folder
 shows the TCP client count and the last commands, newest first, a refused
 one marked so; a checkbox shows the collision geometry.
 
@@ -23,6 +24,7 @@ import numpy as np
 import pinocchio as pin
 import viser
 
+from ..scene import Marker
 from ..world import RobotState
 from . import adapter
 
@@ -32,6 +34,7 @@ RECENT_COMMANDS = 8  # lines kept for the 'last commands' readout
 SHOWN_LINE_CHARS = 80
 MAX_LABEL_CHARS = 13  # what fits on one line beside a slider in a folder
 REJECTED = "  [rejected]"
+NO_MARKER = "click one in the scene"
 _AFFIXES = ("_joint", "joint_", "_jnt")
 
 
@@ -56,6 +59,9 @@ class RobotPanel:
         motion: ``idle`` or ``moving, 1.20 s left``.
         trail: The Trail checkbox (runs ``trail on`` / ``trail off``).
         collisions: The colliding pairs readout.
+        marker: The readout of the marker clicked last (``chosen``).
+        goto: The "Go to marker" button (runs ``moveto marker N``).
+        chosen: The marker clicked last, until it is gone.
     """
 
     def __init__(self, gui: viser.GuiApi, state: RobotState, speed: float) -> None:
@@ -116,6 +122,15 @@ class RobotPanel:
             self.collisions: Any = gui.add_text(
                 "Collisions", "none", disabled=True, hint="colliding pairs, link~object"
             )
+            self.marker: Any = gui.add_text(
+                "Marker", NO_MARKER, disabled=True, hint="the marker clicked last (world frame)"
+            )
+            self.goto: Any = gui.add_button(
+                "Go to marker",
+                disabled=True,
+                hint="move the tool to the marker clicked last (moveto marker N)",
+            )
+        self.chosen: Marker | None = None
 
     def to_slider(self, index: int, value: float) -> float:
         """Joint value [rad or m] in slider units (deg or m), within the slider's range."""
@@ -160,6 +175,16 @@ class RobotPanel:
     def show_collisions(self, pairs: Sequence[tuple[str, str]]) -> None:
         """The colliding pairs, ``a~b, c~d``; ``none`` when there are none."""
         self.collisions.value = ", ".join(f"{a}~{b}" for a, b in pairs) or "none"
+
+    def choose(self, marker: Marker | None) -> None:
+        """``marker`` is the one clicked last (None: none, or it is gone)."""
+        self.chosen = marker
+        self.goto.disabled = marker is None
+        if marker is None:
+            self.marker.value = NO_MARKER
+        else:
+            x, y, z = (round(float(v), 3) + 0.0 for v in marker.position)
+            self.marker.value = f"x {x:+.3f}  y {y:+.3f}  z {z:+.3f} m"
 
     def show_trail(self, on: bool) -> None:
         """The Trail checkbox to ``on`` (set by a ``trail`` line from anywhere)."""

@@ -137,12 +137,12 @@ class ViserScene(Scene):
                 geometry[id(state.robot)] = load_link_geometry(state.robot.source)
             shapes = geometry[id(state.robot)]
             self.views[name] = RobotView(server, name, state.robot, state.origin, shapes, segment)
-        self.markers = MarkerLayer(server, segments)
+        self.markers = MarkerLayer(server, segments, self._pick)
         self.workcells = {name: WorkcellLayer(server, view) for name, view in self.views.items()}
         self.trails = TrailLayer(server, segments)
         self.handles = ToolHandles(server, segments, self.scheduler.request)
         self._frame_camera()
-        self.page_input = PageInput(server)
+        self.page_input = PageInput(server, self.markers)
         self.panels: dict[str, RobotPanel] = {}
         self.sessions: dict[str, Session] = {}
         for name, state in world.robots.items():
@@ -187,6 +187,9 @@ class ViserScene(Scene):
 
     def on_clear_markers(self, robot: str) -> None:
         self.markers.clear(robot)
+        panel = self.panels.get(robot)
+        if panel is not None and panel.chosen is not None:
+            panel.choose(None)
         self.scheduler.request()
 
     def on_clients(self, count: int) -> None:
@@ -210,6 +213,10 @@ class ViserScene(Scene):
     def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
         self._collisions[robot] = list(pairs)
         self.scheduler.request()
+
+    def _pick(self, robot: str, shape: str, instance: int) -> None:
+        """A marker clicked in a page (viser's thread): chosen in its robot's folder."""
+        self.page_input.pick(robot, shape, instance)
 
     # lifecycle
 
