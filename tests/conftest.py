@@ -32,6 +32,15 @@ from c2rviz.server import CommandServer
 from c2rviz.world import World
 
 ROOT = Path(__file__).resolve().parent.parent
+CHROMIUM = Path("/usr/bin/chromium")  # Debian's; Playwright cannot download browsers here
+ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--no-first-run",
+]
 ROBOTS = {
     "motoman_sia20d": ("robots/motoman_sia20d/robot.urdf", "base_link", "link_t"),
     "fanuc_lrmate200id": ("robots/fanuc_lrmate200id/robot.urdf", "base_link", "link_6"),
@@ -220,3 +229,20 @@ def c2rviz_process() -> Iterator[Callable[..., Process]]:
             proc.popen.wait(timeout=10)
         if proc.popen.stdout is not None:
             proc.popen.stdout.close()
+
+
+@pytest.fixture
+def browser() -> Iterator[Any]:
+    """A headless Chromium (Playwright); a CI run without it fails rather than skips."""
+    if not CHROMIUM.exists():
+        if os.environ.get("CI") == "true":
+            pytest.fail(f"{CHROMIUM} is missing: install Debian's chromium")
+        pytest.skip(f"{CHROMIUM} is missing")
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as pw:
+        chromium = pw.chromium.launch(executable_path=str(CHROMIUM), args=ARGS)
+        try:
+            yield chromium
+        finally:
+            chromium.close()

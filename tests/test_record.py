@@ -388,7 +388,8 @@ def test_the_recorded_page_plays_in_a_browser_without_a_server(
     start_server, connect, tmp_path: Path
 ):
     """NAME.html opens from a file:// URL in headless Chromium and the robot moves."""
-    from test_browser import ARGS, CHROMIUM, changed, wait_until
+    from conftest import ARGS, CHROMIUM
+    from test_browser import changed, wait_until
 
     if not CHROMIUM.exists():
         pytest.fail(f"{CHROMIUM} is missing: install Debian's chromium")

@@ -716,29 +716,18 @@ def test_a_websocket_server_started_another_way_fails_loudly(
 # the real page
 
 
-CHROMIUM = Path("/usr/bin/chromium")
-
-
 @pytest.mark.browser
-def test_the_real_page_gets_through_with_its_token(served: Callable[..., Served]) -> None:
+def test_the_real_page_gets_through_with_its_token(
+    served: Callable[..., Served], browser: Any
+) -> None:
     """viser's own page, opened at the printed URL: it connects, nothing it says is
     dropped, and a click on the button reaches the callback."""
-    if not CHROMIUM.exists():
-        pytest.skip(f"{CHROMIUM} is missing")
-    from playwright.sync_api import sync_playwright
-
     s = served(DoorPolicy(token="s3cret"))
-    args = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run"]
-    with sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=args)
-        try:
-            page = browser.new_page()
-            page.goto(s.door.policy.page_url(f"http://127.0.0.1:{s.port}"))
-            # viser counts a tab once its first camera update got through the door.
-            s.wait(lambda: bool(s.server.get_clients()), "the page's camera", timeout_s=60)
-            page.get_by_text("button", exact=True).click()
-            s.wait(lambda: bool(s.calls), "the click", timeout_s=30)
-        finally:
-            browser.close()
+    page = browser.new_page()
+    page.goto(s.door.policy.page_url(f"http://127.0.0.1:{s.port}"))
+    # viser counts a tab once its first camera update got through the door.
+    s.wait(lambda: bool(s.server.get_clients()), "the page's camera", timeout_s=60)
+    page.get_by_text("button", exact=True).click()
+    s.wait(lambda: bool(s.calls), "the click", timeout_s=30)
     assert s.calls == [("button", 0, True)]
     assert not s.door.refused
