@@ -3,9 +3,12 @@
 Each connection is an ``asyncio.Protocol``: it splits what arrives into lines,
 runs every complete line through its ``Session`` (the one way in), and answers
 all lines of one read (up to ``_BATCH_BYTES`` of them: a big read is run in
-batches, one loop turn each) with one write. Nothing here knows kinematics or
-drawing. The limits in ``config.ServerLimits`` bound what one client can cost; a
-client that breaks one is told why and closed, and no other client notices.
+batches, one loop turn each) with one write. A turn also ends after
+``TURN_S`` of work, so a flood of costly lines (a ``mark`` computes forward
+kinematics) delays the other clients no more than a flood of cheap ones.
+Nothing here knows kinematics or drawing. The limits in ``config.ServerLimits``
+bound what one client can cost; a client that breaks one is told why and
+closed, and no other client notices.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from __future__ import annotations
 import asyncio
 import itertools
 import logging
+import time
 from collections.abc import Awaitable, Callable
 from itertools import chain
 
@@ -139,8 +143,7 @@ class Connection(asyncio.Protocol):
         if self.closing or self.waiting:
             return  # while paused we do not read, so an unfinished line is not the client's fault
         if b"\n" in self.buffer:  # more complete lines: let the other clients in first
-            self._pause_reading()
-            self.yield_timer = asyncio.get_running_loop().call_soon(self._yielded)
+            self._yield([])
         elif len(self.buffer) > self.limits.max_line:
             self._close_with(replies.error(LineTooLong(self.limits.max_line)))
         elif self.buffer and self.partial_timer is None:
@@ -172,15 +175,21 @@ class Connection(asyncio.Protocol):
         return lines
 
     def _run(self, lines: list[Line]) -> None:
-        """Answer ``lines`` in order, stopping at a reply that waits, bye, quit or a fatal line."""
+        """Answer ``lines`` in order, stopping at a reply that waits, bye, quit or a fatal line,
+        or after ``TURN_S`` of work (the rest runs after the other clients' turns)."""
         out: list[str] = []
         reply = out.append
         run = self.session.run
         session = self.session
         skip_to = 0
+        started = time.perf_counter()
         for i, line in enumerate(lines):
             if i < skip_to:
                 continue  # answered as part of a run of plain `joints` lines
+            if i % _TURN_CHECK == _TURN_CHECK - 1 and time.perf_counter() - started > TURN_S:
+                self._write(out)
+                self._yield(lines[i:])
+                return
             if line.__class__ is str and line.startswith(_PLAIN_JOINTS):
                 skip_to = self._joints_run(lines, i, out)
                 if skip_to > i:
@@ -270,6 +279,12 @@ class Connection(asyncio.Protocol):
             text = pending.result()
         self._write([text])
         self._go_on()
+
+    def _yield(self, rest: list[Line]) -> None:
+        """Stop reading for a loop turn, so the other clients go first; then run ``rest``."""
+        self.backlog = rest
+        self._pause_reading()
+        self.yield_timer = asyncio.get_running_loop().call_soon(self._yielded)
 
     def _yielded(self) -> None:
         self.yield_timer = None
@@ -372,7 +387,9 @@ def _is_command(line: Line) -> bool:
 
 
 _PLAIN_JOINTS = ("joints ", "j ")  # how a controller streaming setpoints writes them
-_BATCH_BYTES = 8192  # complete lines run per client per loop turn: at most ~20 ms of work
+_BATCH_BYTES = 8192  # complete lines run per client per loop turn
+TURN_S = 0.002  # work per client per loop turn [s]: then the others go first
+_TURN_CHECK = 32  # lines between looks at the clock
 _LINGER_S = 2.0  # after the last reply, how long a closing client's input is read and dropped
 
 

@@ -13,6 +13,7 @@ import http.client
 import inspect
 import logging
 import math
+import select
 import socket
 import struct
 import threading
@@ -24,9 +25,10 @@ from pathlib import Path
 import pytest
 
 from c2rviz import cli, config, replies
+from c2rviz import server as server_module
 from c2rviz.commands import _MAX_INDEX_DIGITS
 from c2rviz.errors import LineTooLong
-from c2rviz.server import _BATCH_BYTES, _LINGER_S, CommandServer
+from c2rviz.server import _BATCH_BYTES, _LINGER_S, TURN_S, CommandServer
 from c2rviz.view.policy import DoorPolicy
 
 # A state away from home (so a stray home or joints shows) with long `where` replies.
@@ -458,6 +460,42 @@ def test_thousands_of_lines_in_one_write_are_all_answered_in_order(live, connect
     check()
 
 
+def test_a_long_batch_gives_way_to_another_client_after_its_time_slice(live, connect, monkeypatch):
+    """A batch of lines stops after ``TURN_S`` of work (here: at once) and lets the other
+    clients in: a `where` that arrived just after it sees the arm partway through it."""
+    server, _bystander, _check = live()
+    monkeypatch.setattr(server_module, "TURN_S", 0.0)
+    flooder, reader = connect(server), connect(server)
+    assert reader.ask("where") == WHERE  # both connections are set up on the server
+    steps = [f"move 0 {1 + k / 500:.3f}" for k in range(1, 501)]  # 1.002 .. 2 rad
+    assert len("".join(line + "\n" for line in steps)) < _BATCH_BYTES  # one batch
+    hold, held = threading.Event(), threading.Event()
+
+    def block() -> None:  # the loop waits here while the lines arrive, in a known order
+        held.set()
+        hold.wait(timeout=60)
+
+    def arrived(client) -> None:
+        """Wait until the server's end of ``client``'s socket has data to read."""
+        host, port = client.sock.getsockname()[:2]
+        local = f"{host}:{port}"
+        (mine,) = [c for c in server.server.connections if c.peer == local]
+        fd = mine.transport.get_extra_info("socket").fileno()
+        assert select.select([fd], [], [], 60)[0], "the lines did not arrive"
+
+    server.loop.call_soon_threadsafe(block)
+    assert held.wait(timeout=60)
+    flooder.send("".join(line + "\n" for line in steps))
+    arrived(flooder)  # epoll reports ready sockets first come, first served
+    reader.send("where\n")
+    arrived(reader)
+    hold.set()
+    seen = float(reader.read_line().removeprefix("ok ").split(",")[0])
+    assert [flooder.read_line() for _ in steps] == ["ok"] * len(steps)
+    assert 1.0 < seen < 2.0  # after the flood began, before it ended
+    assert server.q[0] == 2.0
+
+
 def test_a_quit_after_thousands_of_lines_answers_the_rest_with_shutting_down(live, connect):
     server, _bystander, _check = live()
     client = connect(server)
@@ -485,6 +523,7 @@ def test_the_limits_table_matches_the_code():
         seen.add(field)
     assert seen == set(defaults)  # every limit is in the table
     assert f"| {_BATCH_BYTES} | `server._BATCH_BYTES` |" in text
+    assert f"| {TURN_S * 1000:g} ms | `server.TURN_S` |" in text
     assert f"| {_LINGER_S:g} s | `server._LINGER_S` |" in text
     assert f"| {_MAX_INDEX_DIGITS} | `commands._MAX_INDEX_DIGITS` |" in text
     grace = inspect.signature(CommandServer.stop).parameters["grace_s"].default
