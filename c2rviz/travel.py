@@ -20,41 +20,13 @@ import numpy as np
 
 from . import replies
 from .errors import MotionInterrupted
+from .line_play import LinePlay
 from .motion import Motion, MotionLimits
 
 if TYPE_CHECKING:
     from .world import RobotState
 
 __all__ = ["Travel", "Travels"]
-
-
-@dataclass(eq=False)
-class LinePlay:
-    """A joint path played at given times (a straight tool line, from ``cartesian``).
-
-    Between two waypoints the joints move at constant speed (linear interpolation).
-
-    Attributes:
-        times: When the arm passes each waypoint, on the world's clock [s], increasing.
-        qs: The waypoints' chain values [rad or m], one row each.
-    """
-
-    times: np.ndarray
-    qs: np.ndarray
-
-    def sample(self, t: float) -> tuple[float, ...]:
-        k = int(np.searchsorted(self.times, t, side="right"))
-        if k >= len(self.times):
-            return tuple(self.qs[-1].tolist())
-        if k == 0:
-            return tuple(self.qs[0].tolist())
-        t0, t1 = self.times[k - 1], self.times[k]
-        f = (t - t0) / (t1 - t0) if t1 > t0 else 1.0
-        return tuple((self.qs[k - 1] + f * (self.qs[k] - self.qs[k - 1])).tolist())
-
-    @property
-    def arrival(self) -> float:
-        return float(self.times[-1])
 
 
 @dataclass(eq=False)
@@ -150,16 +122,23 @@ class Travels:
         return arrival
 
     def play_line(
-        self, state: RobotState, qs: np.ndarray, times: Sequence[float], source: str, wait: bool
+        self,
+        state: RobotState,
+        qs: np.ndarray,
+        times: Sequence[float],
+        ramp: tuple[float, float],
+        source: str,
+        wait: bool,
     ) -> asyncio.Future[str] | None:
-        """Play the joint path ``qs`` (from where the arm is) at ``times`` [s from now].
+        """Play the joint path ``qs`` (from where the arm is, at rest) along ``times`` [s],
+        eased in and out with the path-time acceleration and jerk ``ramp`` (``line_play``).
 
         Returns:
             As ``go``: with ``wait`` a reply on arrival, else None.
         """
         travel = self.by_robot[state.name]
         self._interrupt(travel, f"preempted by {source}")
-        travel.line = LinePlay(self.clock() + np.asarray(times, dtype=float), qs)
+        travel.line = LinePlay(self.clock(), times, qs, *ramp)
         travel.synced = False
         state.target = tuple(qs[-1].tolist())
         travel.active = True
@@ -176,17 +155,10 @@ class Travels:
         if not travel.active:
             return None
         self._interrupt(travel, f"motion stopped by {source}")
-        if travel.line is not None:  # a line stops where it is (see README)
-            t = self.clock()
-            q = travel.line.sample(t)
-            travel.line = None
-            travel.motion.jump(q, t)
-            travel.synced = True
-            state.target = q
-            travel.active = False
-            self.publish(state, q, t)
-            _settle(travel.rests, replies.OK)
-            return None
+        if travel.line is not None:  # a line brakes on the line
+            travel.line.brake(self.clock())
+            state.target = travel.line.sample(travel.line.arrival)
+            return self.rest(state)
         travel.motion.stop(self.clock())
         state.target = travel.motion.target
         return self.rest(state)

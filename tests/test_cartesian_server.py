@@ -164,6 +164,39 @@ def test_movel_keeps_the_tool_on_the_line_within_lspeed_and_the_limits(
     assert client.ask("lspeed") == "ok 0.2"
 
 
+def test_stop_during_movel_brakes_on_the_line_short_of_the_goal(server: ServerThread, connect):
+    mover, other = connect(server), connect(server)
+    mover.ask("j 0.1,0.4,0,-0.6,0,0.7,0")
+    start = pose_of(mover.ask("pose"))
+    goal = start.copy()
+    goal.translation = start.translation + np.array([0.0, 0.25, -0.1])
+    rpy = pin.rpy.matrixToRpy(goal.rotation)
+    for line in ("motion on", "speed 100", "lspeed 0.05"):  # ~5.4 s on the line
+        assert mover.ask(line) == "ok"
+    first = server.call(lambda: len(server.scene.joints))
+    mover.send(f"movel {text([*goal.translation, *rpy])}\n")
+    while np.linalg.norm(pose_of(other.ask("pose")).translation - start.translation) < 0.03:
+        pass  # until the tool is 3 cm down the line, at its speed
+    assert other.ask("stop") == "ok"  # at rest
+    assert mover.read_line().startswith("error: motion stopped by tcp ")
+    times, joints = server.call(lambda: (list(server.scene.times), list(server.scene.joints)))
+    times, joints = np.array(times[first:]), np.array(joints[first:])
+    points = np.array([server.robot.ee_pose(q).translation for q in joints])
+    direction = (goal.translation - start.translation) / np.linalg.norm(
+        goal.translation - start.translation
+    )
+    offsets = points - start.translation
+    along = offsets @ direction
+    assert np.linalg.norm(offsets - np.outer(along, direction), axis=1).max() <= 1e-3
+    assert (np.diff(along) >= -1e-9).all()  # forward only, no jump back
+    assert 0.0 < along[-1] < np.linalg.norm(goal.translation - start.translation) - 0.01
+    # It slowed down to rest rather than halting at speed: the last step was slow.
+    speeds = np.diff(along) / np.maximum(np.diff(times), 1e-9)
+    moving = np.flatnonzero(np.diff(along) > 1e-9)
+    assert speeds[moving[-1]] < 0.5 * speeds.max()
+    np.testing.assert_allclose(pose_of(other.ask("pose")).translation, points[-1], atol=1e-9)
+
+
 def test_movel_across_a_joint_limit_is_refused_before_the_arm_moves(start_server, connect):
     server = start_server("fanuc_lrmate200id")
     client = connect(server)

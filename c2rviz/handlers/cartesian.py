@@ -17,6 +17,7 @@ from .. import replies
 from ..cartesian import plan_line
 from ..errors import ArmMoved, UnknownMarker
 from ..lang.cartesian import Ik, LinearSpeed, MoveL, MoveTo, PoseValues, Tool
+from ..line_play import ramp_limits
 from ..registry import Reply, handler
 
 if TYPE_CHECKING:
@@ -87,10 +88,12 @@ async def movel(session: Session, command: MoveL) -> str:
     if session.motion == "off":
         session.world.set_q(line.waypoints[-1].q, state.name, session.source)
         return replies.OK
-    fraction = session.speed / 100.0
-    velocity = [v * fraction for v in state.travel.motion.limits.velocity]
-    times = line.timestamps(session.lspeed, velocity)
-    arrival = world.travels.play_line(state, qs, times, session.source, session.motion == "on")
+    fraction, limits = session.speed / 100.0, state.travel.motion.limits
+    times = line.timestamps(session.lspeed, [v * fraction for v in limits.velocity])
+    ramp = ramp_limits(limits, fraction)
+    arrival = world.travels.play_line(
+        state, qs, times, ramp, session.source, session.motion == "on"
+    )
     return replies.OK if arrival is None else await arrival
 
 
