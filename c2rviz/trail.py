@@ -1,13 +1,14 @@
 """The trail: the path of the tool point as the arm actually moves, kept for drawing.
 
-``TrailKeeper`` is one per world (``TrailKeeper.of(world)``), an observer that keeps,
-for every robot whose trail is on, the end-effector point (``robot.ee_frame``'s origin)
-in the robot's root frame [m] (the world frame for a robot at the world's origin; the
-page draws it under the robot's root) at most once per frame (``1/hz`` of the world's
-clock), so a flood of commands costs one forward kinematics per frame, not one per
-command, and a move in motion leaves its path at frame rate. The latest state of a frame
-is kept and added when the points are read or the next frame is due, so the trail always
-ends where the arm is.
+``TrailKeeper`` is one per world (``TrailKeeper.of(world)``), an observer that
+keeps, for every robot whose trail is on, the tool point (the robot's ``tool`` on
+its end-effector link, as it is when the point is taken) in the robot's root frame
+[m] (the world frame for a robot at the world's origin; the page draws it under the
+robot's root) at most once per frame (``1/hz`` of the world's clock), so a flood of
+commands costs one forward kinematics per frame, not one per command, and a move in
+motion leaves its path at frame rate. The latest state of a frame is kept and added
+when the points are read or the next frame is due, so the trail always ends where
+the arm is.
 
 A trail is bounded: at ``cap`` points it thins its older half (every other point goes)
 instead of growing, so a long trail keeps its whole extent with the recent part dense.
@@ -29,8 +30,7 @@ import numpy as np
 from .scene import Observer
 
 if TYPE_CHECKING:
-    from .robot import Robot
-    from .world import World
+    from .world import RobotState, World
 
 __all__ = ["DEFAULT_TRAIL_POINTS", "MIN_TRAIL_POINTS", "RobotTrail", "TrailKeeper"]
 
@@ -42,8 +42,8 @@ MIN_TRAIL_POINTS = 16
 class RobotTrail:
     """One robot's trail: up to ``cap`` points [m], oldest first."""
 
-    def __init__(self, robot: Robot, cap: int, period_s: float) -> None:
-        self.robot = robot
+    def __init__(self, state: RobotState, cap: int, period_s: float) -> None:
+        self.state = state
         self.cap = cap
         self.period_s = period_s
         self._points = np.empty((cap, 3))
@@ -80,8 +80,8 @@ class RobotTrail:
             self._append(q)
 
     def _append(self, q: Sequence[float]) -> None:
-        robot = self.robot
-        point = (robot.base_placement * robot.ee_pose(q)).translation
+        robot = self.state.robot
+        point = (robot.base_placement * robot.ee_pose(q) * self.state.tool).translation
         if self._count and np.array_equal(self._points[self._count - 1], point):
             return  # standing still adds nothing
         if self._count == self.cap:
@@ -128,7 +128,7 @@ class TrailKeeper(Observer):
     def start(self, robot: str) -> None:
         """A fresh trail for ``robot``, from where the arm is now."""
         state = self.world.state(robot)
-        trail = RobotTrail(state.robot, self.cap, self.world.travels.frame_s)
+        trail = RobotTrail(state, self.cap, self.world.travels.frame_s)
         trail.add(state.q, self.world.clock())
         if not self.trails:
             self.world.add_observers([self])

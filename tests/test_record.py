@@ -262,6 +262,8 @@ def test_record_flag_records_from_start_to_exit(c2rviz_process, tmp_path: Path):
 
 def test_the_trail_follows_the_tool_along_a_move(server: ServerThread, connect):
     client = connect(server)
+    assert client.ask("tool 0,0.05,0.1,0,0,0") == "ok"  # the tool point, off the flange
+    offset = pin.SE3(np.eye(3), np.array([0.0, 0.05, 0.1]))
     assert client.ask("trail") == "ok off"
     assert client.ask("trail on") == "ok"
     assert client.ask("trail") == "ok on 1"
@@ -270,11 +272,13 @@ def test_the_trail_follows_the_tool_along_a_move(server: ServerThread, connect):
         assert client.ask(line) == "ok"
     robot = load_robot()
     frames = server.call(lambda: list(server.scene.joints[start:]))
-    along = np.array([(robot.base_placement * robot.ee_pose(q)).translation for q in frames])
+    along = np.array(
+        [(robot.base_placement * robot.ee_pose(q) * offset).translation for q in frames]
+    )
     keeper = server.call(lambda: TrailKeeper.of(server.world))
     points = server.call(keeper.points, "motoman_sia20d")
     assert len(points) > 50  # at frame rate, not only the targets
-    home = (robot.base_placement * robot.ee_pose(robot.home)).translation
+    home = (robot.base_placement * robot.ee_pose(robot.home) * offset).translation
     np.testing.assert_allclose(points[0], home)
     np.testing.assert_allclose(points[-1], along[-1])
     for point in points[1:]:  # every point is where the tool was in a published frame
