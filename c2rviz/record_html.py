@@ -1,8 +1,11 @@
 """NAME.html: a recording as a self-contained page that plays in any browser, no server.
 
 The frames of NAME.csv are replayed into a private, offline viser scene (the
-page's own robot view, so it looks as the live page does) while viser's scene
-serializer keeps every message and the pauses between them; ``as_html`` then
+page's own robot view and marker layer, so it looks as the live page does)
+while viser's scene serializer keeps every message and the pauses between
+them; the markers come from NAME.txt (its ``mark``, ``color``, ``marker`` and
+``clear`` lines, timed by its ``sleep`` lines) and appear at the first frame
+at or after their time; ``as_html`` then
 bundles the player (play/pause, a timeline) and the recording into one file.
 Frames are thinned to at most ``HTML_HZ`` a second and ``MAX_HTML_FRAMES`` in
 all, so a long run stays a page a browser opens (README: Record and replay).
@@ -12,13 +15,18 @@ from __future__ import annotations
 
 import csv
 import logging
+from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pinocchio as pin
 
+from .commands import Clear, Color, Mark, MarkerShape, Sleep, parse_line
 from .recorder import Recorded
 from .robot import Robot
+from .scene import Marker
 from .view import adapter
+from .view.markers import MarkerLayer
 from .view.robot_view import RobotView
 from .visuals import load_link_geometry
 
@@ -41,18 +49,55 @@ def write_html(recorded: Recorded, robot: Robot, origin: pin.SE3) -> Path:
         view = RobotView(
             server, recorded.name, robot, origin, load_link_geometry(robot.source), "robot"
         )
-        if joints:
-            view.draw(joints[0])
+        markers = MarkerLayer(server, {recorded.name: "robot"})
+        events = _marker_events(recorded.txt, robot, origin)
+        event = next(events, None)
         serializer = server.get_scene_serializer()
-        for before, now, q in zip(times, times[1:], joints[1:]):
-            serializer.insert_sleep(now - before)
+        for k, (now, q) in enumerate(zip(times, joints)):
+            if k:
+                serializer.insert_sleep(now - times[k - 1])
+            while event is not None and event[0] <= now:
+                if event[1] is None:
+                    markers.clear(recorded.name)
+                else:
+                    markers.add(recorded.name, event[1])
+                event = next(events, None)
             view.draw(q)
+            markers.draw()
         html = serializer.as_html()
     finally:
         adapter.stop(server)
     path = recorded.csv.with_suffix(".html")
     path.write_text(html, encoding="utf-8")
     return path
+
+
+def _marker_events(
+    txt: Path | None, robot: Robot, origin: pin.SE3
+) -> Iterator[tuple[float, Marker | None]]:
+    """NAME.txt's markers in order, each with its time [s] from the start (None: a clear)."""
+    if txt is None:  # a write error stopped the recording: no command file
+        return
+    t, rgb, shape = 0.0, (1.0, 0.0, 0.0), "sphere"  # a replaying session's style
+    base = origin * robot.base_placement
+    with open(txt, encoding="ascii") as file:
+        for line in file:
+            command = parse_line(line)  # written by the recorder: radians, base frame
+            if isinstance(command, Sleep):
+                t += command.seconds
+            elif isinstance(command, Color):
+                rgb = command.rgb
+            elif isinstance(command, MarkerShape):
+                shape = command.shape
+            elif isinstance(command, Clear):
+                yield t, None
+            elif isinstance(command, Mark) and command.pose is not None:
+                x, y, z, roll, pitch, yaw = command.pose
+                pose = pin.SE3(pin.rpy.rpyToMatrix(roll, pitch, yaw), np.array([x, y, z]))
+                placement = pose if command.in_world else base * pose
+                qx, qy, qz, qw = map(float, pin.Quaternion(placement.rotation).coeffs())
+                px, py, pz = map(float, placement.translation)
+                yield t, Marker((px, py, pz), (qw, qx, qy, qz), rgb, shape)
 
 
 def _frames(path: Path, n: int) -> tuple[list[float], list[tuple[float, ...]]]:

@@ -207,7 +207,7 @@ class Recorder(Observer):
         us = self._sleep_to(t)
         self._due = t + self.period_s
         values = _numbers(q)
-        placement = self.state.robot.ee_pose(q)
+        placement = self.state.robot.ee_pose(q) * self.state.tool
         pose = _numbers([*placement.translation, *pin.rpy.matrixToRpy(placement.rotation)])
         self._write(self._body, f"joints {values}\n")
         self._write(self._rows, f"{us / 1e6:.6f},{values},{pose}\n")
@@ -230,7 +230,7 @@ class Recorder(Observer):
             lines.append(f"marker {marker.shape}\n")
         w, x, y, z = marker.wxyz
         in_world = pin.SE3(pin.Quaternion(w, x, y, z).toRotationMatrix(), np.array(marker.position))
-        pose = self.state.robot.base_placement.actInv(in_world)
+        pose = (self.state.origin * self.state.robot.base_placement).actInv(in_world)
         rpy = pin.rpy.matrixToRpy(pose.rotation)
         lines.append(f"mark {_numbers([*pose.translation, *rpy])}\n")
         self._write(self._body, "".join(lines))

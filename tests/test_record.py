@@ -28,6 +28,7 @@ from test_watch import STATE, is_reply, read_until
 from c2rviz import player
 from c2rviz.config import load_settings
 from c2rviz.errors import ConfigError
+from c2rviz.recorder import Recorder
 from c2rviz.recordings import Recordings
 from c2rviz.trail import DEFAULT_TRAIL_POINTS, TrailKeeper
 from c2rviz.world import World
@@ -257,6 +258,34 @@ def test_record_flag_records_from_start_to_exit(c2rviz_process, tmp_path: Path):
     assert "record: run already exists in" in again.stderr
 
 
+def test_a_cell_member_records_its_tool_pose_and_marks_in_its_base_frame(tmp_path: Path):
+    """A robot away from the cell's origin, with a tool: NAME.csv has the tool's pose and
+    NAME.txt's `mark` lines the base-frame poses the robot's own client would send."""
+    robot = load_robot()
+    origin = pin.SE3(pin.rpy.rpyToMatrix(0.0, 0.0, 0.5), np.array([1.0, -0.5, 0.2]))
+    world = World({"b": robot}, origins={"b": origin})
+    tool_offset = pin.SE3(pin.rpy.rpyToMatrix(0.0, 0.4, 0.0), np.array([0.0, 0.02, 0.1]))
+    world.set_tool("b", tool_offset)
+    recorder = Recorder(world, "b", "cell", tmp_path, on_failed=lambda *_: None)
+    world.add_observers([recorder])
+    pose = pin.SE3(pin.rpy.rpyToMatrix(0.1, 0.2, 0.3), np.array([0.5, 0.25, 1.0]))
+    world.add_marker(pose, (1.0, 0.0, 0.0), "sphere", robot="b")
+    recorder.stop()
+    recorded = recorder.finish()
+    assert recorded.txt is not None
+    (mark,) = [line for line in recorded.txt.read_text().splitlines() if line.startswith("mark")]
+    np.testing.assert_allclose(
+        [float(v) for v in mark.split()[1].split(",")],
+        [*pose.translation, *pin.rpy.matrixToRpy(pose.rotation)],
+        atol=1e-9,
+    )
+    _header, frames = read_frames(recorded.csv)
+    at_home = robot.ee_pose(robot.home) * tool_offset
+    np.testing.assert_allclose(
+        frames[0, 8:], [*at_home.translation, *pin.rpy.matrixToRpy(at_home.rotation)], atol=1e-9
+    )
+
+
 # --- the trail ---------------------------------------------------------------------------
 
 
@@ -387,18 +416,27 @@ def test_record_flag_refuses_a_bad_name(tmp_path: Path, name: str, message: str)
     assert list(tmp_path.iterdir()) == []
 
 
+# The markers the recorded page holds: instances of its batched marker nodes.
+RECORDED_MARKERS = """() => {
+  const tree = window.__viserSceneTree;
+  if (!tree) return null;
+  let count = 0;
+  for (const [name, node] of Object.entries(tree.getState())) {
+    const at = name.startsWith("/markers/") && node?.message?.props?.batched_positions;
+    count += at ? at.byteLength / 12 : 0;
+  }
+  return count;
+}"""
+
+
 @pytest.mark.browser
 def test_the_recorded_page_plays_in_a_browser_without_a_server(
-    start_server, connect, tmp_path: Path
+    start_server, connect, tmp_path: Path, browser
 ):
-    """NAME.html opens from a file:// URL in headless Chromium and the robot moves."""
-    from conftest import ARGS, CHROMIUM
-    from test_browser import changed, wait_until
-
-    if not CHROMIUM.exists():
-        pytest.fail(f"{CHROMIUM} is missing: install Debian's chromium")
+    """NAME.html opens from a file:// URL in headless Chromium, the robot moves and the
+    recorded markers appear."""
     from PIL import Image
-    from playwright.sync_api import sync_playwright
+    from test_browser import changed, wait_until
 
     record_two_clients(start_server(), connect, tmp_path)
     page_file = tmp_path / "take.html"
@@ -411,13 +449,10 @@ def test_the_recorded_page_plays_in_a_browser_without_a_server(
         picture = Image.open(io.BytesIO(page.screenshot())).convert("RGB")
         return np.asarray(picture, dtype=np.int16)[100:560, 200:800]
 
-    with sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=str(CHROMIUM), args=ARGS)
-        try:
-            page = browser.new_page(viewport={"width": 1000, "height": 700})
-            page.goto(page_file.as_uri())
-            first = shot(page)
-            # The recorded arm swings over about two seconds: the picture changes as it plays.
-            wait_until(lambda: (changed(first, shot(page)) > 500, None), "the recording playing")
-        finally:
-            browser.close()
+    page = browser.new_page(viewport={"width": 1000, "height": 700})
+    page.goto(page_file.as_uri())
+    first = shot(page)
+    # The recorded arm swings over about two seconds: the picture changes as it plays.
+    wait_until(lambda: (changed(first, shot(page)) > 500, None), "the recording playing")
+    # The four markers dropped during the run are there by its end.
+    wait_until(lambda: ((n := page.evaluate(RECORDED_MARKERS)) == 4, n), "the recorded markers")
