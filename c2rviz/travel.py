@@ -42,6 +42,8 @@ class Travel:
         arrivals: Replies waiting for the arm to reach the running move's target.
         rests: Replies waiting for the arm to come to rest (``wait``, ``stop``).
         line: A straight-line path being played instead of ``motion``, if any.
+        stopping: The running move was stopped (``stop``): it ends at rest short of
+            its target. Cleared by the next move.
     """
 
     state: RobotState
@@ -49,6 +51,7 @@ class Travel:
     active: bool = False
     synced: bool = True
     line: LinePlay | None = None
+    stopping: bool = False
     arrivals: list[asyncio.Future[str]] = field(default_factory=list)
     rests: list[asyncio.Future[str]] = field(default_factory=list)
 
@@ -84,6 +87,7 @@ class Travels:
     def preempt(self, travel: Travel, source: str) -> None:
         """An instant command puts the arm somewhere now: the running move ends here."""
         self._interrupt(travel, f"preempted by {source}")
+        travel.stopping = False
         travel.active = False
         travel.synced = False
         travel.line = None
@@ -100,6 +104,7 @@ class Travels:
         """
         travel = self.by_robot[state.name]
         self._interrupt(travel, f"preempted by {source}")
+        travel.stopping = False
         t = self.clock()
         if travel.line is not None:  # leaving a line: from where it is, at rest (see README)
             travel.motion.jump(travel.line.sample(t), t)
@@ -138,6 +143,7 @@ class Travels:
         """
         travel = self.by_robot[state.name]
         self._interrupt(travel, f"preempted by {source}")
+        travel.stopping = False
         travel.line = LinePlay(self.clock(), times, qs, *ramp)
         travel.synced = False
         state.target = tuple(qs[-1].tolist())
@@ -155,6 +161,7 @@ class Travels:
         if not travel.active:
             return None
         self._interrupt(travel, f"motion stopped by {source}")
+        travel.stopping = True
         if travel.line is not None:  # a line brakes on the line
             travel.line.brake(self.clock())
             state.target = travel.line.sample(travel.line.arrival)
@@ -214,8 +221,10 @@ class Travels:
             if line is not None:
                 q = line.sample(t)
                 end = line.arrival
-                if t >= end:
+                if t >= end:  # at rest at the line's end: the planner stands there too
                     travel.active, travel.line = False, None
+                    travel.motion.jump(q, t)
+                    travel.synced = True
             else:
                 q = travel.motion.sample(t)[0]
                 end = travel.motion.arrival()

@@ -216,7 +216,6 @@ class WatchHub(Observer):
         self.active: list[WatchStream] = []
         self._seq = 0
         self._moving: set[str] = set()  # robots seen travelling at their last state
-        self._stopping: dict[str, tuple[float, ...]] = {}  # robot -> target when stopped
 
     @classmethod
     def of(cls, world: World) -> WatchHub:
@@ -261,7 +260,6 @@ class WatchHub(Observer):
         if stream not in self.active:
             if not self.active:
                 self._moving.clear()
-                self._stopping.clear()
                 self.world.add_observers([self])
             self.active.append(stream)
 
@@ -302,14 +300,13 @@ class WatchHub(Observer):
                 self._moving.add(robot)
         elif self._moving and robot in self._moving:
             self._moving.discard(robot)
-            stopped_at = self._stopping.pop(robot, None)
             if travel.synced:  # it came to rest (not cut short by an instant command)
-                target = self.world.robots[robot].target
-                self.event("stopped" if stopped_at == target else "arrived", robot)
+                self.event("stopped" if travel.stopping else "arrived", robot)
 
     def on_marker(self, robot: str, marker: Marker) -> None:
         seq = self.next_seq()
-        base = self.world.robots[robot].robot.base_placement
+        state = self.world.robots[robot]
+        base = state.origin * state.robot.base_placement
         w, x, y, z = marker.wxyz
         rotation = pin.Quaternion(w, x, y, z).toRotationMatrix()
         placement = base.actInv(pin.SE3(rotation, np.array(marker.position)))
@@ -323,11 +320,3 @@ class WatchHub(Observer):
 
     def on_clear_markers(self, robot: str) -> None:
         self.event("clear", robot)
-
-    def on_command(self, source: str, line: str, accepted: bool) -> None:
-        if accepted and "stop" in line[:16].lower():
-            words = line.split("#", 1)[0].split()
-            if len(words) == 1 and words[0].lower() == "stop":
-                for name, state in self.world.robots.items():
-                    if state.travel.active:
-                        self._stopping[name] = state.target

@@ -17,6 +17,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from conftest import ROOT, Client, load_robot
+from test_watch import read_until
 
 from c2rviz.cell import load_cell
 from c2rviz.cli import main
@@ -128,6 +129,34 @@ def test_markers_in_the_base_frame_and_in_the_world_frame(cell: CellThread):
     expected = se3(1.2, 0, 0, 0, 0, math.pi) * robot.base_placement
     np.testing.assert_allclose(base.position, expected * np.array([0.5, 0.0, 0.2]), atol=1e-12)
     np.testing.assert_allclose(world.position, [0.5, 0.0, 0.2], atol=1e-12)
+
+
+def test_watch_events_name_only_their_own_robot(cell: CellThread):
+    """A stop of one robot is `event stopped` for its watchers only; the other robot's
+    watchers see their move arrive, and its markers in its own base frame."""
+    watchers = {name: cell.client(name) for name in ("left", "right")}
+    movers = {name: cell.client(name) for name in ("left", "right")}
+    seen: dict[str, list[str]] = {name: [] for name in watchers}
+    for watcher in watchers.values():
+        assert watcher.ask("watch 1000") == "ok"
+    for name, target in (("left", "60,30,0,0,0,0,0"), ("right", "0,40,0,0,0,0")):
+        for line in ("degrees", "motion follow", "speed 10", f"j {target}"):
+            assert movers[name].ask(line) == "ok"
+    for name, watcher in watchers.items():  # both on their way
+        read_until(
+            watcher,
+            lambda line: line.startswith("state") and "0,0,0,0,0,0" not in line,
+            seen[name],
+        )
+    assert movers["left"].ask("stop") == "ok"  # at rest
+    read_until(watchers["left"], lambda line: line.startswith("event"), seen["left"])
+    assert seen["left"][-1] == "event stopped"
+    assert movers["right"].ask("mark 0.5,0,0.2,0,0,0") == "ok"
+    read_until(watchers["right"], lambda line: line.startswith("event"), seen["right"])
+    assert seen["right"][-1] == "event marker 0.5,0,0.2,0,0,0 sphere 1,0,0"
+    read_until(watchers["right"], lambda line: line.startswith("event"), seen["right"])
+    assert seen["right"][-1] == "event arrived"
+    assert not [line for line in seen["right"] if line == "event stopped"]
 
 
 def test_the_same_model_twice_with_different_origins() -> None:

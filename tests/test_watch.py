@@ -132,6 +132,20 @@ def test_events_marker_clear_stopped(server: ServerThread, connect):
     assert rest != f"ok {FAR}"  # it stopped short
 
 
+def test_a_movel_in_motion_ends_with_event_arrived(server: ServerThread, connect):
+    watcher, mover = connect(server), connect(server)
+    assert mover.ask("j 0.1,0.4,0,-0.6,0,0.7,0") == "ok"
+    x, y, z, *rpy = (float(v) for v in mover.ask("pose")[3:].split(","))
+    assert watcher.ask("watch") == "ok"
+    seen: list[str] = []
+    for line in ("motion on", "lspeed 0.5"):
+        assert mover.ask(line) == "ok"
+    goal = ",".join(map(str, [x, y + 0.1, z, *rpy]))
+    assert mover.ask(f"movel {goal}") == "ok"  # on arrival
+    read_until(watcher, lambda line: line.startswith("event"), seen)
+    assert seen[-1] == "event arrived"
+
+
 def test_unwatch_ends_the_stream_and_watch_again_restarts_it(server: ServerThread, connect):
     watcher, other = connect(server), connect(server)
     assert watcher.ask("watch") == "ok"
