@@ -13,6 +13,10 @@ For each robot it prints:
   is checked;
 - ``random_free``: one collision-free random configuration (3 boxes).
 
+Then, for a cell of two (the motoman at the origin, the Fanuc 1.5 m along x,
+facing it): the same guarded 90 degree move of the motoman checked against the
+other robot as it stands (``between.first_hit_between``).
+
 Run: ``python benchmarks/collision_bench.py`` (``--quick`` for fewer repeats,
 ``--robots ur5 panda`` for example-robot-data arms, when installed).
 """
@@ -32,10 +36,12 @@ import pinocchio as pin
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from c2rviz.between import first_hit_between  # noqa: E402
 from c2rviz.catalogue import example_robots  # noqa: E402
 from c2rviz.collision import DEFAULT_SAMPLES, CollisionModel, segment  # noqa: E402
 from c2rviz.collision_geometry import robot_geometry  # noqa: E402
 from c2rviz.robot import Robot  # noqa: E402
+from c2rviz.world import World  # noqa: E402
 
 BUNDLED = {
     "motoman_sia20d": ("robots/motoman_sia20d/robot.urdf", "base_link", "link_t"),
@@ -116,6 +122,23 @@ def bench(name: str, samples: int, configs: int, repeats: int) -> None:
     print(f"  random_free with 3 objects: {rand * 1e6:.0f} us")
 
 
+def between_robots(repeats: int) -> None:
+    """A guarded 90 degree move of one robot of a cell, checked against the other."""
+    origin = pin.SE3(pin.rpy.rpyToMatrix(0.0, 0.0, math.pi), np.array([1.5, 0.0, 0.0]))
+    world = World(
+        {"a": load("motoman_sia20d"), "b": load("fanuc_lrmate200id")}, origins={"b": origin}
+    )
+    robot = world.state("a").robot
+    path = segment(robot, [0.0] * robot.n, [math.pi / 2] + [0.0] * (robot.n - 1))
+    first_hit_between(world, "a", path)  # build both collision models first
+    took = best_of(repeats, lambda: first_hit_between(world, "a", path))
+    hit = first_hit_between(world, "a", path)
+    print(
+        f"cell: motoman's guarded 90 deg move against a Fanuc 1.5 m away: "
+        f"{took * 1e3:.2f} ms for {len(path)} points (first hit: {hit})"
+    )
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robots", nargs="*", default=list(BUNDLED))
@@ -128,6 +151,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"{name}: not bundled and not an installed example robot; skipped")
             continue
         bench(name, args.samples, configs, repeats)
+    between_robots(repeats)
     return 0
 
 
