@@ -57,6 +57,11 @@ def numbers(values: Iterable[float]) -> str:
     return ",".join([f"{value:.10g}" if abs(value) > 1e-9 else "0" for value in values])
 
 
+def pairs(colliding: Iterable[tuple[str, str]]) -> str:
+    """Colliding pairs as ``a~b,c~d``, or ``none``."""
+    return ",".join(f"{a}~{b}" for a, b in colliding) or "none"
+
+
 def limit(value: float) -> str:
     """One joint limit as ``limits``, limit errors and the page print it.
 

@@ -7,6 +7,8 @@ A connection that sent ``watch [HZ]`` also receives, between its replies::
     event clear              every marker is gone
     event arrived            a move came to rest at its target
     event stopped            a move came to rest after ``stop``
+    event collision a~b,...  the colliding pairs changed (``none``: clear again), once
+                             collisions are checked (an object, ``collisions``, ``guard on``)
     event record-stopped NAME: WHY
     event dropped N          N events were dropped for a reader too slow to take them
 
@@ -320,3 +322,6 @@ class WatchHub(Observer):
 
     def on_clear_markers(self, robot: str) -> None:
         self.event("clear", robot)
+
+    def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
+        self.event(f"collision {replies.pairs(pairs)}", robot)

@@ -24,7 +24,8 @@ FAR = "90,45,0,-30,0,60,0"  # degrees, motoman_sia20d
 STATE = re.compile(r"state (\d+\.\d{6}) (\S+)")
 NUMBER = r"-?\d+(?:\.\d+)?(?:e[+-]?\d+)?"
 EVENT = re.compile(
-    r"event (arrived|stopped|clear|dropped \d+|marker \S+ \w+ \S+|record-stopped .+)"
+    r"event (arrived|stopped|clear|dropped \d+|marker \S+ \w+ \S+|record-stopped .+"
+    r"|collision \S+)"
 )
 
 
@@ -144,6 +145,24 @@ def test_a_movel_in_motion_ends_with_event_arrived(server: ServerThread, connect
     assert mover.ask(f"movel {goal}") == "ok"  # on arrival
     read_until(watcher, lambda line: line.startswith("event"), seen)
     assert seen[-1] == "event arrived"
+
+
+def test_collisions_are_events_when_they_begin_and_end(server: ServerThread, connect):
+    watcher, other = connect(server), connect(server)
+    assert watcher.ask("watch") == "ok"
+    seen: list[str] = []
+    # A box in front of the arm; folding the arm forward puts its wrist in the box.
+    assert other.ask("object table box 0.4,0.4,0.1 0.6,0,0.9,0,0,0") == "ok"
+    assert other.ask("degrees") == "ok"
+    assert other.ask("j 0,60,0,60,0,0,0") == "ok"
+    read_until(watcher, lambda line: line.startswith("event collision"), seen)
+    pairs = seen[-1].removeprefix("event collision ")
+    assert pairs != "none" and all(pair.endswith("~table") for pair in pairs.split(","))
+    assert other.ask("collisions") == f"ok {pairs}"
+    assert other.ask("home") == "ok"
+    read_until(watcher, lambda line: line.startswith("event collision"), seen)
+    assert seen[-1] == "event collision none"
+    assert all(EVENT.fullmatch(line) for line in seen if line.startswith("event"))
 
 
 def test_unwatch_ends_the_stream_and_watch_again_restarts_it(server: ServerThread, connect):

@@ -45,8 +45,7 @@ def objects(session: Session, command: Objects) -> str:
 
 @handler(Collisions)
 def collisions(session: Session, command: Collisions) -> str:
-    pairs = session.world.contacts.now(session.state.name)
-    return replies.ok(",".join(f"{a}~{b}" for a, b in pairs) if pairs else "none")
+    return replies.ok(replies.pairs(session.world.contacts.now(session.state.name)))
 
 
 @handler(Guard)

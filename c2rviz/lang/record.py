@@ -33,7 +33,8 @@ separators, no leading dot)."""
     "this connection also receives `state T v0,...,vn-1` lines (T: seconds since the server "
     "started; values in the connection's units) when the arm moves, at most HZ a second "
     "(default: the frame rate), and `event ...` lines (`event marker ...`, `event clear`, "
-    "`event arrived`, `event stopped`, `event record-stopped ...`, `event dropped N`); "
+    "`event arrived`, `event stopped`, `event collision PAIRS` (or `none`, once collisions "
+    "are checked), `event record-stopped ...`, `event dropped N`); "
     "replies still come one line each, in order",
 )
 @dataclass(frozen=True, slots=True)
