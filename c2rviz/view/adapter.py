@@ -179,14 +179,20 @@ def door(server: viser.ViserServer) -> Door:
     return found
 
 
-def accept_input(server: viser.ViserServer, handle: Any, callback: InputCallback) -> None:
+def accept_input(
+    server: viser.ViserServer,
+    handle: Any,
+    callback: InputCallback,
+    refused: Callable[[int], None] | None = None,
+) -> None:
     """Let the page set ``handle`` (a slider, number, checkbox or button) through ``callback``.
 
     The page's ``{"value": v}`` for the handle goes to ``callback(client_id, v)``
     (viser's client id; ``v`` a float, or a bool for a checkbox or button) on
     viser's thread, and nowhere else: viser neither applies it nor shows it to
     other tabs. The caller decides the true value and sends it with
-    ``set_gui_value``. A handle not registered cannot be set from the page.
+    ``set_gui_value``. A value the door drops for the handle (NaN, a word) goes
+    to ``refused(client_id)``. A handle not registered cannot be set from the page.
     """
     state = handle._impl
     if isinstance(state.value, bool):
@@ -195,7 +201,7 @@ def accept_input(server: viser.ViserServer, handle: Any, callback: InputCallback
         kind = float
     else:
         raise TypeError(f"page input {handle.label!r} holds {type(state.value).__name__}")
-    door(server).accept_input(state.uuid, kind, callback)
+    door(server).accept_input(state.uuid, kind, callback, refused)
 
 
 def accept_handle(

@@ -16,7 +16,9 @@ adapter (``view.adapter``) puts a ``Door`` in front of viser's websocket server:
 * each frame (``screen``), already bounded in size by the server
   (``max_frame_bytes``): a camera update goes on to viser; ``{"value": v}`` for
   an input the viewer registered goes to the viewer's callback and never to
-  viser (which would apply and re-broadcast it); so does a transform-controls
+  viser (which would apply and re-broadcast it), and a bad value for it (NaN,
+  a word) to the viewer's ``refused`` callback, which shows the tab the true
+  value again; so does a transform-controls
   update (finite position, unit quaternion) for a handle the viewer
   registered (its drag start and end are let go quietly); a click (finite
   ray) on a node the viewer made clickable goes on to viser, which calls the
@@ -79,6 +81,7 @@ def _is_page(path: str) -> bool:
 class _Input:
     kind: type
     callback: InputCallback
+    refused: Callable[[int], None] | None
 
 
 class Door:
@@ -124,16 +127,24 @@ class Door:
 
     # what the viewer registers
 
-    def accept_input(self, uuid: str, kind: type, callback: InputCallback) -> None:
+    def accept_input(
+        self,
+        uuid: str,
+        kind: type,
+        callback: InputCallback,
+        refused: Callable[[int], None] | None = None,
+    ) -> None:
         """Hand ``{"value": v}`` for ``uuid`` to ``callback(client_id, v)``.
 
         ``kind`` is ``bool`` (a checkbox or button: only true/false) or
-        ``float`` (a slider or number: any finite number, as a float). The
-        callback runs on viser's thread and must return at once.
+        ``float`` (a slider or number: any finite number, as a float). A value
+        dropped for ``uuid`` (NaN, a word, another field) goes to
+        ``refused(client_id)``, so the tab can be shown the true value again.
+        Both run on viser's thread and must return at once.
         """
         if kind not in (bool, float):
             raise TypeError(f"an input's kind is bool or float, not {kind!r}")
-        self._inputs[uuid] = _Input(kind, callback)
+        self._inputs[uuid] = _Input(kind, callback, refused)
 
     def forget_input(self, uuid: str) -> None:
         self._inputs.pop(uuid, None)
@@ -281,6 +292,7 @@ class Door:
                 self._drop("message", "a camera update that is malformed or not finite")
         except frames.Dropped as dropped:
             self._drop(dropped.kind, dropped.what)
+            self._refused(connection, dropped.uuid)
         return None
 
     def _input(self, connection: ServerConnection, update: frames.GuiUpdate) -> None:
@@ -291,11 +303,19 @@ class Door:
             return
         if target.kind is bool and not isinstance(value, bool):
             self._drop("input", "a number for a checkbox or button")
+            self._refused(connection, update.uuid)
             return
         if target.kind is float and (isinstance(value, bool) or not math.isfinite(value)):
             self._drop("input", f"{value!r} for a slider (a finite number is needed)")
+            self._refused(connection, update.uuid)
             return
         self._call(target.callback, self.identify(connection), value)
+
+    def _refused(self, connection: ServerConnection, uuid: str | None) -> None:
+        """Tell the control's owner that a value for it was dropped (if it asked)."""
+        target = self._inputs.get(uuid) if uuid is not None else None
+        if target is not None and target.refused is not None:
+            self._call(target.refused, self.identify(connection))
 
     def _handle(self, connection: ServerConnection, move: frames.HandleMove) -> None:
         target = self._handles.get(move.name)

@@ -47,12 +47,14 @@ REFUSED = {
 
 
 class Dropped(Exception):
-    """A frame the door does not take: ``kind`` counts it, ``what`` says it in a log line."""
+    """A frame the door does not take: ``kind`` counts it, ``what`` says it in a log line,
+    ``uuid`` names the control it was meant for, when it could be read."""
 
-    def __init__(self, kind: str, what: str) -> None:
+    def __init__(self, kind: str, what: str, uuid: str | None = None) -> None:
         super().__init__(what)
         self.kind = kind
         self.what = what
+        self.uuid = uuid
 
 
 class _Envelope(msgspec.Struct):
@@ -67,6 +69,10 @@ class GuiUpdate(msgspec.Struct, forbid_unknown_fields=True):
     type: str
     uuid: str
     updates: _Value
+
+
+class _AnyUpdate(msgspec.Struct):
+    uuid: str
 
 
 class HandleMove(msgspec.Struct, forbid_unknown_fields=True):
@@ -110,6 +116,7 @@ class _Camera(msgspec.Struct, forbid_unknown_fields=True):
 CAMERA_FIELDS = tuple(f for f in _Camera.__struct_fields__ if f != "type")
 _ENVELOPE = msgspec.msgpack.Decoder(_Envelope)
 _GUI_UPDATE = msgspec.msgpack.Decoder(GuiUpdate)
+_ANY_UPDATE = msgspec.msgpack.Decoder(_AnyUpdate)
 _CAMERA = msgspec.msgpack.Decoder(_Camera)
 _HANDLE_MOVE = msgspec.msgpack.Decoder(HandleMove)
 _HANDLE_GRAB = msgspec.msgpack.Decoder(HandleGrab)
@@ -131,8 +138,12 @@ def read_input(frame: bytes) -> GuiUpdate:
     try:
         return _GUI_UPDATE.decode(frame)
     except msgspec.MsgspecError:
+        try:
+            uuid: str | None = _ANY_UPDATE.decode(frame).uuid
+        except msgspec.MsgspecError:
+            uuid = None
         raise Dropped(
-            "input", "an input update other than {'value': a number or true/false}"
+            "input", "an input update other than {'value': a number or true/false}", uuid
         ) from None
 
 

@@ -5,7 +5,8 @@ becomes ``move 1 30.0`` on that robot's page session (source ``page``,
 degrees mode), the Home / Random / Stop buttons ``home`` / ``rand`` /
 ``stop``, the speed slider ``speed 40.0``, the Trail checkbox ``trail on`` /
 ``trail off``. The session checks them; a refused
-value is sent back to the tab as the true one. A click on a marker chooses it
+value is sent back to the tab as the true one, and so is a value the door
+drops (NaN, a word). A click on a marker chooses it
 in its robot's folder; "Go to marker" then runs ``moveto marker N`` (N: where
 the chosen marker stands now among the robot's markers).
 
@@ -106,7 +107,17 @@ class PageInput:
 
     def _bind(self, handle: Any, apply: Apply) -> None:
         arrived = functools.partial(self._arrived, id(handle), apply)
-        adapter.accept_input(self._server, handle, arrived)
+        refused = functools.partial(self._arrived, ("refused", id(handle)), self._resend(handle))
+        adapter.accept_input(self._server, handle, arrived, lambda client: refused(client, None))
+
+    @staticmethod
+    def _resend(handle: Any) -> Apply:
+        """Show every tab ``handle``'s true value (after a value the door dropped)."""
+
+        def resend(client: int, value: Any) -> None:
+            adapter.set_gui_value(handle, handle.value, force=True)
+
+        return resend
 
     def _arrived(self, key: Any, apply: Apply, client: int, value: Any) -> None:
         loop = self._loop
