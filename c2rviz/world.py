@@ -107,7 +107,7 @@ class World:
             self.state(name).origin = origin
         self.default = next(iter(self.robots))
         self.contacts = Contacts(
-            self.robots, self._tell_collisions, 1.0 / hz, dict(disabled_pairs or {})
+            self.robots, self._tell_collisions, 1.0 / hz, dict(disabled_pairs or {}), max_objects
         )
         self.observers: list[Observer] = [self.contacts]
         if scene is not None:

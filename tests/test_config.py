@@ -228,3 +228,61 @@ def test_a_bad_door_setting_exits_2_with_one_sentence(argv, message, capsys):
     assert main([*argv, "--viser-port", "0", "--port", "0"]) == 2
     err = capsys.readouterr().err.strip()
     assert message in err and err.count("\n") == 0, err
+
+
+def session_settings(port: int) -> dict[str, str]:
+    """What a new connection starts with: motion, speed, guard and lspeed replies."""
+    sock = socket.create_connection(("127.0.0.1", port), timeout=30)
+    with sock, sock.makefile("rb") as replies_in:
+        answers = {}
+        for verb in ("motion", "speed", "guard", "lspeed"):
+            sock.sendall(f"{verb}\n".encode())
+            answers[verb] = replies_in.readline().decode().strip()
+        return answers
+
+
+def test_session_defaults_and_workcell_limits_from_the_ini_and_from_flags(tmp_path, c2rviz_process):
+    """motion, speed, guard, lspeed and max_objects from [options]; the flags win; --srdf
+    turns pairs off. Read back over the command port, as a controller would."""
+    ini = tmp_path / "c2rviz.ini"  # the shipped file, its defaults changed
+    text = (ROOT / "cmdinterpreter.ini").read_text().replace("= robots/", f"= {ROOT}/robots/")
+    for default, value in (
+        ("motion = off", "motion = on"),
+        ("speed = 50", "speed = 30"),
+        ("guard = off", "guard = on"),
+        ("lspeed = 0.25", "lspeed = 0.1"),
+        ("max_objects = 100", "max_objects = 2"),
+    ):
+        assert f"\n{default}\n" in text, default
+        text = text.replace(f"\n{default}\n", f"\n{value}\n", 1)
+    ini.write_text(text)
+    proc = c2rviz_process("--config", str(ini), "--no-viewer")
+    assert session_settings(proc.port) == {
+        "motion": "ok on",
+        "speed": "ok 30",
+        "guard": "ok on",
+        "lspeed": "ok 0.1",
+    }
+    client = Client("127.0.0.1", proc.port)
+    try:
+        assert client.ask("object a sphere 0.05 2,0,0") == "ok"
+        assert client.ask("object b sphere 0.05 2,1,0") == "ok"
+        assert client.ask("object c sphere 0.05 2,2,0").startswith("error: ")  # 2 at most
+    finally:
+        client.close()
+    srdf = ROOT / "tests" / "data" / "collision" / "motoman.srdf"
+    flags = ("--motion", "follow", "--speed", "70", "--guard", "off", "--srdf", str(srdf))
+    other = c2rviz_process("--config", str(ini), "--no-viewer", *flags)
+    assert session_settings(other.port) == {
+        "motion": "ok follow",
+        "speed": "ok 70",
+        "guard": "ok off",
+        "lspeed": "ok 0.1",
+    }
+    client = Client("127.0.0.1", other.port)
+    try:
+        for line in ("motion off", "degrees", "j 0,-106,0,122,0,0,0"):  # folded onto its base
+            assert client.ask(line) == "ok"
+        assert client.ask("collisions") == "ok base_link~link_u"  # the SRDF's pairs are off
+    finally:
+        client.close()
