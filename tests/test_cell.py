@@ -159,6 +159,47 @@ def test_watch_events_name_only_their_own_robot(cell: CellThread):
     assert not [line for line in seen["right"] if line == "event stopped"]
 
 
+def test_a_switch_keeps_speed_and_marker_style_and_pose_stays_in_the_base_frame(
+    cell: CellThread,
+):
+    client = cell.client("left")
+    for line in ("speed 30", "marker cube", "color 0,1,0", "robot right"):
+        assert client.ask(line) == "ok"
+    assert client.ask("speed") == "ok 30"
+    assert client.ask("mark 0.4,0,0.3,0,0,0") == "ok"
+    (marker,) = cell.call(lambda: list(cell.world.state("right").markers))
+    assert (marker.shape, marker.rgb) == ("cube", (0.0, 1.0, 0.0))
+    # The Fanuc stands at x = 1.2 m, turned round: its pose is in its own base frame.
+    fanuc = load_robot("fanuc_lrmate200id")
+    home = fanuc.ee_pose(fanuc.home)
+    expected = [*home.translation, *pin.rpy.matrixToRpy(home.rotation)]
+    got = [float(v) for v in client.ask("pose").removeprefix("ok ").split(",")]
+    np.testing.assert_allclose(got, expected, atol=1e-9)
+
+
+def test_the_seeds_command_line_client_drives_the_second_robot(cell: CellThread):
+    """`python clients/socketcmdline.py --port <right's port>` drives the Fanuc."""
+    script = "degrees\nj 0,30,0,0,0,0\nwhere\nnames\n"
+    done = subprocess.run(
+        [
+            sys.executable,
+            str(ROOT / "clients" / "socketcmdline.py"),
+            "--port",
+            str(cell.ports["right"]),
+        ],
+        input=script,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        cwd=ROOT,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "  1  joint_2  30\n" in done.stdout  # the REPL's `where`, a row per joint
+    assert "ok right joint_1," in done.stdout
+    assert cell.call(lambda: cell.world.state("right").q)[1] == pytest.approx(math.radians(30))
+    assert cell.call(lambda: cell.world.state("left").q) == (0.0,) * 7
+
+
 def test_the_same_model_twice_with_different_origins() -> None:
     cell = CellThread(
         {"a": "motoman_sia20d", "b": "motoman_sia20d"},

@@ -91,6 +91,29 @@ def test_guarded_motion_refuses_a_path_through_the_box_before_it_starts(
     assert client.ask(f"j {REACH}") == "ok"  # a free path goes
 
 
+def test_guard_covers_moveto_and_the_whole_movel_line(server: ServerThread, connect):
+    client = connect(server)
+    client.ask("degrees")
+    client.ask(BOX)
+    poses = {}
+    for name, q in (("into", INTO), ("left", "70,60,0,0,0,0,0"), ("right", "110,60,0,0,0,0,0")):
+        assert client.ask(f"j {q}") == "ok"  # guard off: anywhere
+        poses[name] = client.ask("pose")[3:]
+    assert client.ask(f"j {REACH}") == "ok"
+    assert client.ask("guard on") == "ok"
+    reply = client.ask(f"moveto {poses['into']}")  # the tool in the box
+    assert re.fullmatch(r"error: link_\w+ would hit table at the target", reply), reply
+    assert client.ask("where") == f"ok {REACH}"
+    # 70 and 110 degrees round are free; the straight line between passes the box at 90.
+    assert client.ask("j 70,60,0,0,0,0,0") == "ok"
+    reply = client.ask(f"movel {poses['right']}")
+    assert re.fullmatch(r"error: .*link_\w+ would hit table.*", reply), reply
+    assert client.ask("where") == "ok 70,60,0,0,0,0,0"
+    assert client.ask("guard off") == "ok"
+    assert client.ask(f"movel {poses['right']}") == "ok"  # the same line, unguarded, goes
+    assert client.ask("collisions") == "ok none"
+
+
 def test_rand_under_guard_draws_only_free_configurations(server: ServerThread, connect):
     client = connect(server)
     watcher = connect(server)
