@@ -83,6 +83,8 @@ def load_link_geometry(source: RobotSource) -> dict[str, LinkGeometry]:
         io.BytesIO(source.xml.encode("utf-8")), build_scene_graph=False, load_meshes=False
     )
     materials = {m.name: m for m in urdf.robot.materials if m.name is not None}
+    for missing in source.missing_meshes():  # each once, with its links and a hint
+        log.warning("%s", missing.message())
     loader = _MeshLoader(source)
     links: dict[str, LinkGeometry] = {}
     for link in urdf.robot.links:
@@ -192,9 +194,7 @@ class _MeshLoader:
 
     def _read(self, uri: str) -> list[trimesh.Trimesh] | None:
         path = self.source.resolve(uri)
-        if path is None:
-            searched = ", ".join(map(str, self.source.searched(uri))) or "nowhere (remote URI)"
-            log.warning("mesh %s not found; looked in: %s", uri, searched)
+        if path is None:  # said already (load_link_geometry)
             return None
         try:
             with warnings.catch_warnings(record=True) as caught:

@@ -355,7 +355,7 @@ def test_long_joint_names_stay_on_one_line(
     proc = c2rviz_process("--robot", "ur5", "--viser-port", "0")
     page = browser.new_page(viewport=VIEWPORT)
     page.goto(proc.viewer_url + "/?fixedDpr=1")
-    page.get_by_text("Speed %").first.wait_for(timeout=30_000)
+    page.get_by_text("Speed %").first.wait_for(timeout=DEADLINE_S * 1000)
     assert page.title() == "c2rviz — ur5"
     heights = {}
     for label in ("Speed %", "shoulder_pan", "shoulder_lift", "elbow", "wrist_1"):

@@ -414,9 +414,11 @@ def test_missing_meshes_warn_and_fall_back(
     with caplog.at_level(logging.WARNING):
         h = harness(robot)
     text = caplog.text
-    assert "package://nowhere_pkg/meshes/base.stl not found" in text
+    assert "mesh package://nowhere_pkg/meshes/base.stl of link base not found" in text
     assert str(tmp_path / "nowhere_pkg" / "meshes" / "base.stl") in text  # a place searched
-    assert "file:///no/such/hand.dae not found" in text
+    assert "holds nowhere_pkg with --package-path DIR" in text  # what to do about it
+    assert "mesh file:///no/such/hand.dae of link hand not found" in text
+    assert text.count("hand.dae of link hand not found") == 1  # once, not per use
     assert "link base is drawn with its collision geometry" in text
     assert "link hand is drawn with a placeholder box" in text
     assert "arm.stl" not in text  # found next to the URDF

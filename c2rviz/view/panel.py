@@ -103,7 +103,9 @@ class RobotPanel:
                 hint="speed of the page's own moves, % of the joints' limits",
             )
             self.buttons = {
-                "home": gui.add_button("Home", hint="all joints to zero (home)"),
+                "home": gui.add_button(
+                    "Home", hint="every joint home: 0, or its nearest limit if 0 is outside"
+                ),
                 "rand": gui.add_button("Random", hint="every joint to a random value"),
                 "stop": gui.add_button("Stop", hint="stop the arm where it is"),
             }
