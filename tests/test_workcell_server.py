@@ -131,12 +131,24 @@ def test_rand_under_guard_draws_only_free_configurations(server: ServerThread, c
         ("object t cone 1 0,0,0", "unknown shape 'cone'; choose box, sphere or cylinder"),
         ("object t mesh /etc/passwd 0,0,0,0,0,0", "unknown shape 'mesh'"),
         ("object a/b sphere 1 0,0,0", "bad object name 'a/b'"),
+        ("object my table box 1,1,1 0,0,0,0,0,0", "bad object name 'my table': one word"),
         ("object all sphere 1 0,0,0", "'all' is not an object name"),
         ("object t sphere 1", "sphere takes a size and a pose"),
         ("object t box 1,1 0,0,0,0,0,0", "needs 3 values, got 2"),
         ("guard maybe", "'maybe' is neither on nor off"),
     ],
-    ids=["negative", "nan", "cone", "mesh-file", "slash", "all", "no-pose", "two-sizes", "guard"],
+    ids=[
+        "negative",
+        "nan",
+        "cone",
+        "mesh-file",
+        "slash",
+        "space",
+        "all",
+        "no-pose",
+        "two-sizes",
+        "guard",
+    ],
 )
 def test_bad_object_lines_change_nothing(server: ServerThread, connect, line: str, error: str):
     client = connect(server)

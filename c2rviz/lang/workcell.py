@@ -41,6 +41,13 @@ def _parse_object(verb: str, words: list[str]) -> ObjectEdit:
         return ObjectEdit(name, "remove")
     if name == "all":
         raise BadArguments(verb, "'all' is not an object name (all remove clears)", usage(verb))
+    if kind not in _SHAPES and len(words) > 2 and words[2].lower() in (*_SHAPES, "remove"):
+        raise BadArguments(
+            verb,
+            f"bad object name {shown(' '.join(words[:2]))}: one word, no spaces "
+            "(letters, digits, _ . -)",
+            usage(verb),
+        )
     if kind not in _SHAPES:
         raise BadArguments(
             verb,
