@@ -15,6 +15,9 @@ where its base stands in the cell and which port it listens on::
     origin = 1.2,0,0,0,0,180
     port = 31001
 
+A member may instead be a robot section itself (``urdf = ...``, with ``base``,
+``eelink`` and the other robot keys), plus its ``origin`` and ``port``.
+
 ``--cell NAME`` takes ``[cell:NAME]`` from the ini in use; ``--cell PATH`` reads
 the ini file at PATH and takes its only cell. Every mistake is a ``ConfigError``
 naming the section and the valid choices.
@@ -28,7 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .catalogue import CatalogueEntry, find_robot
-from .config import number, read_robots
+from .config import ROBOT_KEYS, number, read_robots
 from .errors import ConfigError
 
 __all__ = ["Cell", "CellMember", "load_cell"]
@@ -124,12 +127,19 @@ def _member(
     if not parser.has_section(name):
         raise ConfigError(f"[{cell}] of {ini} names robot {name!r}, which has no [{name}] section")
     items = dict(parser.items(name))
-    unknown = sorted(set(items) - set(_MEMBER_KEYS))
-    if unknown:
-        raise ConfigError(f"unknown key {unknown[0]!r} in [{name}] of {ini}", _MEMBER_KEYS)
-    if "robot" not in items:
-        raise ConfigError(f"[{name}] of {ini} needs robot = NAME (any name --robot takes)")
-    entry = find_robot(items["robot"], robots, ini)
+    if "robot" not in items and "urdf" in items:  # the member is a robot section itself
+        entry = find_robot(name, robots, ini)
+    else:
+        unknown = sorted(set(items) - set(_MEMBER_KEYS))
+        if unknown:
+            raise ConfigError(
+                f"unknown key {unknown[0]!r} in [{name}] of {ini}", [*_MEMBER_KEYS, *ROBOT_KEYS]
+            )
+        if "robot" not in items:
+            raise ConfigError(
+                f"[{name}] of {ini} needs robot = NAME (any name --robot takes) or urdf = PATH"
+            )
+        entry = find_robot(items["robot"], robots, ini)
     port = number(f"[{name}] port", items.get("port", "0"), int, 0, 65535)
     extras = robots[entry.name].extras if entry.name in robots else ()
     origin = _origin(items.get("origin", "0,0,0,0,0,0"), name)

@@ -24,6 +24,7 @@ from .sources import split_package_path
 
 __all__ = [
     "INI_NAME",
+    "ROBOT_KEYS",
     "ServerLimits",
     "SessionDefaults",
     "RobotEntry",
@@ -173,7 +174,8 @@ _TEXT_OPTIONS = (
 )
 _CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on")}
 _EXTRA_KEYS = ["tool", "max_velocity", "max_acceleration", "max_jerk"]
-_ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args", *_EXTRA_KEYS]
+ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args", *_EXTRA_KEYS]
+_MEMBER_PLACE_KEYS = ("origin", "port")  # a cell member's, beside its robot keys (cell.py)
 _LIMIT_FIELDS = {f for f in ServerLimits.__dataclass_fields__}
 _SESSION_FIELDS = {f for f in SessionDefaults.__dataclass_fields__}
 
@@ -233,16 +235,24 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
                     sorted([*_OPTIONS, *_TEXT_OPTIONS]),
                 )
     robots = {}
+    members = {  # sections a cell names: they may also say where the robot stands
+        name
+        for section in parser.sections()
+        if section.startswith("cell:")
+        for name in parser.get(section, "robots", fallback="").split()
+    }
     for section in parser.sections():
         if section in ("options", "objects") or section.startswith(("cell:", "objects:")):
             continue
         items = dict(parser.items(section))
         if "robot" in items:  # a member of a cell (see cell.py), not a robot of its own
             continue
-        unknown = set(items) - set(_ROBOT_KEYS)
+        if section in members:
+            items = {k: v for k, v in items.items() if k not in _MEMBER_PLACE_KEYS}
+        unknown = set(items) - set(ROBOT_KEYS)
         if unknown:
             raise ConfigError(
-                f"unknown key {sorted(unknown)[0]!r} in [{section}] of {path}", _ROBOT_KEYS
+                f"unknown key {sorted(unknown)[0]!r} in [{section}] of {path}", ROBOT_KEYS
             )
         urdf = items.get("urdf")
         if not urdf:

@@ -270,6 +270,25 @@ def test_a_cell_from_the_ini(tmp_path: Path):
         assert cell.members[1].origin == pytest.approx((1.2, 0, 0, 0, 0, math.pi))
 
 
+def test_a_member_may_be_a_urdf_of_its_own(tmp_path: Path):
+    """`[right]` with `urdf = ...` (and base, eelink, tool) instead of `robot = NAME`."""
+    text = CELL_INI.replace(
+        "[right]\nrobot = fanuc_lrmate200id\n",
+        "[right]\nurdf = {root}/robots/kuka_lwr/robot.urdf\nbase = lwr_base_link\n"
+        "eelink = lwr_7_link\ntool = 0,0,0.1,0,0,0\n",
+    )
+    cell = load_cell("twoarms", write_ini(tmp_path, text))
+    right = cell.members[1]
+    assert (right.name, right.entry.name, right.port) == ("right", "right", 31001)
+    assert right.entry.urdf == ROOT / "robots" / "kuka_lwr" / "robot.urdf"
+    assert (right.entry.base, right.entry.eelink) == ("lwr_base_link", "lwr_7_link")
+    assert right.extras == (("tool", "0,0,0.1,0,0,0"),)
+    assert right.origin == pytest.approx((1.2, 0, 0, 0, 0, math.pi))
+    bad = text.replace("tool = 0,0,0.1,0,0,0", "colour = red")
+    with pytest.raises(ConfigError, match="unknown key 'colour' in \\[right\\]"):
+        load_cell("twoarms", write_ini(tmp_path, bad))
+
+
 @pytest.mark.parametrize(
     ("change", "message"),
     [
