@@ -170,6 +170,28 @@ def test_the_ghost_stands_at_the_target_while_moving_and_stop_stops(
     assert ("stop", True) in h.scene._commands
 
 
+def test_a_slider_dragged_during_a_move_preempts_it(harness: Callable[..., Harness]) -> None:
+    """The page is a client like any other: its slider's move takes over a TCP client's,
+    which hears `preempted by page`; the arm goes on to the page's target."""
+    world = World(load_robot(), None, defaults=SessionDefaults(motion="on", speed=20.0))
+    h = harness(world)
+    tab = h.tab()
+    client = Session(world, source="tcp 1")
+    client.set_degrees(True)
+    client.motion = "on"
+    arrival = h.call(lambda: client.run("move 0,1 90,60"))
+    arrived: list[Any] = []
+    arrival.add_done_callback(lambda f: arrived.append(f.exception()))
+    h.until(lambda: world.q[0] > np.radians(5.0), "the move under way")
+    tab.set(h.panel.sliders[0], -30.0)
+    h.until(lambda: bool(arrived), "the client's reply")
+    assert isinstance(arrived[0], MotionInterrupted)
+    assert "preempted by page" in str(arrived[0])
+    h.until(lambda: not world.state().travel.active, "the page's move to end")
+    assert world.q[0] == pytest.approx(np.radians(-30.0))
+    assert world.q[1] == pytest.approx(np.radians(60.0))  # `move` keeps the other targets
+
+
 def test_the_speed_slider_sets_the_page_sessions_speed(harness: Callable[..., Harness]) -> None:
     world = World(load_robot(), None, defaults=SessionDefaults(motion="on"))
     h = harness(world)
