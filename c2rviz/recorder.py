@@ -11,7 +11,8 @@ and replays alike) that writes, in the recording folder:
   sources that sent commands.
 - ``NAME.csv``, one row per frame: ``time`` [s from the start], each joint by name
   [rad or m], and the tool pose ``x,y,z`` [m] ``roll,pitch,yaw`` [rad] in the base
-  frame (as ``pose`` gives it), with a header row.
+  frame (as ``pose`` gives it), with a header row; values to 10 significant digits
+  as replies give them (NAME.txt keeps them exact, so a replay is the same states).
 
 It never slows the command path: states are coalesced to at most one frame per
 ``1/hz`` of the world's clock (a state superseded within a frame is dropped; the
@@ -37,6 +38,7 @@ from typing import TYPE_CHECKING, TextIO
 import numpy as np
 import pinocchio as pin
 
+from . import replies
 from .scene import Marker, Observer
 
 if TYPE_CHECKING:
@@ -206,11 +208,10 @@ class Recorder(Observer):
     def _frame(self, q: Sequence[float], t: float) -> None:
         us = self._sleep_to(t)
         self._due = t + self.period_s
-        values = _numbers(q)
         placement = self.state.robot.ee_pose(q) * self.state.tool
-        pose = _numbers([*placement.translation, *pin.rpy.matrixToRpy(placement.rotation)])
-        self._write(self._body, f"joints {values}\n")
-        self._write(self._rows, f"{us / 1e6:.6f},{values},{pose}\n")
+        pose = replies.numbers([*placement.translation, *pin.rpy.matrixToRpy(placement.rotation)])
+        self._write(self._body, f"joints {_numbers(q)}\n")  # exact: a replay is the same
+        self._write(self._rows, f"{us / 1e6:.6f},{replies.numbers(q)},{pose}\n")
         self.frames += 1
         if t - self._flushed >= FLUSH_S and not self.closed:
             self._flushed = t

@@ -106,14 +106,18 @@ def test_a_recorded_session_replays_to_the_same_states(
     assert header == ["time", *names, "x", "y", "z", "roll", "pitch", "yaw"]
     joints_lines = [line.wire for line in script.lines if line.wire.startswith("joints")]
     assert len(frames) == len(joints_lines) > 100  # the moves took over a second each
-    for line, row in zip(joints_lines, frames):
-        assert [float(v) for v in line.split()[1].split(",")] == list(row[1:8])
-    assert (np.diff(frames[:, 0]) >= FRAME_S - 1e-6).all()
     robot = load_robot()
-    for row in frames[:: len(frames) // 10]:
-        pose = robot.ee_pose(row[1:8])
+    for line, row in zip(joints_lines, frames):  # the file exact, the table to 10 digits
+        exact = [float(v) for v in line.split()[1].split(",")]
+        assert row[1:8] == pytest.approx(exact, rel=1e-9, abs=1e-9)
+    with open(table, newline="") as file:
+        raw = list(csv.reader(file))[1:]
+    assert all(v == "0" or v == f"{float(v):.10g}" for row in raw for v in row[1:])  # short
+    assert (np.diff(frames[:, 0]) >= FRAME_S - 1e-6).all()
+    for line, row in list(zip(joints_lines, frames))[:: len(frames) // 10]:
+        pose = robot.ee_pose([float(v) for v in line.split()[1].split(",")])
         expected = [*pose.translation, *pin.rpy.matrixToRpy(pose.rotation)]
-        np.testing.assert_allclose(row[8:], expected, atol=1e-12)
+        np.testing.assert_allclose(row[8:], expected, rtol=1e-9, atol=1e-9)
     assert ",".join(f"{v:.10g}" for v in frames[-1, 1:8]) == ",".join(
         f"{v:.10g}" for v in map(float, final[3:].split(","))
     )
