@@ -288,6 +288,37 @@ def test_the_page_is_titled_by_the_robot(harness: Callable[..., Harness], encodi
     assert b"<title>Viser</title>" not in body
 
 
+def test_a_sliders_hint_gives_the_limits_as_limits_prints_them(
+    harness: Callable[..., Harness],
+) -> None:
+    """puma560's +-1.570796325 rad: `limits` says -89.9999999..89.9999999 deg, and so does
+    the slider's hint; the slider itself stops at its last 0.1 step inside the limits."""
+    from test_any_robot import LIMITS_URDF
+
+    world = World(Robot.from_urdf(LIMITS_URDF), None)
+    h = harness(world)
+    tab = h.tab()
+    session = Session(world)
+    session.set_degrees(True)
+    limits = session.run("limits").removeprefix("ok ").split(",")
+
+    def shown(slider: Any) -> dict[str, Any]:  # what the page was told of the slider
+        (added,) = [m for m in tab.received if m.get("uuid") == slider._impl.uuid and "props" in m]
+        return dict(added["props"])
+
+    for i, slider in enumerate(h.panel.sliders):
+        props = shown(slider)
+        low, high = limits[i].split(" ")[0].split("..")
+        if world.robot.joints[i].continuous:
+            assert props["hint"].endswith("turns freely")
+            continue
+        assert props["hint"].endswith(f"limits {low}..{high}"), i
+        assert float(low) <= props["min"] and props["max"] <= float(high)  # inside the limits
+    props = shown(h.panel.sliders[0])
+    assert props["hint"] == "joint 0: joint1 [deg], limits -89.9999999..89.9999999"
+    assert (props["min"], props["max"]) == (-89.9, 89.9)
+
+
 def test_long_joint_names_get_short_labels_and_keep_the_whole_in_the_hint() -> None:
     assert short_label("joint_s") == "joint_s"
     assert short_label("shoulder_pan_joint") == "shoulder_pan"

@@ -25,6 +25,7 @@ import pinocchio as pin
 import viser
 
 from ..scene import Marker
+from ..tolerance import limit_text
 from ..world import RobotState
 from . import adapter
 
@@ -79,8 +80,10 @@ class RobotPanel:
                 else:
                     low, high = math.degrees(joint.lower), math.degrees(joint.upper)
                     step, unit = 0.1, "deg"
-                # Round the ends inward to a step: "-180.000421" reads badly, and the
-                # slider cannot pass a limit (values shown are clamped to the ends).
+                # The slider stops at its last step inside each limit (it cannot pass one)
+                # and its end labels say where; the hint gives the limits as `limits` and
+                # errors print them (printed under the track, 10 digits do not fit).
+                ends = (limit_text(low), limit_text(high))
                 low = round(math.ceil(low / step - 1e-9) * step, 6)
                 high = round(math.floor(high / step + 1e-9) * step, 6)
                 self.ranges.append((low, high))
@@ -91,7 +94,8 @@ class RobotPanel:
                         max=high,
                         step=step,
                         initial_value=self.to_slider(i, state.target[i]),
-                        hint=f"joint {i}: {joint.name} [{unit}]",
+                        hint=f"joint {i}: {joint.name} [{unit}], "
+                        + ("turns freely" if joint.continuous else f"limits {ends[0]}..{ends[1]}"),
                     )
                 )
             self.speed: Any = gui.add_slider(
