@@ -14,6 +14,7 @@ CI machine is slow, not wrong; a timeout says what it last saw.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import socket
 import time
@@ -208,6 +209,23 @@ def open_page(browser: Any, url: str) -> Any:
     page.goto(url + "/?fixedDpr=1")
     page.get_by_text(JOINTS[-1]).first.wait_for(timeout=DEADLINE_S * 1000)  # the panel
     return page
+
+
+@contextlib.contextmanager
+def program_page(
+    browser: Any, c2rviz_process: Callable[..., Any], *args: str
+) -> Iterator[tuple[Any, Any, Tcp]]:
+    """The program (``ARGS``, its viewer on a free port), a page with the robot drawn, and a
+    controller on its command port (closed after)."""
+    ARTIFACTS.mkdir(exist_ok=True)
+    proc = c2rviz_process("--viser-port", "0", *args)
+    page = open_page(browser, proc.viewer_url)
+    wait_for_robot(page)
+    tcp = Tcp(proc.port)
+    try:
+        yield proc, page, tcp
+    finally:
+        tcp.close()
 
 
 def wait_for(predicate: Callable[[], bool], what: str = "timed out") -> None:

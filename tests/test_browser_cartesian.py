@@ -17,17 +17,7 @@ from collections.abc import Callable
 from typing import Any
 
 import pytest
-from test_browser import (
-    ARTIFACTS,
-    Tcp,
-    changed,
-    field,
-    open_page,
-    settle,
-    wait_for,
-    wait_for_robot,
-    wait_until,
-)
+from test_browser import changed, field, program_page, settle, wait_for, wait_until
 
 pytestmark = pytest.mark.browser
 
@@ -76,12 +66,7 @@ def numbers(reply: str) -> list[float]:
 def test_dragging_the_tool_handle_moves_the_arm(
     browser: Any, c2rviz_process: Callable[..., Any]
 ) -> None:
-    ARTIFACTS.mkdir(exist_ok=True)
-    proc = c2rviz_process("--viser-port", "0")
-    page = open_page(browser, proc.viewer_url)
-    wait_for_robot(page)
-    tcp = Tcp(proc.port)
-    try:
+    with program_page(browser, c2rviz_process) as (_proc, page, tcp):
         home = tcp.ask("where")
         before = settle(page, "handle-1-before")
         found = wait_until(
@@ -105,19 +90,12 @@ def test_dragging_the_tool_handle_moves_the_arm(
         assert moved.startswith("ok ") and len(numbers(moved)) == 7
         wait_for(lambda: changed(before, settle(page, "handle-2-after")) > 200, "a new picture")
         assert "moveto " in field(page, "Last commands").input_value()
-    finally:
-        tcp.close()
 
 
 def test_clicking_a_marker_and_go_to_puts_the_tool_on_it(
     browser: Any, c2rviz_process: Callable[..., Any]
 ) -> None:
-    ARTIFACTS.mkdir(exist_ok=True)
-    proc = c2rviz_process("--viser-port", "0")
-    page = open_page(browser, proc.viewer_url)
-    wait_for_robot(page)
-    tcp = Tcp(proc.port)
-    try:
+    with program_page(browser, c2rviz_process) as (_proc, page, tcp):
         # A marker where the tool stands at a reachable pose, then back home.
         for line in ("degrees", "move 1,3,5 30,-40,45", "marker cube", "mark"):
             assert tcp.ask(line) == "ok", line
@@ -145,5 +123,3 @@ def test_clicking_a_marker_and_go_to_puts_the_tool_on_it(
         assert all(min(d, 360.0 - d) < 0.1 for d in turned), (reached, marked)
         assert "moveto marker 1" in field(page, "Last commands").input_value()
         settle(page, "marker-2-there")
-    finally:
-        tcp.close()

@@ -13,16 +13,14 @@ from typing import Any
 import numpy as np
 import pytest
 from test_browser import (
-    ARTIFACTS,
     Tcp,
     changed,
-    open_page,
     page_state,
+    program_page,
     same_poses,
     scene_pixels,
     settle,
     wait_for,
-    wait_for_robot,
     wait_for_scene,
 )
 
@@ -34,12 +32,9 @@ TARGET = "90,45,0,-30,0,60,0"  # degrees
 def test_a_move_in_motion_is_drawn_as_it_goes_and_ends_at_the_target(
     browser: Any, c2rviz_process: Callable[..., Any]
 ) -> None:
-    ARTIFACTS.mkdir(exist_ok=True)
-    proc = c2rviz_process("--viser-port", "0")
-    page = open_page(browser, proc.viewer_url)
-    home_poses = wait_for_robot(page)["poses"]
-    mover, asker = Tcp(proc.port), Tcp(proc.port)
-    try:
+    with program_page(browser, c2rviz_process) as (proc, page, mover):
+        asker = Tcp(proc.port)
+        home_poses = page_state(page)["poses"]  # type: ignore[index]
         for line in ("degrees", "motion on", "speed 15"):
             assert mover.ask(line) == "ok"
         mover.sock.sendall(f"j {TARGET}\n".encode())  # the reply comes on arrival
@@ -70,6 +65,4 @@ def test_a_move_in_motion_is_drawn_as_it_goes_and_ends_at_the_target(
         wait_for_scene(page, "the target", lambda state: same_poses(state["poses"], end_poses))
         at_once = settle(page, "motion-2-at-once")
         assert changed(moved, at_once) < 20
-    finally:
-        mover.close()
         asker.close()

@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from test_browser import ARTIFACTS, Tcp, open_page, scene_pixels, settle, wait_for, wait_for_robot
+from test_browser import program_page, scene_pixels, settle, wait_for
 
 pytestmark = pytest.mark.browser
 
@@ -29,12 +29,7 @@ def orange_pixels(scene: np.ndarray) -> int:
 def test_a_move_leaves_a_trail_on_the_page(
     browser: Any, c2rviz_process: Callable[..., Any]
 ) -> None:
-    ARTIFACTS.mkdir(exist_ok=True)
-    proc = c2rviz_process("--viser-port", "0")
-    page = open_page(browser, proc.viewer_url)
-    wait_for_robot(page)
-    tcp = Tcp(proc.port)
-    try:
+    with program_page(browser, c2rviz_process) as (_proc, page, tcp):
         before = orange_pixels(settle(page, "trail-1-before"))
         for line in ("trail on", "motion on", "speed 100", "degrees"):
             assert tcp.ask(line) == "ok"
@@ -53,5 +48,3 @@ def test_a_move_leaves_a_trail_on_the_page(
         wait_for(lambda: page.evaluate(TRAIL_SEGMENTS, node) is None, "the trail removed")
         wait_for(lambda: orange_pixels(scene_pixels(page)) <= before + 5, "the trail gone")
         settle(page, "trail-3-off")
-    finally:
-        tcp.close()

@@ -14,15 +14,19 @@ adapter (``view.adapter``) puts a ``Door`` in front of viser's websocket server:
 * the connection (``handle``): the page's viser version, and at most
   ``max_clients`` tabs (one more is closed with code 1013 and a reason).
 * each frame (``screen``), already bounded in size by the server
-  (``max_frame_bytes``): a camera update goes on to viser; ``{"value": v}`` for
-  an input the viewer registered goes to the viewer's callback and never to
-  viser (which would apply and re-broadcast it), and a bad value for it (NaN,
-  a word) to the viewer's ``refused`` callback, which shows the tab the true
-  value again; so does a transform-controls
-  update (finite position, unit quaternion) for a handle the viewer
-  registered (its drag start and end are let go quietly); a click (finite
-  ray) on a node the viewer made clickable goes on to viser, which calls the
-  node's click callback; everything else is dropped (``frames`` reads them).
+  (``max_frame_bytes``), read by ``frames``:
+
+  - a camera update (finite) goes on to viser;
+  - ``{"value": v}`` for an input the viewer registered goes to the viewer's
+    callback and never to viser (which would apply and re-broadcast it); a bad
+    value for it (NaN, a word, another field) to the input's ``refused``
+    callback, which shows the tab the true value again;
+  - a transform-controls update (finite position, unit quaternion) of a handle
+    the viewer registered goes to the viewer's callback too (its drag start and
+    end to its grab callback);
+  - a click (finite ray) on a node the viewer made clickable goes on to viser,
+    which calls the node's click callback;
+  - everything else is dropped.
 
 Every refusal is counted in ``refused`` and logged on one line, at most once a
 minute per kind (per origin for origins). This module uses websockets' public
