@@ -24,6 +24,7 @@ from . import replies
 from .commands import ForeignProtocol, parse_line
 from .config import ServerLimits
 from .errors import C2rvizError, LineError, LineTooLong
+from .registry import VERBS
 from .session import Session
 from .watch import STREAM_ALLOWANCE_BYTES, WatchHub
 from .world import World
@@ -386,7 +387,8 @@ def _is_command(line: Line) -> bool:
         return True
 
 
-_PLAIN_JOINTS = ("joints ", "j ")  # how a controller streaming setpoints writes them
+# How a controller streaming setpoints writes them: the registry's spellings of `joints`.
+_PLAIN_JOINTS = tuple(f"{name} " for name in (VERBS["joints"].name, *VERBS["joints"].aliases))
 _BATCH_BYTES = 8192  # complete lines run per client per loop turn
 TURN_S = 0.002  # work per client per loop turn [s]: then the others go first
 _TURN_CHECK = 32  # lines between looks at the clock
