@@ -35,7 +35,7 @@ def test_a_move_in_motion_is_drawn_as_it_goes_and_ends_at_the_target(
     with program_page(browser, c2rviz_process) as (proc, page, mover):
         asker = Tcp(proc.port)
         home_poses = page_state(page)["poses"]  # type: ignore[index]
-        for line in ("degrees", "motion on", "speed 15"):
+        for line in ("degrees", "motion on", "speed 10"):  # a move of several seconds
             assert mover.ask(line) == "ok"
         mover.sock.sendall(f"j {TARGET}\n".encode())  # the reply comes on arrival
         status = asker.ask("status")
@@ -52,7 +52,8 @@ def test_a_move_in_motion_is_drawn_as_it_goes_and_ends_at_the_target(
             shots.append(scene_pixels(page))
         assert len(shots) == 3, "the move ended before three pictures of it were taken"
         assert all(changed(a, b) > 50 for a, b in zip(shots, shots[1:]))
-        assert mover.file.readline().decode().strip() == "ok"  # arrived
+        wait_for(lambda: asker.ask("status") == "ok idle", "the arm to arrive")
+        assert mover.file.readline().decode().strip() == "ok"  # the reply on arrival
         end_poses = wait_for_scene(
             page, "the arm at rest", lambda state: not same_poses(state["poses"], poses)
         )["poses"]
