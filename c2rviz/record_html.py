@@ -5,8 +5,8 @@ page's own robot view and marker layer, so it looks as the live page does)
 while viser's scene serializer keeps every message and the pauses between
 them; the markers come from NAME.txt (its ``mark``, ``color``, ``marker`` and
 ``clear`` lines, timed by its ``sleep`` lines) and appear at the first frame
-at or after their time; ``as_html`` then
-bundles the player (play/pause, a timeline) and the recording into one file.
+at or after their time. ``as_html`` then bundles the player (play/pause, a
+timeline) and the recording into one file.
 Frames are thinned to at most ``HTML_HZ`` a second and ``MAX_HTML_FRAMES`` in
 all, so a long run stays a page a browser opens (README: Record and replay).
 """

@@ -87,7 +87,6 @@ class Travels:
     def preempt(self, travel: Travel, source: str) -> None:
         """An instant command puts the arm somewhere now: the running move ends here."""
         self._interrupt(travel, f"preempted by {source}")
-        travel.stopping = False
         travel.active = False
         travel.synced = False
         travel.line = None
@@ -104,7 +103,6 @@ class Travels:
         """
         travel = self.by_robot[state.name]
         self._interrupt(travel, f"preempted by {source}")
-        travel.stopping = False
         t = self.clock()
         if travel.line is not None:  # leaving a line: from where it is, at rest (see README)
             travel.motion.jump(travel.line.sample(t), t)
@@ -143,7 +141,6 @@ class Travels:
         """
         travel = self.by_robot[state.name]
         self._interrupt(travel, f"preempted by {source}")
-        travel.stopping = False
         travel.line = LinePlay(self.clock(), times, qs, *ramp)
         travel.synced = False
         state.target = tuple(qs[-1].tolist())
@@ -242,6 +239,8 @@ class Travels:
 
     @staticmethod
     def _interrupt(travel: Travel, why: str) -> None:
+        """The running move ends (a new one, or a stop, follows): its waiters hear ``why``."""
+        travel.stopping = False
         waiting, travel.arrivals = travel.arrivals, []
         for future in waiting:
             if not future.done():
