@@ -4,11 +4,11 @@ The page is a source of commands like any TCP client: a slider dragged to 30
 becomes ``move 1 30.0`` on that robot's page session (source ``page``,
 degrees mode), the Home / Random / Stop buttons ``home`` / ``rand`` /
 ``stop``, the speed slider ``speed 40.0``, the Trail checkbox ``trail on`` /
-``trail off``. The session checks them; a refused
-value is sent back to the tab as the true one, and so is a value the door
-drops (NaN, a word). A click on a marker chooses it
-in its robot's folder; "Go to marker" then runs ``moveto marker N`` (N: where
-the chosen marker stands now among the robot's markers).
+``trail off``. The session checks them; a refused value is sent back to the
+tab as the true one, and so is a value the door drops (NaN, a word). A click
+on a marker chooses it in its robot's folder; "Go to marker" then runs
+``moveto marker N`` (N: where the chosen marker stands now among the robot's
+markers).
 
 viser's door (``adapter.accept_input``) hands each value to a callback on
 viser's thread and nowhere else. Here the callback only records the newest
