@@ -34,14 +34,14 @@ ROWS = [
 NUMBER = r"[0-9][0-9,]*(\.[0-9]+)?"
 
 
-@pytest.mark.timeout(600)
-def test_quick_run_prints_every_row() -> None:
+def quick_table(script: str, timeout_s: float) -> tuple[str, dict[str, list[str]]]:
+    """Run ``benchmarks/SCRIPT --quick``; its output and its table's rows by first cell."""
     done = subprocess.run(
-        [sys.executable, str(ROOT / "benchmarks" / "run.py"), "--quick"],
+        [sys.executable, str(ROOT / "benchmarks" / script), "--quick"],
         cwd=ROOT,
         capture_output=True,
         text=True,
-        timeout=540,
+        timeout=timeout_s,
     )
     assert done.returncode == 0, done.stdout + done.stderr
     assert done.stdout.startswith("machine: "), done.stdout
@@ -50,8 +50,14 @@ def test_quick_run_prints_every_row() -> None:
         if line.startswith("| "):
             row = [cell.strip() for cell in line.strip("|").split("|")]
             cells[row[0]] = row
+    return done.stdout, cells
+
+
+@pytest.mark.timeout(600)
+def test_quick_run_prints_every_row() -> None:
+    stdout, cells = quick_table("run.py", 540)
     for label in ROWS:
-        assert label in cells, f"row {label!r} missing from:\n{done.stdout}"
+        assert label in cells, f"row {label!r} missing from:\n{stdout}"
         _, unit, ours, ceiling, ratio, _target, _met = cells[label]
         assert unit, label
         assert re.fullmatch(NUMBER, ours), f"{label}: c2rviz figure {ours!r}"

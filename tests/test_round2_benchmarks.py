@@ -7,7 +7,6 @@ has a figure and a load average, and that the script exits cleanly.
 from __future__ import annotations
 
 import re
-import subprocess
 import sys
 from pathlib import Path
 
@@ -17,32 +16,20 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 from round2 import ROWS  # noqa: E402
+from test_benchmarks import quick_table  # noqa: E402
 
 NUMBER = r"[0-9][0-9,]*(\.[0-9]+)?"
 
 
 @pytest.mark.timeout(900)
 def test_quick_run_prints_every_row() -> None:
-    done = subprocess.run(
-        [sys.executable, str(ROOT / "benchmarks" / "round2.py"), "--quick"],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=840,
-    )
-    assert done.returncode == 0, done.stdout + done.stderr
-    assert done.stdout.startswith("machine: "), done.stdout
-    cells = {}
-    for line in done.stdout.splitlines():
-        if line.startswith("| "):
-            row = [cell.strip() for cell in line.strip("|").split("|")]
-            cells[row[0]] = row
-    cell_left_out = "row 4 left out" in done.stdout
+    stdout, cells = quick_table("round2.py", 840)
+    cell_left_out = "row 4 left out" in stdout
     for key, label, *_ in ROWS:
         if key.startswith("cell_") and cell_left_out:
             assert label not in cells, label
             continue
-        assert label in cells, f"row {label!r} missing from:\n{done.stdout}"
+        assert label in cells, f"row {label!r} missing from:\n{stdout}"
         _, unit, median, load, _note = cells[label]
         assert unit, label
         assert re.fullmatch(NUMBER, median), f"{label}: figure {median!r}"
