@@ -36,12 +36,12 @@ import pinocchio as pin
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from c2rviz.between import first_hit_between  # noqa: E402
-from c2rviz.catalogue import example_robots  # noqa: E402
-from c2rviz.collision import DEFAULT_SAMPLES, CollisionModel, segment  # noqa: E402
-from c2rviz.collision_geometry import robot_geometry  # noqa: E402
-from c2rviz.robot import Robot  # noqa: E402
-from c2rviz.world import World  # noqa: E402
+from c2rviz.collision.geometry import robot_geometry  # noqa: E402
+from c2rviz.collision.model import DEFAULT_SAMPLES, CollisionModel, segment  # noqa: E402
+from c2rviz.collision.other_robots import first_hit_between  # noqa: E402
+from c2rviz.robot.catalogue import example_robots  # noqa: E402
+from c2rviz.robot.model import Robot  # noqa: E402
+from c2rviz.world.world import World  # noqa: E402
 
 BUNDLED = {
     "motoman_sia20d": ("robots/motoman_sia20d/robot.urdf", "base_link", "link_t"),

@@ -21,8 +21,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from c2rviz.commands import parse_line  # noqa: E402
 from c2rviz.errors import C2rvizError  # noqa: E402
+from c2rviz.protocol.grammar import parse_line  # noqa: E402
 
 __all__ = ["HOSTILE", "main", "seconds_to_refuse"]
 

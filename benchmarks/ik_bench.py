@@ -31,11 +31,11 @@ import pinocchio as pin
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from c2rviz.cartesian import LineBlocked, plan_line  # noqa: E402
-from c2rviz.catalogue import example_robots  # noqa: E402
 from c2rviz.errors import C2rvizError  # noqa: E402
-from c2rviz.ik import IkSolver, Unreachable  # noqa: E402
-from c2rviz.robot import Robot  # noqa: E402
+from c2rviz.ik.line import LineBlocked, plan_line  # noqa: E402
+from c2rviz.ik.solver import IkSolver, Unreachable  # noqa: E402
+from c2rviz.robot.catalogue import example_robots  # noqa: E402
+from c2rviz.robot.model import Robot  # noqa: E402
 
 __all__ = ["main"]
 

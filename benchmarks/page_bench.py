@@ -36,11 +36,11 @@ from websockets.sync.client import connect
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from processes import launch_ours  # noqa: E402
 
-from c2rviz.robot import Robot  # noqa: E402
-from c2rviz.scene import Marker  # noqa: E402
+from c2rviz.robot.model import Robot  # noqa: E402
 from c2rviz.view import adapter  # noqa: E402
-from c2rviz.viewer import ViserScene  # noqa: E402
-from c2rviz.world import World  # noqa: E402
+from c2rviz.view.viser_scene import ViserScene  # noqa: E402
+from c2rviz.world.effects import Marker  # noqa: E402
+from c2rviz.world.world import World  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 CAMERA = {

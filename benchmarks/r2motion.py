@@ -39,9 +39,9 @@ from r2clients import Bystander, Figure, LineClient, percentile
 
 sys.path.insert(0, str(ROOT))  # this tree's c2rviz, not an installed one
 
-from c2rviz.motion import Motion  # noqa: E402
-from c2rviz.motion_limits import motion_limits  # noqa: E402
-from c2rviz.robot import Robot  # noqa: E402
+from c2rviz.motion.limits import motion_limits  # noqa: E402
+from c2rviz.motion.planner import Motion  # noqa: E402
+from c2rviz.robot.model import Robot  # noqa: E402
 
 __all__ = ["MotionPlan", "measure_motion"]
 

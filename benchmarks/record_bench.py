@@ -131,7 +131,14 @@ def replay_lag(proc: Launched, control: Control, folder: Path) -> tuple[float, f
     frames = [(float(r.split(",")[0]), r.split(",")[1 : 1 + N_JOINTS]) for r in rows]
     watcher = Watcher(proc.address, 1000)
     played = subprocess.run(
-        [sys.executable, "-m", "c2rviz.player", str(folder / "lag.txt"), "--port", str(proc.port)],
+        [
+            sys.executable,
+            "-m",
+            "c2rviz.clients.player",
+            str(folder / "lag.txt"),
+            "--port",
+            str(proc.port),
+        ],
         cwd=ROOT,
         capture_output=True,
         text=True,

@@ -227,7 +227,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     plan = QUICK if args.quick else FULL
     if args.reps is not None:
         plan = Plan(**{**plan.__dict__, "reps": max(1, args.reps)})
-    viewer = not args.no_viewer and (ROOT / "c2rviz" / "viewer.py").is_file()
+    viewer = not args.no_viewer and (ROOT / "c2rviz" / "view" / "viser_scene.py").is_file()
 
     def log(text: str) -> None:
         print(f"  {text}", file=sys.stderr, flush=True)
@@ -253,7 +253,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"{plan.reps} repetition(s); pipelined {plan.pipelined:,} joints lines; "
         f"{plan.round_trips:,} round trips; {plan.clients} clients x {plan.per_client:,}; "
         f"{plan.frame_samples} command->frame samples; flood {plan.flood_s:g} s"
-        + ("" if viewer else "; viewer rows skipped (no c2rviz/viewer.py or --no-viewer)")
+        + ("" if viewer else "; viewer rows skipped (no c2rviz/view/viser_scene.py or --no-viewer)")
     )
     print(
         "ours/ceil is the ratio of the medians: higher is better for rates, lower for times "

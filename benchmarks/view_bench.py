@@ -33,7 +33,7 @@ import numpy as np
 import pinocchio as pin
 import viser
 
-from c2rviz.robot import Robot
+from c2rviz.robot.model import Robot
 from c2rviz.view import adapter
 from c2rviz.view.policy import DoorPolicy
 

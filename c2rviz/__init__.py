@@ -34,14 +34,14 @@ __version__ = "0.2.0"
 
 _HOME = {
     "C2rvizError": "errors",
-    "CommandServer": "server",
-    "Marker": "scene",
-    "RecordingScene": "scene",
-    "Robot": "robot",
-    "Scene": "scene",
-    "Session": "session",
-    "World": "world",
-    "parse_line": "commands",
+    "CommandServer": "transports.tcp_text",
+    "Marker": "world.effects",
+    "RecordingScene": "world.effects",
+    "Robot": "robot.model",
+    "Scene": "world.effects",
+    "Session": "session.session",
+    "World": "world.world",
+    "parse_line": "protocol.grammar",
 }
 
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Play a c2rviz command file: ``python fileplayer.py commands/motoman.txt``.
 
-A thin wrapper around ``c2rviz.player.main`` (also installed as ``c2rviz-play``);
+A thin wrapper around ``c2rviz.clients.player.main`` (also installed as ``c2rviz-play``);
 it runs from a checkout without installing c2rviz. See ``--help``.
 """
 
@@ -13,7 +13,7 @@ try:
 except ImportError:  # not installed: use the checkout this file lives in
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from c2rviz.player import main  # noqa: E402
+from c2rviz.clients.player import main  # noqa: E402
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -25,11 +25,11 @@ from typing import Any
 
 import pytest
 
-from c2rviz.config import ServerLimits
-from c2rviz.robot import Robot
-from c2rviz.scene import RecordingScene
-from c2rviz.server import CommandServer
-from c2rviz.world import World
+from c2rviz.app.config import ServerLimits
+from c2rviz.robot.model import Robot
+from c2rviz.transports.tcp_text import CommandServer
+from c2rviz.world.effects import RecordingScene
+from c2rviz.world.world import World
 
 ROOT = Path(__file__).resolve().parent.parent
 CHROMIUM = Path("/usr/bin/chromium")  # Debian's; Playwright cannot download browsers here

@@ -18,12 +18,12 @@ import pytest
 import yourdfpy
 from conftest import Client, ServerThread
 
-from c2rviz import cli
-from c2rviz.catalogue import EXAMPLE_ROBOTS, example_robot_data_dir, example_robots
-from c2rviz.config import ServerLimits, find_ini, load_settings
+from c2rviz.app import cli
+from c2rviz.app.config import ServerLimits, find_ini, load_settings
 from c2rviz.errors import ConfigError, RobotError
-from c2rviz.motion import motion_limits
-from c2rviz.robot import CONTINUOUS_LIMIT, Robot
+from c2rviz.motion.planner import motion_limits
+from c2rviz.robot.catalogue import EXAMPLE_ROBOTS, example_robot_data_dir, example_robots
+from c2rviz.robot.model import CONTINUOUS_LIMIT, Robot
 
 DATA = Path(__file__).parent / "data"
 TREE = DATA / "tree_robot" / "tree.urdf"
@@ -129,7 +129,7 @@ def test_list_robots(capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_without_example_robot_data(monkeypatch: pytest.MonkeyPatch) -> None:
-    from c2rviz import catalogue
+    from c2rviz.robot import catalogue
 
     monkeypatch.setattr(catalogue, "example_robot_data_dir", lambda: None)
     monkeypatch.setattr(catalogue, "example_robots", dict)
@@ -202,7 +202,7 @@ def test_missing_mesh_folder_loads_with_a_warning(
     link_uri = "package://tiny_description/meshes/link.stl"
     assert missing[link_uri].links == ("base_link", "link1")
     assert package / "meshes" / "link.stl" in missing[link_uri].searched
-    visuals = pytest.importorskip("c2rviz.visuals")
+    visuals = pytest.importorskip("c2rviz.robot.visuals")
     with caplog.at_level(logging.WARNING, logger="c2rviz"):
         geometry = visuals.load_link_geometry(robot.source)
     text = caplog.text

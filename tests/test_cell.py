@@ -19,13 +19,13 @@ import pytest
 from conftest import ROOT, Client, load_robot
 from test_watch import read_until
 
-from c2rviz.cell import load_cell
-from c2rviz.cli import main
-from c2rviz.config import ServerLimits
+from c2rviz.app.cell import load_cell
+from c2rviz.app.cli import main
+from c2rviz.app.config import ServerLimits
 from c2rviz.errors import ConfigError
-from c2rviz.scene import RecordingScene
-from c2rviz.server import CommandServer
-from c2rviz.world import World
+from c2rviz.transports.tcp_text import CommandServer
+from c2rviz.world.effects import RecordingScene
+from c2rviz.world.world import World
 
 LEFT = "0,0,0,0,0,0"
 RIGHT = "1.2,0,0,0,0,180"
@@ -401,7 +401,7 @@ def test_a_cell_port_in_use_exits_2(tmp_path: Path, capsys: pytest.CaptureFixtur
 def test_the_seeds_file_plays_on_one_robot_while_another_moves(cell: CellThread, capsys):
     """The seed's motoman.txt through the player on the left port while a client of the
     right robot sends `rand` in a loop: each ends where its own commands put it."""
-    from c2rviz import player
+    from c2rviz.clients import player
 
     stop = threading.Event()
     right_answers: list[str] = []

@@ -22,10 +22,17 @@ from pathlib import Path
 
 import pytest
 
-from c2rviz import client as client_module
-from c2rviz import player, registry, repl
-from c2rviz.client import Client, ServerUnavailable, default_address, motion_of, server_address
+from c2rviz.clients import client as client_module
+from c2rviz.clients import player, repl
+from c2rviz.clients.client import (
+    Client,
+    ServerUnavailable,
+    default_address,
+    motion_of,
+    server_address,
+)
 from c2rviz.errors import C2rvizError, ConfigError
+from c2rviz.protocol import registry
 
 ROOT = Path(__file__).resolve().parent.parent
 MOTOMAN = str(ROOT / "commands" / "motoman.txt")
@@ -85,8 +92,8 @@ def old_server(server, monkeypatch):
 
 def test_clients_do_not_import_pinocchio():
     code = (
-        "import sys, c2rviz.client, c2rviz.repl, c2rviz.player\n"
-        "print(c2rviz.client.default_address())\n"
+        "import sys, c2rviz.clients.client, c2rviz.clients.repl, c2rviz.clients.player\n"
+        "print(c2rviz.clients.client.default_address())\n"
         "print(sorted(m for m in ('pinocchio', 'viser', 'numpy') if m in sys.modules))"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
@@ -151,7 +158,7 @@ def cell():
     """A real server with two robots, ``left`` (motoman) and ``right`` (kuka_lwr)."""
     from conftest import ServerThread, load_robot
 
-    from c2rviz.config import ServerLimits
+    from c2rviz.app.config import ServerLimits
 
     robots = {"left": load_robot("motoman_sia20d"), "right": load_robot("kuka_lwr")}
     server = ServerThread(robots, ServerLimits()).start()  # type: ignore[arg-type]

@@ -11,7 +11,7 @@ import pinocchio as pin
 import pytest
 from conftest import ROOT, load_robot
 
-from c2rviz.collision import (
+from c2rviz.collision.model import (
     CollisionModel,
     NoFreeConfiguration,
     SrdfError,
@@ -19,9 +19,7 @@ from c2rviz.collision import (
     read_srdf,
     segment,
 )
-from c2rviz.robot import Robot
-from c2rviz.sources import load_source
-from c2rviz.workcell import (
+from c2rviz.collision.workcell import (
     DEFAULT_RGBA,
     BadColour,
     BadMesh,
@@ -33,6 +31,8 @@ from c2rviz.workcell import (
     UnknownObject,
     WorkcellError,
 )
+from c2rviz.robot.model import Robot
+from c2rviz.robot.sources import load_source
 
 DATA = Path(__file__).parent / "data"
 SLOT = DATA / "collision" / "slot.urdf"

@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 from conftest import ROBOTS
 
-from c2rviz import player
-from c2rviz.commands import parse_line
+from c2rviz.clients import player
+from c2rviz.protocol.grammar import parse_line
 
 COMMANDS_DIR = Path(__file__).resolve().parent.parent / "commands"
 FILES = sorted(COMMANDS_DIR.glob("*.txt"))

@@ -8,10 +8,10 @@ import socket
 import pytest
 from conftest import ROOT, Client
 
-from c2rviz.cli import main
-from c2rviz.config import ServerLimits, find_ini, load_settings
+from c2rviz.app.cli import main
+from c2rviz.app.config import ServerLimits, find_ini, load_settings
 from c2rviz.errors import ConfigError
-from c2rviz.sources import load_source
+from c2rviz.robot.sources import load_source
 
 INI = ROOT / "cmdinterpreter.ini"
 

@@ -8,7 +8,7 @@ import pytest
 import trimesh
 from conftest import ROOT, Client
 
-from c2rviz.cli import main
+from c2rviz.app.cli import main
 
 INI = """
 [options]

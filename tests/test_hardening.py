@@ -24,11 +24,12 @@ from pathlib import Path
 
 import pytest
 
-from c2rviz import cli, config, replies
-from c2rviz import server as server_module
-from c2rviz.commands import _MAX_INDEX_DIGITS
+from c2rviz.app import cli, config
 from c2rviz.errors import LineTooLong
-from c2rviz.server import _BATCH_BYTES, _LINGER_S, TURN_S, CommandServer
+from c2rviz.protocol import replies
+from c2rviz.protocol.grammar import _MAX_INDEX_DIGITS
+from c2rviz.transports import tcp_text as server_module
+from c2rviz.transports.tcp_text import _BATCH_BYTES, _LINGER_S, TURN_S, CommandServer
 from c2rviz.view.policy import DoorPolicy
 
 # A state away from home (so a stray home or joints shows) with long `where` replies.
@@ -525,7 +526,7 @@ def test_the_limits_table_matches_the_code():
     assert f"| {_BATCH_BYTES} | `server._BATCH_BYTES` |" in text
     assert f"| {TURN_S * 1000:g} ms | `server.TURN_S` |" in text
     assert f"| {_LINGER_S:g} s | `server._LINGER_S` |" in text
-    assert f"| {_MAX_INDEX_DIGITS} | `commands._MAX_INDEX_DIGITS` |" in text
+    assert f"| {_MAX_INDEX_DIGITS} | `protocol.grammar._MAX_INDEX_DIGITS` |" in text
     grace = inspect.signature(CommandServer.stop).parameters["grace_s"].default
     assert f"| {grace:g} s | `CommandServer.stop(grace_s)` |" in text
     assert "| Command server | `127.0.0.1` | `--host` | `host` |" in text

@@ -21,11 +21,11 @@ from conftest import ROBOTS, load_robot
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from c2rviz.cartesian import LineBlocked, interpolate, plan_line
-from c2rviz.catalogue import EXAMPLE_ROBOTS, example_robot_data_dir, example_robots
 from c2rviz.errors import C2rvizError, JointCountError
-from c2rviz.ik import IkSolver, Unreachable
-from c2rviz.robot import Robot
+from c2rviz.ik.line import LineBlocked, interpolate, plan_line
+from c2rviz.ik.solver import IkSolver, Unreachable
+from c2rviz.robot.catalogue import EXAMPLE_ROBOTS, example_robot_data_dir, example_robots
+from c2rviz.robot.model import Robot
 
 TREE = Path(__file__).parent / "data" / "tree_robot" / "tree.urdf"
 POSITION_TOL_M = 1e-4  # the promise: 0.1 mm ...

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from conftest import load_robot
 
-from c2rviz.line_play import LinePlay, ramp_limits
-from c2rviz.motion import motion_limits
+from c2rviz.motion.line_play import LinePlay, ramp_limits
+from c2rviz.motion.planner import motion_limits
 
 DT = 1e-3  # sampling step [s]
 LIMITS = motion_limits(load_robot("motoman_sia20d"))

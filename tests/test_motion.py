@@ -26,14 +26,20 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from c2rviz.errors import JointCountError
-from c2rviz.motion import Motion, MotionLimitError, MotionLimits, _position_range, motion_limits
-from c2rviz.motion_limits import (
+from c2rviz.motion.limits import (
     ACCELERATION_PER_VELOCITY,
     DEFAULT_PRISMATIC_VELOCITY,
     DEFAULT_REVOLUTE_VELOCITY,
     JERK_PER_VELOCITY,
 )
-from c2rviz.robot import CONTINUOUS_LIMIT, Robot
+from c2rviz.motion.planner import (
+    Motion,
+    MotionLimitError,
+    MotionLimits,
+    _position_range,
+    motion_limits,
+)
+from c2rviz.robot.model import CONTINUOUS_LIMIT, Robot
 
 TREE = Path(__file__).parent / "data" / "tree_robot" / "tree.urdf"
 BUNDLED = ("motoman_sia20d", "fanuc_lrmate200id", "kuka_lwr")

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from conftest import Client, ServerThread
 
-from c2rviz.motion import motion_limits
+from c2rviz.motion.planner import motion_limits
 
 FAR = "90,45,0,-30,0,60,0"  # degrees, motoman_sia20d
 OTHER = "-45,20,30,0,0,-30,0"

@@ -11,34 +11,18 @@ import sys
 import pytest
 from conftest import ROOT
 
-from c2rviz.commands import (
-    Bye,
-    Clear,
-    Color,
-    ForeignProtocol,
-    Help,
-    Home,
-    Joints,
-    Limits,
-    Mark,
-    MarkerShape,
-    Move,
-    Names,
-    Pose,
-    Quit,
-    Rand,
-    Sleep,
-    Units,
-    Version,
-    Where,
-    parse_line,
-)
 from c2rviz.errors import BadArguments, LineError, UnknownCommand
-from c2rviz.lang.cartesian import Ik, LinearSpeed, MoveL, MoveTo, Tool
-from c2rviz.lang.cell import RobotChoice, RobotsList
-from c2rviz.lang.motion import MotionMode, Speed, Status, Stop, Target, Wait
-from c2rviz.lang.record import Record, Trail, Unwatch, Watch
-from c2rviz.lang.workcell import Collisions, Guard, ObjectEdit, Objects
+from c2rviz.protocol.grammar import ForeignProtocol, parse_line
+from c2rviz.protocol.verbs.cartesian import Ik, LinearSpeed, MoveL, MoveTo, Tool
+from c2rviz.protocol.verbs.cell import RobotChoice, RobotsList
+from c2rviz.protocol.verbs.connection import Bye, Quit, Sleep
+from c2rviz.protocol.verbs.joints import Home, Joints, Move, Rand, Units
+from c2rviz.protocol.verbs.markers import Clear, Color, Mark, MarkerShape
+from c2rviz.protocol.verbs.motion import MotionMode, Speed, Status, Stop, Target, Wait
+from c2rviz.protocol.verbs.observe import Trail, Unwatch, Watch
+from c2rviz.protocol.verbs.queries import Help, Limits, Names, Pose, Version, Where
+from c2rviz.protocol.verbs.record import Record
+from c2rviz.protocol.verbs.workcell import Collisions, Guard, ObjectEdit, Objects
 
 GOOD = [
     ("home", Home(), "home"),

@@ -18,12 +18,13 @@ from conftest import ServerThread, load_robot
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
-from c2rviz import replies
-from c2rviz.commands import Bye, ForeignProtocol, Quit, Sleep, parse_line
-from c2rviz.config import ServerLimits
+from c2rviz.app.config import ServerLimits
 from c2rviz.errors import C2rvizError, LineTooLong
-from c2rviz.session import Session
-from c2rviz.world import World
+from c2rviz.protocol import replies
+from c2rviz.protocol.grammar import ForeignProtocol, parse_line
+from c2rviz.protocol.verbs.connection import Bye, Quit, Sleep
+from c2rviz.session.session import Session
+from c2rviz.world.world import World
 
 VERBS = [
     "rand", "home", "degrees", "degree", "radians", "radian", "joints", "j", "move", "clear",

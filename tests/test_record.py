@@ -25,13 +25,13 @@ import pytest
 from conftest import Client, ServerThread, load_robot
 from test_watch import STATE, is_reply, read_until
 
-from c2rviz import player
-from c2rviz.config import load_settings
+from c2rviz.app.config import load_settings
+from c2rviz.clients import player
 from c2rviz.errors import ConfigError
-from c2rviz.recorder import Recorder
-from c2rviz.recordings import Recordings
-from c2rviz.trail import DEFAULT_TRAIL_POINTS, TrailKeeper
-from c2rviz.world import World
+from c2rviz.observers.recorder import Recorder
+from c2rviz.observers.recordings import Recordings
+from c2rviz.observers.trail import DEFAULT_TRAIL_POINTS, TrailKeeper
+from c2rviz.world.world import World
 
 FAR = "90,45,0,-30,0,60,0"  # degrees, motoman_sia20d
 OTHER = "-45,20,30,0,0,-30,0"

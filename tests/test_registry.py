@@ -7,9 +7,9 @@ from pathlib import Path
 
 from test_parser import GOOD
 
-from c2rviz import replies, session  # noqa: F401  (session registers the handlers)
-from c2rviz.commands import parse_line
-from c2rviz.registry import HANDLERS, LOOKUP, VERBS, help_text, readme_table
+from c2rviz.protocol import replies
+from c2rviz.protocol.grammar import parse_line
+from c2rviz.protocol.registry import HANDLERS, LOOKUP, VERBS, help_text, readme_table
 
 README = Path(__file__).resolve().parent.parent / "README.md"
 
@@ -37,7 +37,7 @@ def test_help_lists_every_verb_and_alias_once():
     assert [w.split("|")[0] for w in listed] == list(VERBS)
     words = [word for item in listed for word in item.split("|")]
     assert sorted(words) == sorted(LOOKUP)
-    assert "ok commands: " + help_text() == replies.HELP
+    assert "ok commands: " + help_text() == replies.help_reply()
 
 
 def test_the_readme_command_table_is_the_registry():

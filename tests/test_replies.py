@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from c2rviz import replies
+from c2rviz.protocol import replies
 
 
 @pytest.mark.parametrize(

@@ -8,7 +8,7 @@ import pytest
 from conftest import ROBOTS, ROOT, load_robot
 
 from c2rviz.errors import RobotError
-from c2rviz.robot import Robot
+from c2rviz.robot.model import Robot
 
 CHAINS = {
     "motoman_sia20d": (

@@ -12,8 +12,8 @@ import pinocchio as pin
 import pytest
 
 import c2rviz
-from c2rviz import replies
-from c2rviz.scene import MAX_MARKERS
+from c2rviz.protocol import replies
+from c2rviz.world.effects import MAX_MARKERS
 
 MOTOMAN_LIMITS_DEG = [180.0, 109.4, 169.6, 129.5, 180.0, 109.4, 180.0]
 
@@ -165,7 +165,7 @@ def test_names_help_and_unknown(server, connect):
     assert client.ask("names") == (
         "ok motoman_sia20d joint_s,joint_l,joint_e,joint_u,joint_r,joint_b,joint_t"
     )
-    assert client.ask("help") == replies.HELP
+    assert client.ask("help") == replies.help_reply()
     digest = hashlib.sha256(server.robot.source.xml.encode()).hexdigest()[:12]
     assert client.ask("version") == f"ok c2rviz {c2rviz.__version__} robot.urdf sha256:{digest}"
     assert client.ask("fly") == "error: unknown command 'fly' (try 'help')"
@@ -296,8 +296,8 @@ RUNS = {
 def test_runs_of_joints_lines_answer_as_line_by_line(server, connect, name):
     """Plain joints lines read together are checked as one batch and only the last is
     shown; every reply, error and the final state equal running them one by one."""
-    from c2rviz.session import Session
-    from c2rviz.world import World
+    from c2rviz.session.session import Session
+    from c2rviz.world.world import World
 
     shadow = Session(World(server.robot))
     expected = []

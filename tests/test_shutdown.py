@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 import pytest
 
-from c2rviz import replies
+from c2rviz.protocol import replies
 
 HOME = "ok 0,0,0,0,0,0,0"
 

@@ -14,9 +14,9 @@ import socket
 import threading
 import time
 
-from c2rviz import replies
 from c2rviz.errors import LineTooLong
-from c2rviz.scene import MAX_MARKERS
+from c2rviz.protocol import replies
+from c2rviz.world.effects import MAX_MARKERS
 
 CLIENTS = 20
 LINES = 2000
@@ -62,7 +62,11 @@ BAD = [
     ("move 0 \u0661".encode(), Start("error: character")),
 ]
 QUIET = [b"", b"   ", b"# a comment", b"\t# another\r"]
-ASK = [(b"pose", Start("ok ")), (b"names", Start("ok motoman_sia20d ")), (b"help", replies.HELP)]
+ASK = [
+    (b"pose", Start("ok ")),
+    (b"names", Start("ok motoman_sia20d ")),
+    (b"help", replies.help_reply()),
+]
 
 
 def script(k: int) -> tuple[list[bytes], list[str], float | None, int]:

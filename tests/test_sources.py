@@ -11,10 +11,10 @@ import pytest
 import trimesh
 from xacro import substitution_args
 
-from c2rviz.cli import main
+from c2rviz.app.cli import main
 from c2rviz.errors import ConfigError, RobotError
-from c2rviz.robot import Robot
-from c2rviz.sources import RobotSource, load_source, parse_xacro_args, split_package_path
+from c2rviz.robot.model import Robot
+from c2rviz.robot.sources import RobotSource, load_source, parse_xacro_args, split_package_path
 
 DATA = Path(__file__).parent / "data"
 WS_SRC = DATA / "tiny_ws" / "src"

@@ -11,11 +11,12 @@ from conftest import ROBOTS, load_robot
 from hypothesis import given
 from hypothesis import strategies as st
 
-from c2rviz import replies, tolerance
+from c2rviz import tolerance
 from c2rviz.errors import JointLimitError
-from c2rviz.session import Session
+from c2rviz.protocol import replies
+from c2rviz.session.session import Session
 from c2rviz.tolerance import LIMIT_TOLERANCE, limit_text, texts_apart, within_limit
-from c2rviz.world import World
+from c2rviz.world.world import World
 
 
 @pytest.mark.parametrize(

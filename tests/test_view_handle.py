@@ -19,7 +19,7 @@ from viewer_tabs import Harness, Tab
 from c2rviz.view import adapter
 from c2rviz.view.handle import moveto_line
 from c2rviz.view.robot_view import wxyz
-from c2rviz.world import RobotState, World
+from c2rviz.world.world import RobotState, World
 
 
 @pytest.fixture

@@ -12,10 +12,10 @@ import pytest
 from conftest import load_robot
 from viewer_tabs import Harness
 
-from c2rviz.session import Session
-from c2rviz.trail import TrailKeeper
+from c2rviz.observers.trail import TrailKeeper
+from c2rviz.session.session import Session
 from c2rviz.view.workcell_layer import COLLISION_RGBA
-from c2rviz.world import World
+from c2rviz.world.world import World
 
 RED = tuple(int(round(255 * c)) for c in COLLISION_RGBA[:3])
 

@@ -24,17 +24,17 @@ from test_view_adapter import bad_messages
 from viewer_tabs import Harness, Tab
 from websockets.exceptions import InvalidStatus
 
-from c2rviz.config import ServerLimits, SessionDefaults
+from c2rviz.app.config import ServerLimits, SessionDefaults
 from c2rviz.errors import MotionInterrupted
-from c2rviz.robot import Robot
-from c2rviz.scene import MAX_MARKERS
-from c2rviz.server import CommandServer
-from c2rviz.session import Session
+from c2rviz.robot.model import Robot
+from c2rviz.session.session import Session
+from c2rviz.transports.tcp_text import CommandServer
 from c2rviz.view import adapter
 from c2rviz.view.panel import MAX_LABEL_CHARS, short_label
 from c2rviz.view.policy import DoorPolicy
-from c2rviz.viewer import ViserScene
-from c2rviz.world import World
+from c2rviz.view.viser_scene import ViserScene
+from c2rviz.world.effects import MAX_MARKERS
+from c2rviz.world.world import World
 
 
 @pytest.fixture

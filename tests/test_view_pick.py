@@ -17,10 +17,10 @@ import pytest
 from conftest import load_robot
 from viewer_tabs import Harness, Tab
 
-from c2rviz.scene import MAX_MARKERS, Marker
 from c2rviz.view import adapter
 from c2rviz.view.panel import NO_MARKER
-from c2rviz.world import World
+from c2rviz.world.effects import MAX_MARKERS, Marker
+from c2rviz.world.world import World
 
 RED = (1.0, 0.0, 0.0)
 

@@ -24,12 +24,12 @@ import yourdfpy
 from conftest import ROBOTS, load_robot
 from viewer_tabs import Harness
 
-from c2rviz.robot import Robot
-from c2rviz.scene import Marker
+from c2rviz.robot.model import Robot
+from c2rviz.robot.visuals import load_link_geometry
 from c2rviz.view import adapter
-from c2rviz.viewer import RECENT_COMMANDS, ViserScene
-from c2rviz.visuals import load_link_geometry
-from c2rviz.world import World
+from c2rviz.view.viser_scene import RECENT_COMMANDS, ViserScene
+from c2rviz.world.effects import Marker
+from c2rviz.world.world import World
 
 
 @pytest.fixture

@@ -16,9 +16,9 @@ import numpy as np
 import pytest
 from conftest import ROOT, Client, ServerThread
 
-from c2rviz import replies
-from c2rviz.session import Session
-from c2rviz.watch import STREAM_ALLOWANCE_BYTES, NotAConnection, WatchHub
+from c2rviz.observers.watch import STREAM_ALLOWANCE_BYTES, NotAConnection, WatchHub
+from c2rviz.protocol import replies
+from c2rviz.session.session import Session
 
 FAR = "90,45,0,-30,0,60,0"  # degrees, motoman_sia20d
 STATE = re.compile(r"state (\d+\.\d{6}) (\S+)")
@@ -273,7 +273,7 @@ def _read_lines(client: Client, count: int, into: list[str]) -> None:
 
 def test_cli_watch_prints_the_stream_until_ctrl_c(server: ServerThread, connect):
     proc = subprocess.Popen(
-        [sys.executable, "-m", "c2rviz.repl", "--watch", "50", "--port", str(server.port)],
+        [sys.executable, "-m", "c2rviz.clients.repl", "--watch", "50", "--port", str(server.port)],
         cwd=ROOT,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -301,7 +301,7 @@ def test_cli_watch_prints_the_stream_until_ctrl_c(server: ServerThread, connect)
 
 def test_repl_watch_prints_the_stream_until_ctrl_c_then_goes_on(server: ServerThread, connect):
     proc = subprocess.Popen(
-        [sys.executable, "-m", "c2rviz.repl", "--port", str(server.port)],
+        [sys.executable, "-m", "c2rviz.clients.repl", "--port", str(server.port)],
         cwd=ROOT,
         stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,

@@ -22,8 +22,8 @@ import zstandard
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import ClientConnection, connect
 
-from c2rviz.viewer import ViserScene
-from c2rviz.world import World
+from c2rviz.view.viser_scene import ViserScene
+from c2rviz.world.world import World
 
 VERSION = f"viser-v{viser.__version__}"
 CAMERA = {

@@ -46,9 +46,9 @@ from viser import _messages
 from viser.infra import ClientId
 
 from ..errors import C2rvizError
-from .door import Door, GrabCallback, GuardedConnection, HandleCallback, InputCallback
-from .frames import CAMERA_FIELDS, Click
+from .page_messages import CAMERA_FIELDS, Click
 from .policy import DoorPolicy
+from .ws_guard import Door, GrabCallback, GuardedConnection, HandleCallback, InputCallback
 
 __all__ = [
     "INTERNALS",

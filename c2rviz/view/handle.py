@@ -30,10 +30,10 @@ import numpy as np
 import pinocchio as pin
 import viser
 
-from .. import replies
 from ..errors import C2rvizError
-from ..session import Session
-from ..world import RobotState
+from ..protocol import replies
+from ..session.session import Session
+from ..world.world import RobotState
 from . import adapter
 from .ratelog import RateLimitedLog
 from .robot_view import wxyz

@@ -19,8 +19,8 @@ import numpy as np
 import trimesh
 import viser
 
-from ..commands import MARKER_SHAPES
-from ..scene import MAX_MARKERS, Marker
+from ..protocol.grammar import MARKER_SHAPES
+from ..world.effects import MAX_MARKERS, Marker
 from . import adapter
 from .robot_view import node_name
 
@@ -30,7 +30,7 @@ MARKER_SIZE_M = 0.03
 
 
 def marker_mesh(shape: str, size: float = MARKER_SIZE_M) -> trimesh.Trimesh:
-    """The mesh of one marker of ``shape`` (``commands.MARKER_SHAPES``), centred.
+    """The mesh of one marker of ``shape`` (``protocol.MARKER_SHAPES``), centred.
 
     A sphere of diameter ``size``, a cube of edge ``size``, a cylinder of
     height ``size`` along z, an arrow of length 1.7 ``size`` along x (as RViz).

@@ -31,8 +31,8 @@ from typing import Any
 import viser
 
 from ..errors import C2rvizError, MotionInterrupted
-from ..session import Session
-from ..trail import TrailKeeper
+from ..observers.trail import TrailKeeper
+from ..session.session import Session
 from . import adapter
 from .markers import MarkerLayer
 from .panel import RobotPanel

@@ -24,9 +24,9 @@ import numpy as np
 import pinocchio as pin
 import viser
 
-from ..scene import Marker
 from ..tolerance import limit_text
-from ..world import RobotState
+from ..world.effects import Marker
+from ..world.world import RobotState
 from . import adapter
 
 __all__ = ["MAX_LABEL_CHARS", "RECENT_COMMANDS", "RobotPanel", "StatePanel", "short_label"]

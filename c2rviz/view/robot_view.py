@@ -23,8 +23,8 @@ import pinocchio as pin
 import trimesh
 import viser
 
-from ..robot import Robot
-from ..visuals import LinkGeometry, Shape
+from ..robot.model import Robot
+from ..robot.visuals import LinkGeometry, Shape
 from . import adapter
 
 __all__ = ["GHOST_OPACITY", "RobotView", "node_name", "wxyz"]

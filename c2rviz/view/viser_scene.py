@@ -26,12 +26,12 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
-from ..scene import Marker, Scene
-from ..session import Session
-from ..trail import TrailKeeper
-from ..visuals import LinkGeometry, load_link_geometry
-from ..workcell import WorkcellObject
-from ..world import World
+from ..collision.workcell import WorkcellObject
+from ..observers.trail import TrailKeeper
+from ..robot.visuals import LinkGeometry, load_link_geometry
+from ..session.session import Session
+from ..world.effects import Marker, Scene
+from ..world.world import World
 from . import adapter
 from .handle import ToolHandles
 from .markers import MarkerLayer

@@ -20,8 +20,8 @@ import pinocchio as pin
 import trimesh
 import viser
 
-from ..trail import TrailKeeper
-from ..workcell import WorkcellObject
+from ..collision.workcell import WorkcellObject
+from ..observers.trail import TrailKeeper
 from .robot_view import RobotView, node_name, wxyz
 
 __all__ = ["COLLISION_RGBA", "TRAIL_RGB", "TrailLayer", "WorkcellLayer"]

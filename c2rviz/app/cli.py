@@ -1,0 +1,198 @@
+"""``c2rviz``: the flags, the settings, and then the program (``program.serve``)."""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import logging
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from ..collision.geometry import read_srdf
+from ..errors import C2rvizError
+from ..robot.catalogue import catalogue, listing
+from .config import find_ini, load_settings, read_robots
+from .program import MOTION_FLAGS, members, serve
+
+__all__ = ["build_parser", "main"]
+
+log = logging.getLogger("c2rviz")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="c2rviz",
+        description="Drive a robot arm with one-line text commands over TCP and watch it "
+        "move in a browser. Flags override cmdinterpreter.ini.",
+    )
+    add = parser.add_argument
+    add(
+        "--config",
+        metavar="PATH",
+        help="ini file (default: ./cmdinterpreter.ini, else the project's)",
+    )
+    add(
+        "--robot",
+        metavar="NAME",
+        help="robot section of the ini file, or an example-robot-data "
+        "arm such as ur5 or panda (default: motoman_sia20d; see --list-robots)",
+    )
+    add("--list-robots", action="store_true", help="list the robots --robot can name, and exit")
+    add(
+        "--cell",
+        metavar="NAME|PATH",
+        help="serve the robots of [cell:NAME] in the ini (or of the ini file PATH), each on "
+        "its own port, in one world and one page (README: Several robots)",
+    )
+    add("--urdf", metavar="PATH", type=Path, help="load this URDF or .xacro instead of the robot's")
+    add(
+        "--package-path",
+        dest="package_paths",
+        metavar="DIR",
+        action="append",
+        help="where package://NAME/... is looked for: a folder holding packages, a package, "
+        "or NAME=DIR (repeatable; then ROS_PACKAGE_PATH, then upward from the URDF)",
+    )
+    add(
+        "--xacro-arg",
+        dest="xacro_args",
+        metavar="NAME:=VALUE",
+        action="append",
+        help="an argument for a .xacro file (repeatable)",
+    )
+    add("--base", metavar="LINK", help="first link of the chain")
+    add("--eelink", metavar="LINK", help="end-effector link: last link of the chain")
+    add("--host", help="address for the command server (default 127.0.0.1)")
+    add("--port", type=int, help="command port (default 31000; 0 picks a free one)")
+    add(
+        "--viser-host",
+        dest="viewer_host",
+        metavar="HOST",
+        help="address for the browser view (default 127.0.0.1)",
+    )
+    add(
+        "--viser-port",
+        dest="viewer_port",
+        type=int,
+        metavar="PORT",
+        help="port for the browser view (default 8080)",
+    )
+    add(
+        "--viewer-origin",
+        dest="viewer_origins",
+        metavar="ORIGIN",
+        action="append",
+        help="an origin besides the viewer's own allowed to open its websocket, e.g. "
+        "https://robot.example.org behind a reverse proxy (repeatable)",
+    )
+    add(
+        "--viewer-token",
+        metavar="TOKEN",
+        help="the page and its websocket need ?token=TOKEN (the printed URL carries it; "
+        "default: none on loopback, else one generated at start)",
+    )
+    add("--max-viewers", type=int, metavar="N", help="viewer tabs at once (default 16)")
+    add("--hz", type=float, help="most scene updates per second (default 100)")
+    add(
+        "--motion",
+        choices=("off", "on", "follow"),
+        help="how new connections' moves are shown: off (at once, the default), on (travel, "
+        "reply on arrival) or follow (travel, reply at once)",
+    )
+    add("--speed", type=float, metavar="P", help="new connections' speed, %% of the limits (50)")
+    add(
+        "--guard",
+        choices=("off", "on"),
+        help="new connections refuse colliding targets and paths (default off)",
+    )
+    add("--srdf", metavar="FILE", type=Path, help="SRDF whose disable_collisions are honoured")
+    add("--max-objects", type=int, metavar="N", help="workcell objects per robot (default 100)")
+    for key, unit in (("velocity", "s"), ("acceleration", "s^2"), ("jerk", "s^3")):
+        add(
+            f"--max-{key}",
+            metavar="V[,V...]",
+            help=f"every robot's {key} limit, rad or m per {unit}: one number, or one per joint "
+            "(over the ini's; default: "
+            + {
+                "velocity": "the URDF's",
+                "acceleration": "2 x velocity",
+                "jerk": "10 x velocity",
+            }[key]
+            + ")",
+        )
+    add(
+        "--no-viewer",
+        dest="viewer",
+        action="store_const",
+        const=False,
+        help="run the command server alone",
+    )
+    add("--max-clients", type=int, metavar="N", help="clients at once (default 64)")
+    add("--max-line", type=int, metavar="BYTES", help="longest line (default 8192)")
+    add(
+        "--max-unread",
+        type=int,
+        metavar="BYTES",
+        help="unread replies before a client is dropped (default 1 MiB)",
+    )
+    add(
+        "--partial-timeout",
+        dest="partial_timeout_s",
+        type=float,
+        metavar="S",
+        help="seconds a started line may stay unfinished (default 10)",
+    )
+    add(
+        "--max-sleep",
+        dest="max_sleep_s",
+        type=float,
+        metavar="S",
+        help="longest sleep command (default 3600)",
+    )
+    add(
+        "--record",
+        metavar="NAME",
+        help="record from start to exit into NAME.txt and NAME.csv in the recording folder",
+    )
+    add(
+        "--record-dir",
+        metavar="DIR",
+        help="where recordings go (default ./recordings; created when needed)",
+    )
+    add("-v", "--verbose", action="store_true", help="log every connection")
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``c2rviz`` command; returns the exit status."""
+    args = build_parser().parse_args(argv)
+    logging.basicConfig(
+        level=logging.INFO if args.verbose else logging.WARNING,
+        format="c2rviz: %(levelname)s: %(message)s",
+    )
+    overrides = {
+        k: v
+        for k, v in vars(args).items()
+        if k not in ("config", "verbose", "list_robots", "cell", *MOTION_FLAGS)
+    }
+    try:
+        if args.list_robots:
+            ini = find_ini(args.config)
+            print(listing(catalogue(read_robots(ini), ini).values()))
+            return 0
+        settings = load_settings(find_ini(args.config), overrides)
+        robots, cell = members(settings, args)
+        if settings.srdf is not None:
+            read_srdf(settings.srdf)  # a bad SRDF stops here, with its one sentence
+    except C2rvizError as exc:
+        print(f"c2rviz: {exc}", file=sys.stderr)
+        return 2
+    try:
+        return asyncio.run(serve(settings, robots, cell))
+    except KeyboardInterrupt:  # a second Ctrl-C while stopping
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,295 @@
+"""Settings: cmdinterpreter.ini, overridden by command-line flags.
+
+The ini file has an ``[options]`` section and one section per robot (named as
+in the seed: ``[motoman_sia20d]`` ...) with ``base``, ``eelink`` and ``urdf``
+(relative to the ini file), and optionally ``package_path`` (where
+``package://`` packages are: each entry ``DIR`` or ``NAME=DIR``, as for
+``--package-path``, relative to the ini file) and ``xacro_args``
+(``name:=value`` ...), each a space-separated list. A robot name with no section
+is looked up in the catalogue (example-robot-data). Every bad value is a
+``ConfigError`` naming the key and what it accepts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from ..errors import ConfigError
+from ..ini import INI_NAME, find_ini, number, read_ini
+from ..robot.catalogue import catalogue, find_robot
+from ..robot.sources import split_package_path
+
+__all__ = [
+    "INI_NAME",
+    "ROBOT_KEYS",
+    "ServerLimits",
+    "SessionDefaults",
+    "RobotEntry",
+    "Settings",
+    "find_ini",
+    "load_settings",
+    "read_robots",
+]
+
+
+@dataclass(frozen=True)
+class ServerLimits:
+    """What one client may cost the server (README: "Limits")."""
+
+    max_line: int = 8192
+    """Longest line [bytes]; longer closes the connection."""
+    max_clients: int = 64
+    """Clients connected at once; one more is told so and closed."""
+    max_unread: int = 1 << 20
+    """Replies a client has not read [bytes]; more closes the connection."""
+    partial_timeout_s: float = 10.0
+    """How long a started line may stay unfinished [s]."""
+    max_sleep_s: float = 3600.0
+    """Longest ``sleep`` [s]."""
+
+
+@dataclass(frozen=True)
+class SessionDefaults:
+    """How a new connection starts (each may change its own with a command)."""
+
+    motion: str = "off"
+    """``off`` (moves shown at once, the seed's way), ``on`` or ``follow``."""
+    speed: float = 50.0
+    """Moves at this % of each joint's velocity limit (1..100)."""
+    guard: bool = False
+    """Refuse commands whose target or path collides."""
+    lspeed: float = 0.25
+    """``movel``'s tool speed [m/s] (as UR's movel)."""
+
+
+@dataclass(frozen=True)
+class RobotEntry:
+    """One robot section of the ini file."""
+
+    name: str
+    urdf: Path
+    base: str | None = None
+    eelink: str | None = None
+    package_paths: tuple[str | Path, ...] = ()
+    """``package_path`` entries made absolute: a folder ``Path``, or ``"NAME=/abs/DIR"``."""
+    xacro_args: tuple[str, ...] = ()
+    ini: Path | None = None
+    """The file the section was read from."""
+    extras: tuple[tuple[str, str], ...] = ()
+    """``tool``, ``max_velocity``, ``max_acceleration``, ``max_jerk`` as written (see
+    ``furnish``, which checks them)."""
+
+    def check_package_paths(self) -> None:
+        """Raise ConfigError, naming ``[section] package_path``, for an entry that is no folder."""
+        for entry in self.package_paths:
+            name, folder = split_package_path(entry)
+            if not folder.is_dir():
+                named = f" (for package {name})" if name is not None else ""
+                raise ConfigError(
+                    f"[{self.name}] package_path in {self.ini}: {str(folder)!r}{named} "
+                    "is not a folder (entries are DIR or NAME=DIR, relative to the ini file)"
+                )
+
+
+def _package_paths(text: str, ini: Path) -> tuple[str | Path, ...]:
+    """The ``package_path`` entries of a section, each made absolute against the ini's folder."""
+    entries: list[str | Path] = []
+    for entry in text.split():
+        name, folder = split_package_path(entry, ini.parent)
+        entries.append(folder if name is None else f"{name}={folder}")
+    return tuple(entries)
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Everything the program needs to start."""
+
+    host: str = "127.0.0.1"
+    port: int = 31000
+    hz: float = 100.0
+    viewer_host: str = "127.0.0.1"
+    viewer_port: int = 8080
+    viewer: bool = True
+    viewer_origins: tuple[str, ...] = ()
+    """Origins allowed to open the viewer's websocket besides its own (a reverse proxy)."""
+    viewer_token: str | None = None
+    """The token the page needs (``?token=``); None: none, unless bound beyond loopback."""
+    max_viewers: int = 16
+    """Viewer tabs connected at once."""
+    robot: str = "motoman_sia20d"
+    urdf: Path | None = None
+    base: str | None = None
+    eelink: str | None = None
+    package_paths: tuple[str | Path, ...] = ()
+    """``package://`` search folders (``DIR`` or ``NAME=DIR``), flags first."""
+    xacro_args: tuple[str, ...] = ()
+    """``name:=value`` for a ``.xacro`` robot, the robot section's then the flags'."""
+    record_dir: Path = Path("recordings")
+    """Where ``record NAME`` writes (the ini's is relative to the ini file)."""
+    record: str | None = None
+    """Record from start to exit under this name (``--record``)."""
+    trail_points: int = 20_000
+    """Points a ``trail`` keeps at most."""
+    limits: ServerLimits = field(default_factory=ServerLimits)
+    session: SessionDefaults = field(default_factory=SessionDefaults)
+    robots: Mapping[str, RobotEntry] = field(default_factory=dict)
+    ini: Path | None = None
+    max_objects: int = 100
+    """Most workcell objects per robot."""
+    srdf: Path | None = None
+    """An SRDF whose ``disable_collisions`` pairs are never checked."""
+
+
+# ini key -> (Settings or ServerLimits field, type, lowest allowed, highest allowed)
+_OPTIONS: dict[str, tuple[str, type, float, float]] = {
+    "port": ("port", int, 0, 65535),
+    "hz": ("hz", float, 1, 1000),
+    "viewer_port": ("viewer_port", int, 0, 65535),
+    "max_line": ("max_line", int, 64, 1 << 24),
+    "max_clients": ("max_clients", int, 1, 100000),
+    "max_unread": ("max_unread", int, 1024, 1 << 30),
+    "partial_timeout": ("partial_timeout_s", float, 0.01, 86400),
+    "max_sleep": ("max_sleep_s", float, 0, 1e6),
+    "speed": ("speed", float, 1, 100),
+    "lspeed": ("lspeed", float, 0.001, 5),
+    "trail_points": ("trail_points", int, 16, 10_000_000),
+    "max_objects": ("max_objects", int, 0, 10_000),
+    "max_viewers": ("max_viewers", int, 1, 1024),
+}
+_TEXT_OPTIONS = (
+    "host",
+    "viewer_host",
+    "robot",
+    "motion",
+    "guard",
+    "record_dir",
+    "viewer_token",
+    "viewer_origins",
+)
+_CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on")}
+_EXTRA_KEYS = ["tool", "max_velocity", "max_acceleration", "max_jerk"]
+ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args", *_EXTRA_KEYS]
+_MEMBER_PLACE_KEYS = ("origin", "port")  # a cell member's, beside its robot keys (cell.py)
+_LIMIT_FIELDS = {f for f in ServerLimits.__dataclass_fields__}
+_SESSION_FIELDS = {f for f in SessionDefaults.__dataclass_fields__}
+
+
+def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
+    parser = read_ini(path)
+    values: dict[str, Any] = {}
+    if parser.has_section("options"):
+        for key, text in parser.items("options"):
+            if key in _OPTIONS:
+                name, kind, low, high = _OPTIONS[key]
+                values[name] = number(f"[options] {key}", text, kind, low, high)
+            elif key in _TEXT_OPTIONS:
+                if text not in _CHOICES.get(key, (text,)):
+                    raise ConfigError(f"[options] {key} = {text!r} is not one", _CHOICES[key])
+                if key == "guard":
+                    values[key] = text == "on"
+                elif key == "record_dir":
+                    values[key] = path.parent / text
+                elif key == "viewer_origins":
+                    values[key] = tuple(text.split())
+                else:
+                    values[key] = text
+            else:
+                raise ConfigError(
+                    f"unknown key {key!r} in [options] of {path}",
+                    sorted([*_OPTIONS, *_TEXT_OPTIONS]),
+                )
+    robots = {}
+    members = {  # sections a cell names: they may also say where the robot stands
+        name
+        for section in parser.sections()
+        if section.startswith("cell:")
+        for name in parser.get(section, "robots", fallback="").split()
+    }
+    for section in parser.sections():
+        if section in ("options", "objects") or section.startswith(("cell:", "objects:")):
+            continue
+        items = dict(parser.items(section))
+        if "robot" in items:  # a member of a cell (see cell.py), not a robot of its own
+            continue
+        if section in members:
+            items = {k: v for k, v in items.items() if k not in _MEMBER_PLACE_KEYS}
+        unknown = set(items) - set(ROBOT_KEYS)
+        if unknown:
+            raise ConfigError(
+                f"unknown key {sorted(unknown)[0]!r} in [{section}] of {path}", ROBOT_KEYS
+            )
+        urdf = items.get("urdf")
+        if not urdf:
+            raise ConfigError(f"[{section}] of {path} has no urdf = PATH")
+        robots[section] = RobotEntry(
+            section,
+            (path.parent / urdf).resolve(),
+            items.get("base"),
+            items.get("eelink"),
+            _package_paths(items.get("package_path", ""), path),
+            tuple(items.get("xacro_args", "").split()),
+            path,
+            tuple((key, items[key]) for key in _EXTRA_KEYS if key in items),
+        )
+    return values, robots
+
+
+def read_robots(ini: Path | None) -> dict[str, RobotEntry]:
+    """The robot sections of ``ini`` (none without an ini)."""
+    return _read_ini(ini)[1] if ini is not None else {}
+
+
+def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
+    """Merge defaults, the ini file and ``overrides`` (flags; None means not given).
+
+    Raises:
+        ConfigError: a bad ini value, or a robot name with no section.
+    """
+    values: dict[str, Any] = {}
+    robots: dict[str, RobotEntry] = {}
+    if ini is not None:
+        values, robots = _read_ini(ini)
+    given = {k: v for k, v in overrides.items() if v is not None}
+    for key, (name, _kind, low, high) in _OPTIONS.items():
+        if name in given and not low <= given[name] <= high:
+            flag = "--" + key.replace("viewer_", "viser_").replace("_", "-")
+            raise ConfigError(f"{flag} {given[name]:g} is outside {low:g}..{high:g}")
+    if "guard" in given:
+        given["guard"] = given["guard"] == "on"
+    values.update(given)
+    if "record_dir" in values:
+        values["record_dir"] = Path(values["record_dir"])
+    for key in ("package_paths", "xacro_args", "viewer_origins"):
+        values[key] = tuple(values.get(key, ()))
+    limit_values = {k: values.pop(k) for k in list(values) if k in _LIMIT_FIELDS}
+    session_values = {k: values.pop(k) for k in list(values) if k in _SESSION_FIELDS}
+    settings = replace(
+        Settings(),
+        **values,
+        limits=ServerLimits(**limit_values),
+        session=SessionDefaults(**session_values),
+        robots=robots,
+        ini=ini,
+    )
+    if settings.urdf is None:
+        entry = find_robot(settings.robot, robots, ini)
+        if settings.robot in robots:
+            robots[settings.robot].check_package_paths()
+        settings = replace(
+            settings,
+            urdf=entry.urdf,
+            base=settings.base or entry.base,
+            eelink=settings.eelink or entry.eelink,
+            package_paths=(*settings.package_paths, *entry.package_paths),
+            xacro_args=(*entry.xacro_args, *settings.xacro_args),
+        )
+    elif "robot" in overrides and overrides["robot"] is not None:
+        found = catalogue(robots, ini).get(settings.robot)
+        if found is not None:
+            settings = replace(
+                settings, base=settings.base or found.base, eelink=settings.eelink or found.eelink
+            )
+    return settings

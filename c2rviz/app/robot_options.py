@@ -1,0 +1,105 @@
+"""What the ini adds to each robot of the world: its tool, motion limits and workcell.
+
+A robot section may set ``tool = x,y,z,roll,pitch,yaw`` (m, deg) and
+``max_velocity``, ``max_acceleration``, ``max_jerk`` (one number for every
+joint, or one per joint, comma-separated; rad or m per s, s², s³). Workcell
+objects come from ``[objects]`` (the first robot's) and ``[objects:NAME]`` (robot
+NAME's, for a cell), one per line, placed in that robot's base frame::
+
+    [objects]
+    table = box 1.2,0.8,0.05  0.6,0,-0.03,0,0,0      # size (m), pose (m, deg)
+    post = cylinder 0.05,0.6  0.5,0.4,0.3,0,0,0  0.8,0.3,0.2,0.6  # optional r,g,b,a
+    fixture = mesh meshes/fixture.stl  0.5,-0.3,0,0,0,90  1,1,1  # mesh: file, pose, scale
+
+Mesh files (relative to the ini) can only come from here, never from a client.
+Every bad value is a ``ConfigError`` naming the section and key.
+"""
+
+from __future__ import annotations
+
+import configparser
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import C2rvizError, ConfigError
+from ..motion.planner import MotionLimits, motion_limits
+from ..robot.model import Robot
+
+__all__ = ["IniObject", "ini_objects", "limits_from", "pose_from", "tool_from"]
+
+IniObject = tuple[str, str, list[float], pin.SE3, "tuple[float, ...] | None", "Path | None"]
+"""name, shape, size, placement in the base frame, rgba (None: default), mesh file."""
+
+
+def pose_from(where: str, text: str) -> pin.SE3:
+    """``x,y,z,roll,pitch,yaw`` (m, deg) as an SE3."""
+    values = _numbers(where, text)
+    if len(values) != 6:
+        raise ConfigError(f"{where} = {text!r} must be 6 numbers: x,y,z (m),roll,pitch,yaw (deg)")
+    x, y, z, roll, pitch, yaw = values
+    rotation = pin.rpy.rpyToMatrix(*(math.radians(a) for a in (roll, pitch, yaw)))
+    return pin.SE3(rotation, np.array([x, y, z]))
+
+
+def tool_from(section: str, extras: Mapping[str, str]) -> pin.SE3 | None:
+    """The section's ``tool``, if it sets one."""
+    text = extras.get("tool")
+    return None if text is None else pose_from(f"[{section}] tool", text)
+
+
+def limits_from(section: str, extras: Mapping[str, str], robot: Robot) -> MotionLimits:
+    """The robot's motion limits, with the section's overrides."""
+    given: dict[str, float | Sequence[float]] = {}
+    for key in ("max_velocity", "max_acceleration", "max_jerk"):
+        if key in extras:
+            values = _numbers(f"[{section}] {key}", extras[key])
+            given[key] = values[0] if len(values) == 1 else values
+    try:
+        return motion_limits(robot, **given)  # type: ignore[arg-type]
+    except C2rvizError as exc:
+        raise ConfigError(f"[{section}] {exc}") from None
+
+
+def ini_objects(
+    ini: Path, robot: str, first: bool
+) -> list[tuple[str, str, list[float], pin.SE3, tuple[float, ...] | None, Path | None]]:
+    """The objects the ini places around ``robot`` (``[objects]`` too when it is the first
+    robot): name, shape, size, placement, rgba, mesh path. Checked again when set."""
+    parser = configparser.ConfigParser(interpolation=None, inline_comment_prefixes=("#", ";"))
+    parser.read(ini, encoding="utf-8")
+    found: list[IniObject] = []
+    for section in (["objects"] if first else []) + [f"objects:{robot}"]:
+        if not parser.has_section(section):
+            continue
+        for name, text in parser.items(section):
+            where = f"[{section}] {name}"
+            words = text.split()
+            if len(words) < 3:
+                raise ConfigError(f"{where} = {text!r} needs a shape, a size and a pose")
+            shape = words[0].lower()
+            rgba: tuple[float, ...] | None = None
+            mesh: Path | None = None
+            if shape == "mesh":
+                mesh = (ini.parent / words[1]).resolve()
+                placement = pose_from(where, words[2])
+                size = _numbers(where, words[3]) if len(words) > 3 else [1.0, 1.0, 1.0]
+            else:
+                size = _numbers(where, words[1])
+                placement = pose_from(where, words[2])
+                rgba = tuple(_numbers(where, words[3])) if len(words) > 3 else None
+            found.append((name, shape, size, placement, rgba, mesh))
+    return found
+
+
+def _numbers(where: str, text: str) -> list[float]:
+    try:
+        values = [float(part) for part in text.split(",")]
+    except ValueError:
+        raise ConfigError(f"{where} = {text!r} is not a comma-separated list of numbers") from None
+    if not all(map(math.isfinite, values)):
+        raise ConfigError(f"{where} = {text!r} has a value that is not a finite number")
+    return values

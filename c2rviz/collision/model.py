@@ -1,0 +1,360 @@
+"""Collisions: the robot against itself and against the workcell, with coal.
+
+The geometry is ``collision_geometry.robot_geometry`` (URDF collision elements,
+visual ones where a link has none, on the full model). Which link pairs are
+checked is settled once, at construction, as MoveIt's setup assistant does:
+never links joined by a joint (a link without geometry passes its neighbours
+on), pairs an SRDF disables, pairs that cannot move relative to each other,
+pairs that touch at home (each chain joint at 0, or its nearest limit), and
+pairs that touch in nearly every one of ``samples`` random configurations (a
+fixed seed, so the choice is reproducible). Pairs that never touched in the
+samples are still checked. Workcell objects (``workcell.py``) are checked
+against every link the chain moves; a link that never moves relative to the
+base (the pedestal a table touches) never collides with them.
+
+A pair is ``(link, link)`` in alphabetical order, or ``(link, object)``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from collections.abc import Iterable, Sequence
+from itertools import combinations
+from pathlib import Path
+from typing import Any
+
+import coal
+import numpy as np
+import pinocchio as pin
+
+from ..robot.model import Robot
+from .geometry import (
+    CollisionError,
+    CollisionModelError,
+    Pair,
+    SelfPairs,
+    SrdfError,
+    adjacent_links,
+    configure_requests,
+    moving_joints,
+    ordered_pair,
+    parse_srdf,
+    read_srdf,
+    robot_geometry,
+)
+from .workcell import MAX_OBJECTS, Workcell, WorkcellObject
+
+__all__ = [
+    "ALWAYS_FRACTION",
+    "DEFAULT_SAMPLES",
+    "MAX_STEP_M",
+    "MAX_STEP_RAD",
+    "CollisionError",
+    "CollisionModel",
+    "CollisionModelError",
+    "NoFreeConfiguration",
+    "Pair",
+    "SelfPairs",
+    "SrdfError",
+    "parse_srdf",
+    "read_srdf",
+    "segment",
+]
+
+DEFAULT_SAMPLES = 2000
+ALWAYS_FRACTION = 0.95  # touching in at least this share of the samples: "always touching"
+MAX_STEP_RAD = math.radians(1.0)  # guarded paths: most a revolute joint moves between checks
+MAX_STEP_M = 0.005  # and a prismatic one
+_Checks = tuple[pin.GeometryModel, pin.GeometryData, list[Pair]]
+
+
+class NoFreeConfiguration(CollisionError):
+    """No collision-free configuration in the bounded number of random draws."""
+
+    def __init__(self, robot: str, tries: int) -> None:
+        self.robot = robot
+        self.tries = tries
+        super().__init__(
+            f"no collision-free configuration of {robot} found in {tries} random draws "
+            "(the workcell may fill its reach; remove objects or turn the guard off)"
+        )
+
+
+def segment(
+    robot: Robot,
+    q0: Sequence[float],
+    q1: Sequence[float],
+    max_step_rad: float = MAX_STEP_RAD,
+    max_step_m: float = MAX_STEP_M,
+) -> list[tuple[float, ...]]:
+    """Points from ``q0`` to ``q1`` (both included), straight in joint space.
+
+    Consecutive points differ by at most ``max_step_rad`` on a revolute joint
+    and ``max_step_m`` on a prismatic one, so a thin link cannot pass through
+    an object between two checks.
+    """
+    a = np.asarray(q0, dtype=float)
+    delta = np.asarray(q1, dtype=float) - a
+    steps = np.where(robot.prismatic, max_step_m, max_step_rad)
+    count = max(1, math.ceil(float(np.max(np.abs(delta) / steps, initial=0.0)) - 1e-9))
+    return [tuple((a + delta * (k / count)).tolist()) for k in range(count + 1)]
+
+
+class CollisionModel:
+    """The robot's collision geometry, the pairs checked, and the workcell.
+
+    Attributes:
+        robot: The robot (configurations come from ``robot.configuration``).
+        self_pairs: Which link pairs are checked, and why the others are not.
+        workcell: The objects (read it for drawing; change it through the
+            methods here so the checks follow).
+        warnings: Meshes dropped or kept as triangles, SRDF links unknown.
+    """
+
+    def __init__(
+        self,
+        robot: Robot,
+        *,
+        disabled: Iterable[Pair] = (),
+        samples: int = DEFAULT_SAMPLES,
+        seed: int = 0,
+        max_objects: int = MAX_OBJECTS,
+        convex: bool = True,
+    ) -> None:
+        """Build the geometry and choose the self-collision pairs (see the module).
+
+        Args:
+            robot: The robot.
+            disabled: Link pairs never to check (an SRDF's, see ``read_srdf``).
+            samples: Random configurations drawn to find always-touching pairs.
+            seed: Seed of those draws, so the pairs chosen are reproducible.
+            max_objects: Most workcell objects at once.
+            convex: Check robot meshes by their convex hulls (quicker, a little larger).
+
+        Raises:
+            CollisionModelError: the URDF's collision geometry cannot be built.
+        """
+        self.robot = robot
+        self.model = robot.model
+        self.data = robot.model.createData()
+        geometry, notes = robot_geometry(robot, convex)
+        self._geometry = geometry
+        self._link_of = [self.model.frames[g.parentFrame].name for g in geometry.geometryObjects]
+        self._links = frozenset(self._link_of)
+        moving = moving_joints(robot)
+        self._moving_geoms = [
+            i for i, g in enumerate(geometry.geometryObjects) if g.parentJoint in moving
+        ]
+        known = set(robot.link_names())
+        skip = {ordered_pair(*pair) for pair in disabled}
+        unknown = sorted({name for pair in skip for name in pair} - known)
+        if unknown:
+            notes.append(f"disabled pairs name links {robot.name} lacks: {', '.join(unknown)}")
+        self.warnings = tuple(notes)
+        self.self_pairs = self._choose_pairs(skip, moving, samples, seed)
+        self.workcell = Workcell(known, max_objects)
+        self._rebuild()
+
+    def _choose_pairs(
+        self, disabled: set[Pair], moving: set[int], samples: int, seed: int
+    ) -> SelfPairs:
+        joint_of = {
+            link: g.parentJoint for link, g in zip(self._link_of, self._geometry.geometryObjects)
+        }
+        adjacent = adjacent_links(self.model, set(self._links))
+        srdf, rigid, candidates = set(), set(), set()
+        for pair in combinations(sorted(self._links), 2):
+            a, b = (joint_of[link] for link in pair)
+            if pair in adjacent:
+                continue
+            if pair in disabled:
+                srdf.add(pair)
+            elif a == b or (a not in moving and b not in moving):
+                rigid.add(pair)
+            else:
+                candidates.add(pair)
+        robot = self.robot
+        home = [min(max(0.0, joint.lower), joint.upper) for joint in robot.joints]
+        at_home = self._hits(*self._build(candidates, []), robot.configuration(home))
+        always = self._always_touching(candidates - at_home, samples, seed)
+        checked = candidates - at_home - always
+        return SelfPairs(
+            checked=frozenset(checked),
+            adjacent=frozenset(adjacent),
+            srdf=frozenset(srdf),
+            rigid=frozenset(rigid),
+            at_home=frozenset(at_home),
+            always=frozenset(always),
+            samples=samples,
+        )
+
+    def _always_touching(self, candidates: set[Pair], samples: int, seed: int) -> set[Pair]:
+        """The pairs touching in at least ``ALWAYS_FRACTION`` of ``samples`` random draws.
+
+        A pair is dropped once it has missed too often to get there, and the
+        draws stop when none is left: the answer is the one all the draws
+        would give, usually after about ``(1 - ALWAYS_FRACTION) * samples``.
+        """
+        if samples <= 0:
+            return set()
+        allowed = samples - math.ceil(ALWAYS_FRACTION * samples)  # misses a pair may have
+        misses: Counter[Pair] = Counter()
+        active = set(candidates)
+        # the counts need no micrometres, and exact checks cost most on touching pairs
+        checks = self._build(active, [], exact=False)
+        rng = np.random.default_rng(seed)
+        robot = self.robot
+        for _ in range(samples):
+            if not active:
+                break
+            hits = self._hits(*checks, robot.configuration(robot.random(rng)))
+            misses.update(active - hits)
+            dropped = {pair for pair in active if misses[pair] > allowed}
+            if dropped:
+                active -= dropped
+                checks = self._build(active, [], exact=False)
+        return active
+
+    def _build(
+        self,
+        link_pairs: set[Pair],
+        objects: list[tuple[WorkcellObject, coal.CollisionGeometry]],
+        exact: bool = True,
+    ) -> _Checks:
+        """A geometry model checking ``link_pairs`` and the objects against moving links."""
+        geometry = pin.GeometryModel()
+        names = []
+        for obj in self._geometry.geometryObjects:
+            geometry.addGeometryObject(obj)
+        for i, j in combinations(range(len(self._link_of)), 2):
+            pair = ordered_pair(self._link_of[i], self._link_of[j])
+            if pair in link_pairs:
+                geometry.addCollisionPair(pin.CollisionPair(i, j))
+                names.append(pair)
+        base = self.model.frames[self.robot.base_frame]
+        for obj, shape in objects:
+            k = geometry.addGeometryObject(
+                pin.GeometryObject(
+                    f"workcell/{obj.name}",
+                    base.parentJoint,
+                    self.robot.base_frame,
+                    base.placement * obj.placement,
+                    shape,
+                )
+            )
+            for i in self._moving_geoms:
+                geometry.addCollisionPair(pin.CollisionPair(i, k))
+                names.append((self._link_of[i], obj.name))
+        data = geometry.createData()
+        configure_requests(data, exact)
+        return geometry, data, names
+
+    def _rebuild(self) -> None:
+        self._checks = self._build(set(self.self_pairs.checked), self.workcell.items())
+
+    def _hits(
+        self,
+        geometry: pin.GeometryModel,
+        data: pin.GeometryData,
+        names: list[Pair],
+        q: np.ndarray,
+    ) -> set[Pair]:
+        if not pin.computeCollisions(self.model, self.data, geometry, data, q, False):
+            return set()
+        return {names[k] for k, result in enumerate(data.collisionResults) if result.isCollision()}
+
+    # --- the workcell -----------------------------------------------------------
+
+    def set_object(
+        self,
+        name: str,
+        shape: str,
+        size: Sequence[float],
+        placement: pin.SE3,
+        rgba: Sequence[float] | None = None,
+        mesh_path: str | Path | None = None,
+    ) -> WorkcellObject:
+        """Add or replace an object, placed in the base frame (``Workcell.set``)."""
+        obj = self.workcell.set(name, shape, size, placement, rgba, mesh_path)
+        self._rebuild()
+        return obj
+
+    def remove_object(self, name: str) -> None:
+        """Remove one object (raises ``UnknownObject``)."""
+        self.workcell.remove(name)
+        self._rebuild()
+
+    def remove_all(self) -> None:
+        """Remove every object."""
+        self.workcell.clear()
+        self._rebuild()
+
+    def objects(self) -> list[str]:
+        """The objects' names, in the order they were first set."""
+        return self.workcell.names()
+
+    def object_list(self) -> list[WorkcellObject]:
+        """Every object with its shape, size, placement and colour (for drawing)."""
+        return [obj for obj, _ in self.workcell.items()]
+
+    # --- checks -----------------------------------------------------------------
+
+    def colliding(self, q: Sequence[float]) -> list[Pair]:
+        """The pairs in collision at chain values ``q`` [rad or m], sorted."""
+        return sorted(self._hits(*self._checks, self.robot.configuration(q)))
+
+    def is_free(self, q: Sequence[float]) -> bool:
+        """True when no checked pair collides at ``q`` (stops at the first hit)."""
+        geometry, data, _ = self._checks
+        config = self.robot.configuration(q)
+        return not pin.computeCollisions(self.model, self.data, geometry, data, config, True)
+
+    def first_collision(self, path: Iterable[Sequence[float]]) -> tuple[int, Pair] | None:
+        """The index of the first point of ``path`` in collision and its first pair."""
+        for index, q in enumerate(path):
+            if not self.is_free(q):
+                return index, self.colliding(q)[0]
+        return None
+
+    def first_collision_on_segment(
+        self,
+        q0: Sequence[float],
+        q1: Sequence[float],
+        max_step_rad: float = MAX_STEP_RAD,
+        max_step_m: float = MAX_STEP_M,
+    ) -> tuple[float, Pair] | None:
+        """How far (0..1) along the joint-space segment q0 -> q1 it first collides."""
+        points = segment(self.robot, q0, q1, max_step_rad, max_step_m)
+        hit = self.first_collision(points)
+        return None if hit is None else (hit[0] / (len(points) - 1), hit[1])
+
+    def random_free(self, rng: np.random.Generator, tries: int = 1000) -> list[float]:
+        """A random configuration within the limits that collides with nothing.
+
+        Raises:
+            NoFreeConfiguration: none in ``tries`` draws.
+        """
+        for _ in range(tries):
+            q = self.robot.random(rng)
+            if self.is_free(q):
+                return q
+        raise NoFreeConfiguration(self.robot.name, tries)
+
+    def link_shapes(self, q: Sequence[float]) -> list[tuple[str, Any, pin.SE3]]:
+        """Every collision shape of the robot at chain values ``q``: its link, its coal
+        geometry and its placement in the model's root frame (for checks against
+        another robot, ``between.py``)."""
+        geometry = self._geometry
+        data = geometry.createData()
+        pin.updateGeometryPlacements(
+            self.model, self.data, geometry, data, self.robot.configuration(q)
+        )
+        return [
+            (link, obj.geometry, data.oMg[k].copy())
+            for k, (link, obj) in enumerate(zip(self._link_of, geometry.geometryObjects))
+        ]
+
+    def links_in(self, pairs: Iterable[Pair]) -> list[str]:
+        """The robot links among ``pairs`` (to highlight), sorted."""
+        return sorted({name for pair in pairs for name in pair if name in self._links})

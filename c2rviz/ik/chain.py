@@ -1,0 +1,145 @@
+"""The chain as the IK solves it: a Pinocchio model of the chain alone, with a tool.
+
+Joints off the chain are locked at their neutral values (as
+``Robot.configuration`` leaves them), so the model's configuration is exactly
+the chain's, except that a continuous joint is stored as (cos, sin). A frame
+for the tool point hangs from the end-effector link; its offset can change
+between calls. Conversions between chain values and the model's
+configuration live here, and nowhere else.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from collections.abc import Sequence
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import JointCountError
+from ..robot.model import Robot
+
+__all__ = ["TOOL_FRAME", "IkChain", "chain_model"]
+
+TOOL_FRAME = "c2rviz_ik_tool"
+_UNBOUNDED = 1e10  # a position limit pink ignores
+
+
+def chain_model(robot: Robot) -> pin.Model:
+    """The chain alone: every joint off the chain locked at its neutral value.
+
+    A reduced model rather than pink on the full model with off-chain joints
+    held: pink has no way to freeze joints short of faking their limits, and
+    the reduced configuration is then the chain's. A mimic joint on the chain
+    stays (and follows its leader) when its leader is a chain joint; else it is
+    locked with everything else, as ``Robot.configuration`` keeps its leader
+    neutral.
+    """
+    model = robot.model
+    chain = set(robot.joint_names)
+    keep = {j for j in range(1, model.njoints) if model.names[j] in chain}
+    for mimic, leader in zip(model.mimicking_joints, model.mimicked_joints):
+        if leader in keep:
+            keep.add(mimic)
+    locked = [j for j in range(1, model.njoints) if j not in keep]
+    model = model.copy()
+    if not locked:
+        return model
+    # Pinocchio finds a locked joint's frame by name alone and refuses when a
+    # link has the same name (so100's "gripper"): rename such joints first.
+    frame_names = Counter(frame.name for frame in model.frames)
+    for j in locked:
+        name = model.names[j]
+        if frame_names[name] > 1:
+            model.frames[model.getFrameId(name, pin.JOINT)].name = f"{name} (joint)"
+            model.names[j] = f"{name} (joint)"
+    return pin.buildReducedModel(model, locked, robot.neutral)
+
+
+class IkChain:
+    """The chain's model with a tool frame, and a copy of it without joint limits.
+
+    Attributes:
+        robot: The robot whose chain this is.
+        model: The chain's model, with the tool frame ``TOOL_FRAME``.
+        free_model: The same model without position limits (for free descents).
+        tool_frame: Index of the tool frame in both models.
+        base_placement: Base link placement in the model's world frame.
+        lower: The model's lower position limits (cos/sin bounds for continuous joints).
+        upper: The model's upper position limits.
+    """
+
+    def __init__(self, robot: Robot) -> None:
+        self.robot = robot
+        model = chain_model(robot)
+        ee = model.getFrameId(robot.eelink, pin.BODY)
+        self._ee_placement = model.frames[ee].placement.copy()
+        self.tool_frame = model.addFrame(
+            pin.Frame(
+                TOOL_FRAME,
+                model.frames[ee].parentJoint,
+                ee,
+                self._ee_placement,
+                pin.FrameType.OP_FRAME,
+            )
+        )
+        self.model = model
+        self.free_model = model.copy()
+        self.free_model.lowerPositionLimit[:] = -_UNBOUNDED
+        self.free_model.upperPositionLimit[:] = _UNBOUNDED
+        self.data = model.createData()
+        pin.framesForwardKinematics(model, self.data, pin.neutral(model))
+        self.base_placement = self.data.oMf[model.getFrameId(robot.base, pin.BODY)].copy()
+        self.lower = model.lowerPositionLimit.copy()
+        self.upper = model.upperPositionLimit.copy()
+        self._idx_q = [model.joints[model.getJointId(j.name)].idx_q for j in robot.joints]
+        self._continuous = [j.continuous and j.nq == 2 for j in robot.joints]
+        self._wraps = [not (j.prismatic or j.continuous) for j in robot.joints]
+
+    def set_tool(self, tool: pin.SE3 | None) -> None:
+        """Put the tool frame at ``tool`` from the end-effector link (identity when None)."""
+        placement = self._ee_placement * (tool if tool is not None else pin.SE3.Identity())
+        self.model.frames[self.tool_frame].placement = placement
+        self.free_model.frames[self.tool_frame].placement = placement
+
+    def tool_pose(self, q: Sequence[float]) -> pin.SE3:
+        """Tool placement in the base frame for chain values ``q`` [rad or m]."""
+        pin.framesForwardKinematics(self.model, self.data, self.to_model(q))
+        return self.base_placement.actInv(self.data.oMf[self.tool_frame])
+
+    def to_model(self, q: Sequence[float]) -> np.ndarray:
+        """The model's configuration for chain values ``q``, within the limits.
+
+        A revolute joint outside its limits is first turned by whole turns
+        towards them (the same pose), then clipped.
+
+        Raises:
+            JointCountError: ``q`` does not have one value per chain joint.
+        """
+        joints = self.robot.joints
+        if len(q) != len(joints):
+            raise JointCountError(len(joints), len(q))
+        out = pin.neutral(self.model)
+        for i, (idx, value) in enumerate(zip(self._idx_q, q)):
+            if self._continuous[i]:
+                out[idx], out[idx + 1] = math.cos(value), math.sin(value)
+                continue
+            lower, upper = joints[i].lower, joints[i].upper
+            if self._wraps[i] and not lower <= value <= upper:
+                turns = math.ceil((lower - value) / math.tau) if value < lower else 0
+                turns -= math.ceil((value - upper) / math.tau) if value > upper else 0
+                value += turns * math.tau
+            out[idx] = min(max(value, lower), upper)
+        return out
+
+    def to_chain(self, q: np.ndarray, near: Sequence[float]) -> tuple[float, ...]:
+        """Chain values [rad or m]; a continuous joint takes the turn nearest ``near``."""
+        out = []
+        for i, idx in enumerate(self._idx_q):
+            if self._continuous[i]:
+                angle = math.atan2(q[idx + 1], q[idx])
+                out.append(near[i] + math.remainder(angle - near[i], math.tau))
+            else:
+                out.append(float(q[idx]))
+        return tuple(out)

@@ -1,0 +1,213 @@
+"""Straight-line tool motion: the joint path that keeps the tool on a segment.
+
+The tool point moves on the straight segment from its pose at ``q0`` to the
+goal while its orientation turns by slerp; both progress with one parameter
+``s`` from 0 to 1. Each waypoint is solved from the one before (warm start),
+so the path is continuous; where joints move fast for little tool motion the
+step is halved, and where even a tiny step cannot follow the line (a joint at
+its limit, a singularity) the whole line is refused before anything moves.
+Pure: time enters only through the speeds given to ``StraightLine.timestamps``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import C2rvizError
+from .solver import IkSolver
+
+__all__ = ["LineBlocked", "LineWaypoint", "StraightLine", "interpolate", "plan_line"]
+
+
+class LineBlocked(C2rvizError):
+    """The tool cannot follow the straight line all the way.
+
+    Attributes:
+        fraction: How far along the line the last good waypoint is (0..1).
+        q: Chain values at that waypoint [rad or m].
+        joint: The joint that reaches its limit there, if that is the cause.
+        joint_count: For an arm of fewer than 6 joints that cannot hold the
+            line's poses, its joint count; None otherwise.
+
+    With neither ``joint`` nor ``joint_count``, the arm passes a singularity.
+    """
+
+    def __init__(
+        self,
+        fraction: float,
+        q: Sequence[float],
+        joint: str | None = None,
+        joint_count: int | None = None,
+    ) -> None:
+        self.fraction = fraction
+        self.q = tuple(q)
+        self.joint = joint
+        self.joint_count = joint_count
+        if joint is not None:
+            reason = f"{joint} reaches its limit"
+        elif joint_count is not None:
+            reason = f"the tool leaves the poses {joint_count} joints can reach"
+        else:
+            reason = "passes a singularity"
+        percent = math.floor(fraction * 100)
+        super().__init__(f"straight line blocked at {percent}% of the way: {reason}")
+
+
+@dataclass(frozen=True)
+class LineWaypoint:
+    """One point of the joint path.
+
+    Attributes:
+        s: Fraction of the way along the line (0 at the start, 1 at the goal).
+        q: Chain values there [rad or m].
+    """
+
+    s: float
+    q: tuple[float, ...]
+
+
+def interpolate(start: pin.SE3, goal: pin.SE3, s: float) -> pin.SE3:
+    """The pose a fraction ``s`` of the way: position on the segment, orientation by slerp."""
+    rotation = start.rotation @ pin.exp3(s * pin.log3(start.rotation.T @ goal.rotation))
+    return pin.SE3(rotation, start.translation + s * (goal.translation - start.translation))
+
+
+@dataclass(frozen=True)
+class StraightLine:
+    """A planned straight line: its two tool poses and the joint path between.
+
+    Attributes:
+        start: Tool pose at ``s = 0`` in the base frame.
+        goal: Tool pose at ``s = 1`` in the base frame.
+        waypoints: The joint path, ``s`` increasing from 0 to 1.
+    """
+
+    start: pin.SE3
+    goal: pin.SE3
+    waypoints: tuple[LineWaypoint, ...]
+
+    @property
+    def length_m(self) -> float:
+        """Distance the tool point travels [m]."""
+        return float(np.linalg.norm(self.goal.translation - self.start.translation))
+
+    @property
+    def angle_rad(self) -> float:
+        """Angle the tool turns through [rad]."""
+        return float(np.linalg.norm(pin.log3(self.start.rotation.T @ self.goal.rotation)))
+
+    def pose_at(self, s: float) -> pin.SE3:
+        """Tool pose a fraction ``s`` of the way, in the base frame."""
+        return interpolate(self.start, self.goal, s)
+
+    def timestamps(
+        self,
+        speed_m_s: float,
+        joint_velocity_limits: Sequence[float],
+        angular_speed_rad_s: float = math.inf,
+    ) -> tuple[float, ...]:
+        """Time of each waypoint [s], from 0, for constant speeds between waypoints.
+
+        Each segment takes the longest of: its length at ``speed_m_s``, its
+        turn at ``angular_speed_rad_s``, and each joint's change at its
+        velocity limit; so the tool never exceeds either speed and the line
+        slows down where a joint cannot keep up. Accelerations are not bounded.
+
+        Args:
+            speed_m_s: Tool point speed [m/s], > 0.
+            joint_velocity_limits: Per chain joint [rad/s or m/s], > 0 (inf: none).
+            angular_speed_rad_s: Tool turning speed [rad/s], > 0 (inf: none).
+        """
+        limits = np.asarray(joint_velocity_limits, dtype=float)
+        if speed_m_s <= 0 or angular_speed_rad_s <= 0 or (limits <= 0).any():
+            raise ValueError("speeds and joint velocity limits must be positive")
+        length, angle = self.length_m, self.angle_rad
+        times = [0.0]
+        for before, after in zip(self.waypoints, self.waypoints[1:]):
+            ds = after.s - before.s
+            joint = np.abs(np.subtract(after.q, before.q)) / limits
+            duration = max(
+                ds * length / speed_m_s, ds * angle / angular_speed_rad_s, float(joint.max())
+            )
+            times.append(times[-1] + duration)
+        return tuple(times)
+
+
+def plan_line(
+    ik: IkSolver,
+    q0: Sequence[float],
+    goal: pin.SE3,
+    tool: pin.SE3 | None = None,
+    *,
+    step_m: float = 0.005,
+    step_rad: float = math.radians(1.0),
+    max_joint_step: float = 0.1,
+    min_step_m: float = 5e-5,
+) -> StraightLine:
+    """The joint path that moves the tool from its pose at ``q0`` straight to ``goal``.
+
+    Waypoints are at most ``step_m`` and ``step_rad`` of tool motion apart;
+    a step that would move a joint more than ``max_joint_step`` is halved,
+    down to ``min_step_m`` (and a turn as small in proportion), where the
+    line is blocked.
+
+    Args:
+        ik: The robot's solver.
+        q0: Chain values at the start [rad or m], within the limits.
+        goal: Tool pose at the end, in the base frame.
+        tool: Tool offset from the end-effector link (identity when None).
+        step_m: Largest tool travel between waypoints [m].
+        step_rad: Largest tool turn between waypoints [rad].
+        max_joint_step: Largest joint change between waypoints [rad or m].
+        min_step_m: Smallest step tried before the line is called blocked [m].
+
+    Returns:
+        The line, its waypoints from ``s = 0`` (``q0``) to ``s = 1``.
+
+    Raises:
+        LineBlocked: a joint reaches its limit, the arm passes a singularity,
+            or (under 6 joints) the line leaves the poses the arm can reach.
+        Unreachable: the goal itself cannot be reached.
+    """
+    ik.solve(goal, q0, tool)  # an unreachable goal is reported as such, not as a block
+    start = ik.tool_pose(q0, tool)
+    length = float(np.linalg.norm(goal.translation - start.translation))
+    angle = float(np.linalg.norm(pin.log3(start.rotation.T @ goal.rotation)))
+    count = max(1, math.ceil(max(length / step_m, angle / step_rad)))
+    nominal = 1.0 / count
+    smallest = nominal * min(1.0, min_step_m / step_m)  # as small a turn, in proportion
+    q = tuple(float(v) for v in q0)
+    waypoints = [LineWaypoint(0.0, q)]
+    s, ds = 0.0, nominal
+    while s < 1.0:
+        s_next = s + ds if s + ds < 1.0 - 1e-9 else 1.0
+        attempt = ik.follow(interpolate(start, goal, s_next), q, tool)
+        jump = float(np.abs(np.subtract(attempt.q, q)).max())
+        if attempt.ok and jump <= max_joint_step:
+            s, q = s_next, attempt.q
+            waypoints.append(LineWaypoint(s, q))
+            ds = min(nominal, 2 * ds)
+            continue
+        if ds > smallest:
+            ds /= 2
+            continue
+        if attempt.ok:  # there, but only by a jump: the arm turns over a singularity
+            raise LineBlocked(s, q)
+        joint = _joint_at_limit(ik, attempt.q)
+        # An arm of under 6 joints reaches a thin set of poses; a line leaves it.
+        few = ik.robot.n if joint is None and ik.robot.n < 6 else None
+        raise LineBlocked(s, q, joint, few)
+    return StraightLine(start, goal, tuple(waypoints))
+
+
+def _joint_at_limit(ik: IkSolver, q: Sequence[float], tolerance: float = 1e-3) -> str | None:
+    """The chain joint nearest its limit when within ``tolerance`` [rad or m], else None."""
+    robot = ik.robot
+    gaps = [min(v - lo, hi - v) for v, lo, hi in zip(q, robot.lower, robot.upper)]
+    index = int(np.argmin(gaps))
+    return robot.joint_names[index] if gaps[index] <= tolerance else None

@@ -1,0 +1,18 @@
+"""Moves that take time, pure (no asyncio, no clock of their own: times are the caller's):
+the ruckig planner (``planner``), the joints' motion limits (``limits``) and a joint
+path played along its own timing (``line_play``).
+"""
+
+from .limits import MotionLimitError, MotionLimits, motion_limits
+from .line_play import LinePlay, ramp_limits
+from .planner import Motion, MotionPlanError
+
+__all__ = [
+    "LinePlay",
+    "Motion",
+    "MotionLimitError",
+    "MotionLimits",
+    "MotionPlanError",
+    "motion_limits",
+    "ramp_limits",
+]

@@ -1,0 +1,122 @@
+"""A straight tool line played in time: its joint path, eased in and out, braked on the path.
+
+``cartesian.StraightLine.timestamps`` times a line's waypoints for constant
+speeds: the tool at ``lspeed`` at most, each joint at its velocity limit at
+most. Played as is, the arm would start and stop at full speed. Here that
+timing becomes *path time* ``u`` (seconds of the timed path), and a one-joint
+ruckig profile ``u(t)`` carries the arm along it: ``u`` goes from 0 to the
+path's duration with ``du/dt <= 1`` (never faster than the timing allows), and
+its acceleration and jerk bounded so that every joint, whose path velocity
+``dq/du`` is at most its velocity limit ``v``, gets at most its acceleration
+limit ``a`` (and jerk limit ``j``) from the ramp: ``du^2/dt^2 <= min(a / v)``,
+``du^3/dt^3 <= min(j / v)``, scaled by the speed fraction like ``motion``'s.
+Between waypoints the joints still move linearly in ``u`` (their velocity
+changes at a waypoint, as the line's direction in joint space does).
+
+A stop brakes ``u`` to rest as fast as those limits allow: the arm slows down
+on the line and stops on it, short of the goal. Pure: times are the caller's.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from ruckig import ControlInterface, InputParameter, Result, Ruckig, Trajectory
+
+from .limits import MotionLimits
+from .planner import MotionPlanError
+
+__all__ = ["LinePlay", "ramp_limits"]
+
+
+def ramp_limits(limits: MotionLimits, fraction: float) -> tuple[float, float]:
+    """The path-time acceleration and jerk [1/s, 1/s^2] a line gets at speed ``fraction``."""
+    velocity = np.asarray(limits.velocity)
+    acceleration = float(np.min(np.asarray(limits.acceleration) / velocity))
+    jerk = float(np.min(np.asarray(limits.jerk) / velocity))
+    return acceleration * fraction, jerk * fraction**2
+
+
+class LinePlay:
+    """A joint path played along its own timing, eased by a path-time profile.
+
+    Attributes:
+        start: When the arm leaves the first waypoint, on the caller's clock [s].
+        times: Path time of each waypoint [s], increasing from 0.
+        qs: The waypoints' chain values [rad or m], one row each.
+    """
+
+    def __init__(
+        self,
+        start: float,
+        times: Sequence[float],
+        qs: np.ndarray,
+        acceleration: float,
+        jerk: float,
+    ) -> None:
+        """Ease in at ``start`` and out at the last waypoint.
+
+        Args:
+            start: The caller's time now [s].
+            times: Path time of each waypoint [s], from 0, increasing.
+            qs: The waypoints [rad or m], one row each.
+            acceleration: Most path-time acceleration [1/s] (``ramp_limits``).
+            jerk: Most path-time jerk [1/s^2] (``ramp_limits``).
+        """
+        self.start = start
+        self.times = np.asarray(times, dtype=float)
+        self.qs = np.asarray(qs, dtype=float)
+        self._limits = (acceleration, jerk)
+        self._origin = start  # the profile's time 0 on the caller's clock
+        self._profile = self._plan(0.0, 0.0, 0.0, ControlInterface.Position)
+
+    @property
+    def arrival(self) -> float:
+        """When the arm comes to rest: at the goal, or where a brake stops it [s]."""
+        return self._origin + self._profile.duration
+
+    def path_time(self, t: float) -> tuple[float, float, float]:
+        """Path time ``u`` [s], its rate and its acceleration at the caller's time ``t``."""
+        u, rate, acceleration = self._profile.at_time(max(t - self._origin, 0.0))
+        return min(max(u[0], 0.0), float(self.times[-1])), rate[0], acceleration[0]
+
+    def sample(self, t: float) -> tuple[float, ...]:
+        """The chain values at the caller's time ``t``."""
+        u = self.path_time(t)[0]
+        k = int(np.searchsorted(self.times, u, side="right"))
+        if k >= len(self.times):
+            return tuple(self.qs[-1].tolist())
+        if k == 0:
+            return tuple(self.qs[0].tolist())
+        u0, u1 = self.times[k - 1], self.times[k]
+        f = (u - u0) / (u1 - u0) if u1 > u0 else 1.0
+        return tuple((self.qs[k - 1] + f * (self.qs[k] - self.qs[k - 1])).tolist())
+
+    def brake(self, t: float) -> float:
+        """From ``t`` on, slow down on the path to rest; return when the arm is at rest."""
+        u, rate, acceleration = self.path_time(t)
+        self._profile = self._plan(u, rate, acceleration, ControlInterface.Velocity)
+        self._origin = t
+        return self.arrival
+
+    def _plan(
+        self, u: float, rate: float, acceleration: float, interface: ControlInterface
+    ) -> Trajectory:
+        max_acceleration, max_jerk = self._limits
+        params = InputParameter(1)
+        params.control_interface = interface
+        params.current_position = [u]
+        params.current_velocity = [rate]
+        params.current_acceleration = [acceleration]
+        params.target_position = [float(self.times[-1])]
+        params.target_velocity = [0.0]
+        params.target_acceleration = [0.0]
+        params.max_velocity = [1.0]
+        params.max_acceleration = [max_acceleration]
+        params.max_jerk = [max_jerk]
+        profile = Trajectory(1)
+        result = Ruckig(1).calculate(params, profile)
+        if result not in (Result.Working, Result.Finished):
+            raise MotionPlanError(f"the line's ramp ({result.name})")
+        return profile

@@ -1,0 +1,328 @@
+"""Recording: what happens to one robot, from every source, kept in two files.
+
+A ``Recorder`` is an observer of the world (so it sees the TCP clients, the page
+and replays alike) that writes, in the recording folder:
+
+- ``NAME.txt``, a command file ``c2rviz-play NAME.txt`` plays back to the same
+  states at the same times: ``radians``, ``motion off``, then ``joints``,
+  ``mark`` (after ``color`` and ``marker`` when they change), ``clear`` and
+  ``sleep S`` between them. Its opening ``#`` comments name the robot
+  (``# robot: NAME``, which the player checks), when it was recorded and the
+  sources that sent commands.
+- ``NAME.csv``, one row per frame: ``time`` [s from the start], each joint by name
+  [rad or m], and the tool pose ``x,y,z`` [m] ``roll,pitch,yaw`` [rad] in the base
+  frame (as ``pose`` gives it), with a header row; values to 10 significant digits
+  as replies give them (NAME.txt keeps them exact, so a replay is the same states).
+
+It never slows the command path: states are coalesced to at most one frame per
+``1/hz`` of the world's clock (a state superseded within a frame is dropped; the
+latest is written at the frame's time, when it was what the arm showed), and
+files are written through large buffers, flushed once a second. A write error
+(a full disk) stops the recording with one warning and an ``event
+record-stopped`` to watchers; the server goes on. The command file's header
+needs the sources, known only at the end, so its body is written to
+``.NAME.txt.part`` and ``NAME.txt`` is put together when the recording stops.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import TYPE_CHECKING, TextIO
+
+import numpy as np
+import pinocchio as pin
+
+from ..protocol import replies
+from ..world.effects import Marker, Observer
+
+if TYPE_CHECKING:
+    from ..world.world import World
+
+__all__ = ["BUFFER_BYTES", "FLUSH_S", "Recorded", "Recorder"]
+
+log = logging.getLogger("c2rviz.recorder")
+
+BUFFER_BYTES = 1 << 18
+"""Write buffer of each file [bytes]."""
+FLUSH_S = 1.0
+"""Files are flushed at most this often [s of the world's clock] (and at the end)."""
+_MAX_SOURCES = 100  # sources named in the header; the rest are counted
+
+
+@dataclass(frozen=True)
+class Recorded:
+    """A finished recording (what an exporter needs to find and describe it).
+
+    Attributes:
+        name: Its name.
+        robot: The robot model's name (the ``# robot:`` header).
+        txt: The command file (None when a write error stopped it: see ``error``).
+        csv: The frames.
+        frames: Rows of the CSV.
+        duration_s: Recorded time [s].
+        started: When it began (UTC).
+        sources: Who sent commands meanwhile.
+        error: Why it stopped early, if it did.
+        html: NAME.html, the run as a page that plays in any browser.
+    """
+
+    name: str
+    robot: str
+    txt: Path | None
+    csv: Path
+    frames: int
+    duration_s: float
+    started: datetime
+    sources: tuple[str, ...]
+    error: str | None = None
+    html: Path | None = None
+    """The self-contained page (``record_html``), once written."""
+
+
+def _numbers(values: Sequence[float]) -> str:
+    """Exact values (shortest round-trip form), comma-separated."""
+    return ",".join([repr(float(v)) for v in values])
+
+
+class Recorder(Observer):
+    """One recording of one robot of a world (the world's clock times it)."""
+
+    def __init__(
+        self,
+        world: World,
+        robot: str,
+        name: str,
+        folder: Path,
+        on_failed: Callable[[Recorder, str], None],
+    ) -> None:
+        """Open the files and write the state now (the caller checked the name and folder).
+
+        Args:
+            world: What is recorded.
+            robot: The robot's name in the world.
+            name: The recording's name (files NAME.txt and NAME.csv in ``folder``).
+            folder: An existing folder.
+            on_failed: Called once, on the asyncio thread, when a write error stops it.
+
+        Raises:
+            OSError: a file cannot be opened.
+        """
+        self.world = world
+        self.robot = robot
+        self.name = name
+        self.state = world.state(robot)
+        self.period_s = world.travels.frame_s
+        self.on_failed = on_failed
+        self.started = datetime.now(timezone.utc)
+        self.t0 = world.clock()
+        self.txt = folder / f"{name}.txt"
+        self.csv = folder / f"{name}.csv"
+        self.part = folder / f".{name}.txt.part"
+        self.sources: dict[str, None] = {}
+        self.more_sources = 0
+        self.frames = 0
+        self.error: str | None = None
+        self.closed = False
+        self._due = -np.inf  # when the next frame may be written [clock s]
+        self._pending: Sequence[float] | None = None  # the latest state, not yet written
+        self._written_us = 0  # time of the last line of the command file [us from t0]
+        self._flushed = self.t0
+        self._rgb = (1.0, 0.0, 0.0)  # a replaying session's marker style
+        self._shape = "sphere"
+        self._body: TextIO = open(self.part, "w", buffering=BUFFER_BYTES, encoding="ascii")  # noqa: SIM115
+        try:
+            self._rows: TextIO = open(self.csv, "w", buffering=BUFFER_BYTES, encoding="ascii")  # noqa: SIM115
+        except OSError:
+            self._body.close()
+            raise
+        joints = ",".join(self.state.robot.joint_names)
+        self._write(self._rows, f"time,{joints},x,y,z,roll,pitch,yaw\n")
+        self._write(self._body, "radians\nmotion off\nclear\n")
+        for marker in self.state.markers:
+            self._mark(marker)
+        self._frame(self.state.q, self.t0)
+
+    @property
+    def seconds(self) -> float:
+        """How long it has been recording [s]."""
+        return self.world.clock() - self.t0
+
+    # The world's effects.
+
+    def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
+        if robot != self.robot or self.closed:
+            return
+        if t < self._due:  # the hot path: a flood of commands within one frame
+            self._pending = q
+            return
+        if self._pending is not None:
+            self._frame(self._pending, self._due)  # it was still the arm's state then
+            self._pending = None
+        if t >= self._due:
+            self._frame(q, t)
+        else:
+            self._pending = q
+
+    def on_marker(self, robot: str, marker: Marker) -> None:
+        if robot == self.robot and not self.closed:
+            self._catch_up(self.world.clock())
+            self._mark(marker)
+
+    def on_clear_markers(self, robot: str) -> None:
+        if robot == self.robot and not self.closed:
+            self._catch_up(self.world.clock())
+            # `clear` also homes the arm: put it back at once where it is (the home move,
+            # if this clear came with one, follows as frames).
+            self._write(self._body, f"clear\njoints {_numbers(self.state.q)}\n")
+
+    def on_command(self, source: str, line: str, accepted: bool) -> None:
+        if accepted and source not in self.sources:
+            if len(self.sources) < _MAX_SOURCES:
+                self.sources[source] = None
+            else:
+                self.more_sources += 1
+
+    # Writing.
+
+    def _catch_up(self, t: float) -> None:
+        """Write the pending state if its frame came before ``t``; then the time to ``t``."""
+        if self._pending is not None and t >= self._due:
+            self._frame(self._pending, self._due)
+            self._pending = None
+        self._sleep_to(t)
+
+    def _sleep_to(self, t: float) -> int:
+        us = round((t - self.t0) * 1e6)
+        if us > self._written_us:
+            seconds = f"{(us - self._written_us) / 1e6:.6f}".rstrip("0").rstrip(".")
+            self._write(self._body, f"sleep {seconds}\n")
+            self._written_us = us
+        return us
+
+    def _frame(self, q: Sequence[float], t: float) -> None:
+        us = self._sleep_to(t)
+        self._due = t + self.period_s
+        placement = self.state.robot.ee_pose(q) * self.state.tool
+        pose = replies.numbers([*placement.translation, *pin.rpy.matrixToRpy(placement.rotation)])
+        self._write(self._body, f"joints {_numbers(q)}\n")  # exact: a replay is the same
+        self._write(self._rows, f"{us / 1e6:.6f},{replies.numbers(q)},{pose}\n")
+        self.frames += 1
+        if t - self._flushed >= FLUSH_S and not self.closed:
+            self._flushed = t
+            try:
+                self._body.flush()
+                self._rows.flush()
+            except OSError as exc:
+                self._fail(exc)
+
+    def _mark(self, marker: Marker) -> None:
+        lines = []
+        if marker.rgb != self._rgb:
+            self._rgb = marker.rgb
+            lines.append(f"color {_numbers(marker.rgb)}\n")
+        if marker.shape != self._shape:
+            self._shape = marker.shape
+            lines.append(f"marker {marker.shape}\n")
+        w, x, y, z = marker.wxyz
+        in_world = pin.SE3(pin.Quaternion(w, x, y, z).toRotationMatrix(), np.array(marker.position))
+        pose = (self.state.origin * self.state.robot.base_placement).actInv(in_world)
+        rpy = pin.rpy.matrixToRpy(pose.rotation)
+        lines.append(f"mark {_numbers([*pose.translation, *rpy])}\n")
+        self._write(self._body, "".join(lines))
+
+    def _write(self, file: TextIO, text: str) -> None:
+        if self.closed:
+            return
+        try:
+            file.write(text)
+        except OSError as exc:
+            self._fail(exc)
+
+    def _fail(self, exc: OSError) -> None:
+        """A write failed: stop here, keep what is on disk, tell the desk."""
+        self.error = f"write error: {exc.strerror or exc}"
+        log.warning(
+            "recording %s stopped by a %s; what was written is in %s and %s",
+            self.name,
+            self.error,
+            self.part,
+            self.csv,
+        )
+        self._close_files()
+        self.on_failed(self, self.error)
+
+    def _close_files(self) -> None:
+        self.closed = True
+        for file in (self._body, self._rows):
+            with contextlib.suppress(OSError, ValueError):
+                file.close()
+
+    # The end.
+
+    def stop(self) -> None:
+        """Write the last state and close the files (on the asyncio thread)."""
+        if self.closed:
+            return
+        now = self.world.clock()
+        if self._pending is not None:
+            self._frame(self._pending, min(now, self._due))
+            self._pending = None
+        self._sleep_to(now)
+        if self.closed:
+            return
+        self.closed = True
+        try:
+            self._body.close()
+            self._rows.close()
+        except OSError as exc:
+            self._fail(exc)
+
+    def finish(self) -> Recorded:
+        """Put NAME.txt together (header, then the body); blocking file I/O, for a thread."""
+        txt: Path | None = None
+        if self.error is None:
+            try:
+                temporary = self.txt.with_name(f".{self.name}.txt.tmp")
+                with open(temporary, "w", encoding="ascii") as out, open(self.part) as body:
+                    out.write(self.header())
+                    while chunk := body.read(BUFFER_BYTES):
+                        out.write(chunk)
+                os.replace(temporary, self.txt)
+                self.part.unlink()
+                txt = self.txt
+            except OSError as exc:
+                self.error = f"write error: {exc.strerror or exc}"
+                log.warning("recording %s: cannot write %s: %s", self.name, self.txt, self.error)
+        return Recorded(
+            self.name,
+            self.state.robot.name,
+            txt,
+            self.csv,
+            self.frames,
+            self._written_us / 1e6,
+            self.started,
+            tuple(self.sources),
+            self.error,
+        )
+
+    def header(self) -> str:
+        sources = ", ".join(self.sources) or "none"
+        if self.more_sources:
+            sources += f" and {self.more_sources} more"
+        robot = self.state.robot.name
+        return (
+            f"# c2rviz recording {self.name}: play it back with c2rviz-play {self.name}.txt\n"
+            f"# robot: {robot}\n"
+            f"# recorded: {self.started.isoformat(timespec='seconds')}, "
+            f"{self._written_us / 1e6:.3f} s, {self.frames} frames "
+            f"(at most {1 / self.period_s:g} a second)\n"
+            f"# sources: {sources}\n"
+            f"# frames: {self.name}.csv (time [s], joints [rad or m], tool pose x,y,z [m] "
+            "roll,pitch,yaw [rad] in the base frame)\n"
+        )

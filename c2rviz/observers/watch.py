@@ -1,0 +1,327 @@
+"""The ``watch`` stream: the arm's state and what happens, as lines on a client's socket.
+
+A connection that sent ``watch [HZ]`` also receives, between its replies::
+
+    state T v0,...,vn-1      the arm at T [s since the server started], in its units
+    event marker x,y,z,roll,pitch,yaw SHAPE r,g,b   a marker (base frame, its units)
+    event clear              every marker is gone
+    event arrived            a move came to rest at its target
+    event stopped            a move came to rest after ``stop``
+    event collision a~b,...  the colliding pairs changed (``none``: clear again), once
+                             collisions are checked (an object, ``collisions``, ``guard on``)
+    event record-stopped NAME: WHY
+    event dropped N          N events were dropped for a reader too slow to take them
+
+A slow reader costs neither memory nor other clients: a stream keeps only the
+latest state (a reader that falls behind skips states) and at most
+``MAX_EVENTS`` events (the oldest go first, counted in ``event dropped N``).
+Lines are written only while the socket's write buffer is below
+``STREAM_HIGH_BYTES`` (asyncio's write flow control: the connection forwards
+``pause_writing``/``resume_writing``), so a watcher that never reads is never
+disconnected for it: at most ``STREAM_ALLOWANCE_BYTES`` of its buffer are stream
+lines, and the unread-replies limit does not count them.
+
+``WatchHub`` is one per world: the observer that fans the world's effects out to
+the active streams (it is in the world's observers only while someone watches,
+so an unwatched server pays nothing). ``WatchStream`` is one per connection.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import math
+import weakref
+from collections import deque
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Protocol
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import C2rvizError
+from ..protocol import replies
+from ..world.effects import Marker, Observer
+
+if TYPE_CHECKING:
+    from ..session.session import Session
+    from ..world.world import World
+
+__all__ = [
+    "MAX_EVENTS",
+    "STREAM_ALLOWANCE_BYTES",
+    "STREAM_HIGH_BYTES",
+    "NotAConnection",
+    "Sink",
+    "WatchHub",
+    "WatchStream",
+]
+
+MAX_EVENTS = 256
+"""Events a stream holds for a reader that does not take them; past it the oldest go."""
+STREAM_HIGH_BYTES = 16 * 1024
+"""A watching connection's write buffer above this pauses the stream (asyncio's high-water
+mark); it goes on below a quarter of it."""
+STREAM_ALLOWANCE_BYTES = STREAM_HIGH_BYTES + MAX_EVENTS * 1024
+"""Most stream output that can sit in a connection's write buffer: one write past the
+high-water mark (the dropped count, every held event, a state). The unread-replies limit
+counts only what is beyond it."""
+
+
+class NotAConnection(C2rvizError):
+    """``watch`` from a source that is not a TCP connection (the page)."""
+
+    def __init__(self, source: str) -> None:
+        self.source = source
+        super().__init__(
+            f"watch: {source} has no stream of its own; watch from a TCP connection "
+            "(for instance c2rviz-cli --watch)"
+        )
+
+
+class Sink(Protocol):
+    """Where a stream writes: the connection (``server.Connection``)."""
+
+    @property
+    def transport(self) -> asyncio.Transport | None: ...
+
+    @property
+    def closing(self) -> bool: ...
+
+
+class WatchStream:
+    """One connection's stream: the latest state and the events not yet written.
+
+    Each item gets a sequence number from the hub, so events and the state are written
+    in the order they happened; states are coalesced (only the latest is kept) and
+    written at most once per ``period_s``.
+    """
+
+    def __init__(self, hub: WatchHub, session: Session, sink: Sink) -> None:
+        self.hub = hub
+        self.session = session
+        self.sink = sink
+        self.active = False
+        self.period_s = 0.0
+        self.robot = ""
+        self.paused = False
+        self.used = False
+        """This connection has watched: its write buffer may hold stream lines."""
+        self._q: tuple[float, ...] | None = None  # the pending state [rad or m]
+        self._t = 0.0  # its clock time [s]
+        self._seq = 0  # its place among the events
+        self._last_t = -math.inf  # clock time of the last state line [s]
+        self._events: deque[tuple[int, str]] = deque()
+        self._dropped = 0
+        self._handle: asyncio.Handle | asyncio.TimerHandle | None = None
+
+    def start(self, hz: float) -> None:
+        """Stream at most ``hz`` states a second [1/s], beginning with the state now."""
+        self.period_s = 1.0 / hz
+        self.robot = self.session.state.name
+        if not self.used:
+            self.used = True
+            transport = self.sink.transport
+            if transport is not None:
+                transport.set_write_buffer_limits(high=STREAM_HIGH_BYTES)
+        self.active = True
+        self.state(self.session.now(), self.hub.world.clock(), self.hub.next_seq())
+
+    def stop(self) -> None:
+        """Write nothing more (what is held is dropped)."""
+        self.active = False
+        self._q = None
+        self._events.clear()
+        self._dropped = 0
+        self._last_t = -math.inf
+        if self._handle is not None:
+            self._handle.cancel()
+            self._handle = None
+
+    # What the hub hands over.
+
+    def state(self, q: tuple[float, ...], t: float, seq: int) -> None:
+        self._q = q
+        self._t = t
+        self._seq = seq
+        if self._handle is None and not self.paused:
+            self._handle = asyncio.get_running_loop().call_soon(self._flush)
+
+    def event(self, text: str, seq: int) -> None:
+        events = self._events
+        if len(events) >= MAX_EVENTS:
+            events.popleft()
+            self._dropped += 1
+        events.append((seq, text))
+        if self._handle is None and not self.paused:
+            self._handle = asyncio.get_running_loop().call_soon(self._flush)
+
+    # Write flow control (forwarded by the connection).
+
+    def pause(self) -> None:
+        self.paused = True
+        if self._handle is not None:
+            self._handle.cancel()
+            self._handle = None
+
+    def resume(self) -> None:
+        self.paused = False
+        if self.active and self._handle is None and (self._q is not None or self._events):
+            self._handle = asyncio.get_running_loop().call_soon(self._flush)
+
+    def _flush(self) -> None:
+        """Write the events, and the state when one is due; come back when the next is."""
+        self._handle = None
+        sink = self.sink
+        transport = sink.transport
+        if not self.active or self.paused or sink.closing or transport is None:
+            return
+        if transport.is_closing():
+            return
+        lines = []
+        if self._dropped:
+            lines.append(f"event dropped {self._dropped}")
+            self._dropped = 0
+        events = self._events
+        q = self._q
+        while events and (q is None or events[0][0] < self._seq):
+            lines.append(events.popleft()[1])
+        if q is not None:
+            now = self.hub.world.clock()
+            due = self._last_t + self.period_s
+            if now >= due:
+                t = max(self._t, due)  # the state is the latest: the arm showed it at t
+                values = replies.numbers(self.session.from_si(q))
+                lines.append(f"state {t - self.hub.origin:.6f} {values}")
+                self._last_t = t
+                self._q = None
+                while events:
+                    lines.append(events.popleft()[1])
+            else:
+                loop = asyncio.get_running_loop()
+                self._handle = loop.call_later(due - now, self._flush)
+        if lines:
+            lines.append("")
+            transport.write("\n".join(lines).encode())
+
+
+_HUBS: weakref.WeakKeyDictionary[World, WatchHub] = weakref.WeakKeyDictionary()
+
+
+class WatchHub(Observer):
+    """The streams of one world, and the observer that feeds them."""
+
+    def __init__(self, world: World) -> None:
+        self.world = world
+        self.origin = world.clock()
+        """Clock time [s] that ``state`` lines count from (the server's start)."""
+        self.streams: dict[Session, WatchStream] = {}
+        self.active: list[WatchStream] = []
+        self._seq = 0
+        self._moving: set[str] = set()  # robots seen travelling at their last state
+
+    @classmethod
+    def of(cls, world: World) -> WatchHub:
+        """The hub of ``world`` (made on first use; the server makes it as it starts)."""
+        hub = _HUBS.get(world)
+        if hub is None:
+            hub = _HUBS[world] = cls(world)
+        return hub
+
+    @property
+    def default_hz(self) -> float:
+        """The frame rate [1/s]: a watcher's default."""
+        return 1.0 / self.world.travels.frame_s
+
+    def next_seq(self) -> int:
+        self._seq += 1
+        return self._seq
+
+    # Connections.
+
+    def open(self, session: Session, sink: Sink) -> WatchStream:
+        """The (idle) stream of a new connection."""
+        stream = self.streams[session] = WatchStream(self, session, sink)
+        return stream
+
+    def close(self, session: Session) -> None:
+        """The connection is gone."""
+        stream = self.streams.pop(session, None)
+        if stream is not None:
+            self._deactivate(stream)
+
+    def watch(self, session: Session, hz: float | None) -> None:
+        """Start (or re-rate) ``session``'s stream.
+
+        Raises:
+            NotAConnection: the session has no connection (the page).
+        """
+        stream = self.streams.get(session)
+        if stream is None:
+            raise NotAConnection(session.source)
+        stream.start(self.default_hz if hz is None else hz)
+        if stream not in self.active:
+            if not self.active:
+                self._moving.clear()
+                self.world.add_observers([self])
+            self.active.append(stream)
+
+    def unwatch(self, session: Session) -> bool:
+        """Stop ``session``'s stream; False if it was not watching."""
+        stream = self.streams.get(session)
+        if stream is None or not stream.active:
+            return False
+        self._deactivate(stream)
+        return True
+
+    def _deactivate(self, stream: WatchStream) -> None:
+        stream.stop()
+        if stream in self.active:
+            self.active.remove(stream)
+            if not self.active:
+                self.world.remove_observer(self)
+
+    def event(self, text: str, robot: str | None = None) -> None:
+        """Tell every watcher (of ``robot``, or all) ``event TEXT``."""
+        seq = self.next_seq()
+        line = f"event {text}"
+        for stream in self.active:
+            if robot is None or stream.robot == robot:
+                stream.event(line, seq)
+
+    # The world's effects.
+
+    def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
+        self._seq = seq = self._seq + 1  # on every command of a flood: kept lean
+        values = q if q.__class__ is tuple else tuple(q)
+        for stream in self.active:
+            if stream.robot == robot:
+                stream.state(values, t, seq)
+        travel = self.world.robots[robot].travel
+        if travel.active:
+            if robot not in self._moving:
+                self._moving.add(robot)
+        elif self._moving and robot in self._moving:
+            self._moving.discard(robot)
+            if travel.synced:  # it came to rest (not cut short by an instant command)
+                self.event("stopped" if travel.stopping else "arrived", robot)
+
+    def on_marker(self, robot: str, marker: Marker) -> None:
+        seq = self.next_seq()
+        state = self.world.robots[robot]
+        base = state.origin * state.robot.base_placement
+        w, x, y, z = marker.wxyz
+        rotation = pin.Quaternion(w, x, y, z).toRotationMatrix()
+        placement = base.actInv(pin.SE3(rotation, np.array(marker.position)))
+        rpy = pin.rpy.matrixToRpy(placement.rotation)
+        rgb = replies.numbers(marker.rgb)
+        for stream in self.active:
+            if stream.robot == robot:
+                angle = stream.session.angle_scale
+                pose = replies.numbers([*placement.translation, *(rpy / angle)])
+                stream.event(f"event marker {pose} {marker.shape} {rgb}", seq)
+
+    def on_clear_markers(self, robot: str) -> None:
+        self.event("clear", robot)
+
+    def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
+        self.event(f"collision {replies.pairs(pairs)}", robot)

@@ -1,0 +1,23 @@
+"""The verbs of the command language, one module per family.
+
+Importing this package registers every verb in ``registry.VERBS``, in the order
+``help`` lists them: the order of the imports below (kept out of isort's reach).
+"""
+
+# isort: off
+from . import joints, markers, queries, connection  # the seed's verbs
+from . import cartesian, cell, motion, observe, record, workcell
+# isort: on
+
+__all__ = [
+    "cartesian",
+    "cell",
+    "connection",
+    "joints",
+    "markers",
+    "motion",
+    "observe",
+    "queries",
+    "record",
+    "workcell",
+]

@@ -1,0 +1,74 @@
+"""Verbs that show what happens: the ``watch`` stream and the tool's ``trail``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ...errors import BadArguments, shown
+from ..grammar import numbers_arg, one_word
+from ..registry import usage, verb
+
+__all__ = ["MAX_WATCH_HZ", "TRAIL_ACTIONS", "Trail", "Unwatch", "Watch"]
+
+MAX_WATCH_HZ = 1000.0
+"""Most ``state`` lines a second a watcher may ask for (the highest frame rate)."""
+TRAIL_ACTIONS = ("on", "off", "clear")
+
+
+@verb(
+    "watch",
+    "[HZ]",
+    "this connection also receives `state T v0,...,vn-1` lines (T: seconds since the server "
+    "started; values in the connection's units) when the arm moves, at most HZ a second "
+    "(default: the frame rate), and `event ...` lines (`event marker ...`, `event clear`, "
+    "`event arrived`, `event stopped`, `event collision PAIRS` (or `none`, once collisions "
+    "are checked), `event record-stopped ...`, `event dropped N`); "
+    "replies still come one line each, in order",
+)
+@dataclass(frozen=True, slots=True)
+class Watch:
+    """Stream the arm's state to this connection, at most ``hz`` lines a second (None: the
+    frame rate)."""
+
+    hz: float | None
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> Watch:
+        if not words:
+            return Watch(None)
+        (hz,) = numbers_arg(verb, words, 1)
+        if not 0 < hz <= MAX_WATCH_HZ:
+            raise BadArguments(
+                verb, f"HZ must be above 0 and at most {MAX_WATCH_HZ:g}, got {hz:g}", usage(verb)
+            )
+        return Watch(hz)
+
+
+@verb("unwatch", "", "stop this connection's `watch` stream")
+@dataclass(frozen=True, slots=True)
+class Unwatch:
+    """Stop the stream."""
+
+
+@verb(
+    "trail",
+    "[on|off|clear]",
+    "a line following the tool point as the arm moves: `on` starts a fresh one, `off` "
+    "removes it, `clear` empties it; alone, reply `ok on N` (its points) or `ok off`",
+)
+@dataclass(frozen=True, slots=True)
+class Trail:
+    """Turn the trail of this connection's robot on, off, clear it, or (None) ask."""
+
+    action: str | None
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> Trail:
+        if not words:
+            return Trail(None)
+        action = one_word(verb, words).lower()
+        if action not in TRAIL_ACTIONS:
+            raise BadArguments(
+                verb, f"unknown action {shown(action)}; choose on, off or clear", usage(verb)
+            )
+        return Trail(action)

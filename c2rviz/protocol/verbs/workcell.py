@@ -1,0 +1,118 @@
+"""Workcell verbs: objects around the robot, collisions now, and guarded commands."""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ...errors import BadArguments, shown
+from ..grammar import count, numbers, one_word
+from ..registry import usage, verb
+
+__all__ = ["Collisions", "Guard", "ObjectEdit", "Objects"]
+
+_NAME = re.compile(r"[A-Za-z0-9_.-]+")
+# shape -> (how many size values, whether the pose has an orientation)
+_SHAPES = {"box": (3, True), "sphere": (1, False), "cylinder": (2, True)}
+
+
+@dataclass(frozen=True, slots=True)
+class ObjectEdit:
+    """Add or replace object ``name`` (size [m]; pose x, y, z [m], roll, pitch, yaw [client's
+    angle unit]) in the robot's base frame; shape ``remove`` removes it (``all``: every one)."""
+
+    name: str
+    shape: str
+    size: tuple[float, ...] = ()
+    pose: tuple[float, float, float, float, float, float] = (0.0,) * 6
+
+
+def _parse_object(verb: str, words: list[str]) -> ObjectEdit:
+    if len(words) < 2:
+        raise BadArguments(verb, "needs a name and a shape (or remove)", usage(verb))
+    name, kind = words[0], words[1].lower()
+    if _NAME.fullmatch(name) is None or len(name) > 64:
+        raise BadArguments(
+            verb, f"bad object name {shown(name)}: use letters, digits, _ . -", usage(verb)
+        )
+    if kind == "remove":
+        if len(words) != 2:
+            raise BadArguments(verb, "remove takes nothing more", usage(verb))
+        return ObjectEdit(name, "remove")
+    if name == "all":
+        raise BadArguments(verb, "'all' is not an object name (all remove clears)", usage(verb))
+    if kind not in _SHAPES and len(words) > 2 and words[2].lower() in (*_SHAPES, "remove"):
+        raise BadArguments(
+            verb,
+            f"bad object name {shown(' '.join(words[:2]))}: one word, no spaces "
+            "(letters, digits, _ . -)",
+            usage(verb),
+        )
+    if kind not in _SHAPES:
+        raise BadArguments(
+            verb,
+            f"unknown shape {shown(kind)}; choose box, sphere or cylinder "
+            "(meshes come from the ini only)",
+            usage(verb),
+        )
+    sizes, oriented = _SHAPES[kind]
+    if len(words) != 4:
+        raise BadArguments(verb, f"{kind} takes a size and a pose", usage(verb))
+    size = count(verb, numbers(verb, words[2]), sizes)
+    for value in size:
+        if value <= 0:
+            raise BadArguments(verb, f"size {value:g} must be > 0", usage(verb))
+    pose = numbers(verb, words[3])
+    if not oriented and len(pose) == 3:
+        pose = (*pose, 0.0, 0.0, 0.0)
+    x, y, z, roll, pitch, yaw = count(verb, pose, 6)
+    return ObjectEdit(name, kind, size, (x, y, z, roll, pitch, yaw))
+
+
+verb(
+    "object",
+    "NAME box sx,sy,sz x,y,z,roll,pitch,yaw | NAME sphere r x,y,z | "
+    "NAME cylinder r,length x,y,z,roll,pitch,yaw | NAME remove | all remove",
+    "add or replace a workcell object in the base frame (metres; angles in the "
+    "connection's unit; a cylinder along its z axis), or remove one or all",
+    parse=_parse_object,
+)(ObjectEdit)
+
+
+@verb("objects", "", "reply the workcell objects' names: `ok table,fixture` (or `ok none`)")
+@dataclass(frozen=True, slots=True)
+class Objects:
+    """Ask for the objects' names."""
+
+
+@verb(
+    "collisions",
+    "",
+    "reply the colliding pairs now: `ok none`, or `ok link_t~table,link_b~link_s`",
+)
+@dataclass(frozen=True, slots=True)
+class Collisions:
+    """Ask which pairs collide now."""
+
+
+@verb(
+    "guard",
+    "[on|off]",
+    "with `guard on` this connection's commands whose target, or any point of a move's path, "
+    "collides are refused (`error: link_t would hit table at 40% of the move`); `rand` "
+    "draws a free configuration; alone, reply it",
+)
+@dataclass(frozen=True, slots=True)
+class Guard:
+    """Set (or, with None, ask) whether this connection's commands are guarded."""
+
+    on: bool | None
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> Guard:
+        if not words:
+            return Guard(None)
+        word = one_word(verb, words).lower()
+        if word not in ("on", "off"):
+            raise BadArguments(verb, f"{shown(word)} is neither on nor off", usage(verb))
+        return Guard(word == "on")

@@ -1,0 +1,260 @@
+"""One source's session: its robot, unit mode and marker style — the one way in.
+
+Every change of the world comes through a ``Session``: a TCP connection has
+one, so does the page, so does a replay. ``run(line)`` parses a line and
+executes it; ``execute(command)`` runs an already parsed one through its
+handler (``registry.HANDLERS``). This is the unit boundary: sources speak
+degrees or radians (metres for prismatic joints, always); everything past the
+session is SI. A handler checks a command whole before the world changes, so a
+bad command never moves the robot partly.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import itertools
+import math
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass
+from operator import le, mul
+
+from ..app.config import ServerLimits
+from ..collision.model import segment
+from ..collision.other_robots import first_hit_between
+from ..errors import C2rvizError, JointLimitError, PathCollides
+from ..protocol import replies
+from ..protocol.grammar import parse_line
+from ..protocol.registry import HANDLERS, Reply
+from ..robot.model import Robot
+from ..tolerance import within_limit
+from ..world.world import RobotState, World
+
+__all__ = ["Session", "UnitTable"]
+
+_NUMBER_CHARS = re.compile(r"[0-9.,eE+-]*")  # as commands.numbers lets float() judge them
+_CADENCE_S = 0.02  # a pause this soon after the previous one's end continues its cadence
+
+
+@dataclass(frozen=True, slots=True)
+class UnitTable:
+    """The chain's limits in one unit mode, and the factor from it to SI.
+
+    Attributes:
+        scale: Per joint, SI value = client value * scale.
+        lower, upper: Limits in client units.
+        unit: Per joint, ``deg``, ``rad`` or ``m``.
+        identity: Every scale is 1 (radians and metres): client values are SI as they are.
+    """
+
+    scale: tuple[float, ...]
+    lower: tuple[float, ...]
+    upper: tuple[float, ...]
+    unit: tuple[str, ...]
+    identity: bool
+
+    @classmethod
+    def build(cls, robot: Robot, degrees: bool) -> UnitTable:
+        angle = math.pi / 180.0 if degrees else 1.0
+        scale = tuple(1.0 if p else angle for p in robot.prismatic)
+        angle_unit = "deg" if degrees else "rad"
+        return cls(
+            scale=scale,
+            lower=tuple(lo / s for lo, s in zip(robot.lower, scale)),
+            upper=tuple(hi / s for hi, s in zip(robot.upper, scale)),
+            unit=tuple("m" if p else angle_unit for p in robot.prismatic),
+            identity=all(s == 1.0 for s in scale),
+        )
+
+
+class Session:
+    """Applies one source's commands to the shared world.
+
+    Attributes:
+        source: Who speaks (``tcp 127.0.0.1:5123``, ``page``), for notes and errors.
+        motion: ``off``, ``on`` or ``follow`` (``lang.motion.MOTION_MODES``).
+        speed: Moves at this % of the joints' limits.
+        guard: Refuse commands whose target or path collides.
+        lspeed: ``movel``'s tool speed [m/s].
+        hangup: Set by a handler to ``"bye"`` or ``"quit"``: the connection closes
+            after this reply (and for ``quit`` stops the program).
+    """
+
+    def __init__(
+        self,
+        world: World,
+        source: str = "tcp",
+        limits: ServerLimits | None = None,
+        robot: str | None = None,
+    ) -> None:
+        self.world = world
+        self.source = source
+        self.limits = limits if limits is not None else ServerLimits()
+        self.degrees = False
+        self.rgb: tuple[float, float, float] = (1.0, 0.0, 0.0)
+        self.shape = "sphere"
+        self.hangup: str | None = None
+        self._pause_end = -math.inf  # when the latest `after` was due [loop time, s]
+        self.motion = world.defaults.motion
+        self.speed = world.defaults.speed
+        self.guard = world.defaults.guard
+        self.lspeed = world.defaults.lspeed
+        self.select(robot)
+
+    def select(self, name: str | None) -> None:
+        """Drive robot ``name`` from now on (None: the world's default robot).
+
+        Raises:
+            UnknownRobot: naming the robots there are; nothing changes.
+        """
+        self.state: RobotState = self.world.state(name)
+        self.robot = self.state.robot
+        self.n = self.robot.n  # Robot.n is a property; this is read per command
+        self._tables = (UnitTable.build(self.robot, False), UnitTable.build(self.robot, True))
+        self.table = self._tables[self.degrees]
+
+    def go(self, q: Sequence[float]) -> Reply:
+        """Send this session's robot to ``q`` [rad or m, checked]: at once (``motion off``),
+        or travelling (``on``: the reply comes on arrival; ``follow``: ``ok`` now)."""
+        if self.guard:
+            self.check_path(q)
+        if self.motion == "off":
+            self.world.set_q(q, self.state.name, self.source)
+            return replies.OK
+        arrival = self.world.travels.go(
+            self.state, q, self.speed / 100.0, self.source, wait=self.motion == "on"
+        )
+        return replies.OK if arrival is None else arrival
+
+    def check_path(self, q: Sequence[float], path: Sequence[Sequence[float]] = ()) -> None:
+        """Refuse ``q`` if it collides, or if any point of the way there does (``path``,
+        else the straight joint-space segment from where the arm is now): with itself,
+        its objects, and the other robots of the world as they stand.
+
+        Raises:
+            PathCollides: naming the pair and how far along the move.
+        """
+        model = self.world.collision_model(self.state.name)
+        at_target = self.motion == "off" and not path
+        if at_target:
+            points: Sequence[Sequence[float]] = [q]
+        else:
+            points = path or segment(self.robot, self.now(), q)
+        found = model.first_collision(points)
+        if found is None and len(self.world.robots) > 1:
+            found = first_hit_between(self.world, self.state.name, points)
+        if found is not None:
+            index, (first, second) = found
+            raise PathCollides(first, second, index / max(len(points) - 1, 1), at_target)
+
+    def joints_run(self, texts: Sequence[str]) -> bool:
+        """A run of ``joints`` lines (their value lists) checked as one: with ``motion off``
+        and no guard, if every line has n values within the limits, only the last is
+        applied (the ones before would be shown for no time at all) and True is returned;
+        else False, and nothing changed: the lines are then run one by one, so every
+        reply and error is exactly as if they had been."""
+        if self.motion != "off" or self.guard:
+            return False
+        commas = self.n - 1
+        joined = ",".join(texts)
+        if _NUMBER_CHARS.fullmatch(joined) is None or any(t.count(",") != commas for t in texts):
+            return False
+        try:
+            flat = list(map(float, joined.split(",")))
+        except ValueError:
+            return False  # an empty or malformed value: its line says which
+        table = self.table
+        if not (
+            math.isfinite(sum(flat))
+            and all(map(le, itertools.cycle(table.lower), flat))
+            and all(map(le, flat, itertools.cycle(table.upper)))
+        ):
+            return False
+        last = flat[-self.n :]
+        self.world.set_q(
+            last if table.identity else list(map(mul, last, table.scale)),
+            self.state.name,
+            self.source,
+        )
+        return True
+
+    def now(self) -> tuple[float, ...]:
+        """The robot's joints at this instant [rad or m] (mid-move too)."""
+        state = self.state
+        return self.world.travels.now(state) if state.travel.active else state.q
+
+    def set_degrees(self, degrees: bool) -> None:
+        self.degrees = degrees
+        self.table = self._tables[degrees]
+
+    @property
+    def angle_scale(self) -> float:
+        """SI angle = client angle * this (for poses)."""
+        return math.pi / 180.0 if self.degrees else 1.0
+
+    def execute(self, command: object) -> Reply:
+        """Run ``command``; return its reply (or an awaitable of it), or raise a
+        ``C2rvizError`` having changed nothing."""
+        return HANDLERS[command.__class__](self, command)
+
+    def run(self, line: str) -> Reply | None:
+        """Parse and run one line (None for a blank or comment line), noting it in the
+        world as accepted or refused."""
+        try:
+            command = parse_line(line)
+            if command is None:
+                return None
+            reply = HANDLERS[command.__class__](self, command)
+        except C2rvizError:
+            self.world.note(self.source, line, False)
+            raise
+        self.world.note(self.source, line, True)
+        return reply
+
+    def after(self, seconds: float, reply: str) -> asyncio.Future[str]:
+        """A reply that comes ``seconds`` [s] from now (on the running loop).
+
+        A pause that follows the previous one at once (within ``_CADENCE_S``: the
+        source went straight on, as a played script does between ``sleep`` lines)
+        counts from that one's end, so a timer that fires a little late does not
+        make a replay drift: ``sleep`` keeps a script's cadence.
+        """
+        loop = asyncio.get_running_loop()
+        now = loop.time()
+        start = self._pause_end if 0.0 <= now - self._pause_end <= _CADENCE_S else now
+        self._pause_end = start + seconds
+        future: asyncio.Future[str] = loop.create_future()
+        timer = loop.call_at(self._pause_end, _settle, future, reply)
+        future.add_done_callback(lambda _: timer.cancel())
+        return future
+
+    # The unit boundary.
+
+    def to_si(self, indices: Sequence[int], values: Sequence[float]) -> list[float]:
+        """Check ``values`` (client units) against the limits; return them in SI.
+
+        Raises:
+            JointLimitError: naming the first joint out of its limits.
+        """
+        table = self.table
+        robot = self.robot
+        out = []
+        for i, value in zip(indices, values):
+            lower = table.lower[i]
+            upper = table.upper[i]
+            if lower <= value <= upper:
+                out.append(value * table.scale[i])
+            elif within_limit(value, lower, upper):  # a rounding error past it: at the limit
+                out.append(robot.lower[i] if value < lower else robot.upper[i])
+            else:
+                raise JointLimitError(robot.joint_names[i], i, value, lower, upper, table.unit[i])
+        return out
+
+    def from_si(self, values: Sequence[float]) -> list[float]:
+        """Chain values in this source's units."""
+        return [v / s for v, s in zip(values, self.table.scale)]
+
+
+def _settle(future: asyncio.Future[str], reply: str) -> None:
+    if not future.done():
+        future.set_result(reply)

@@ -1,0 +1,463 @@
+"""The TCP side: an asyncio line server in front of the shared world.
+
+Each connection is an ``asyncio.Protocol``: it splits what arrives into lines,
+runs every complete line through its ``Session`` (the one way in), and answers
+all lines of one read (up to ``_BATCH_BYTES`` of them: a big read is run in
+batches, one loop turn each) with one write. A turn also ends after
+``TURN_S`` of work, so a flood of costly lines (a ``mark`` computes forward
+kinematics) delays the other clients no more than a flood of cheap ones.
+Nothing here knows kinematics or drawing. The limits in ``config.ServerLimits``
+bound what one client can cost; a client that breaks one is told why and
+closed, and no other client notices.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import itertools
+import logging
+import time
+from collections.abc import Awaitable, Callable
+from itertools import chain
+
+from ..app.config import ServerLimits
+from ..errors import C2rvizError, LineError, LineTooLong
+from ..observers.watch import STREAM_ALLOWANCE_BYTES, WatchHub
+from ..protocol import replies
+from ..protocol.grammar import ForeignProtocol, parse_line
+from ..protocol.registry import VERBS
+from ..session.session import Session
+from ..world.world import World
+
+__all__ = ["CommandServer", "Connection"]
+
+log = logging.getLogger("c2rviz.server")
+
+Line = str | C2rvizError  # a decoded line, or why it could not be one
+
+
+class Connection(asyncio.Protocol):
+    """One TCP client: its buffer, its session and its timers.
+
+    Lines run in order. A reply that waits (an awaitable from the handler, such as
+    ``sleep``'s) stops reading: the lines read behind it wait in ``backlog`` and run
+    when it comes, while other connections go on.
+    """
+
+    def __init__(self, server: CommandServer) -> None:
+        self.server = server
+        self.limits = server.limits
+        self.session = Session(server.world, limits=server.limits, robot=server.robot)
+        self.transport: asyncio.Transport | None = None
+        self.peer = "?"
+        self.buffer = b""
+        self.backlog: list[Line] = []  # lines read but waiting behind a reply
+        self.pending: asyncio.Future[str] | None = None  # the reply being waited for
+        self.yield_timer: asyncio.Handle | None = None  # set while yielding to other clients
+        self.partial_timer: asyncio.TimerHandle | None = None
+        self.linger_timer: asyncio.TimerHandle | None = None
+        self.closing = False
+        self.eof = False
+        self.closed = asyncio.get_running_loop().create_future()
+        self.stream = server.watch.open(self.session, self)  # idle until `watch`
+
+    @property
+    def waiting(self) -> bool:
+        """Reading is paused: behind a reply, or yielding to the other clients."""
+        return self.pending is not None or self.yield_timer is not None
+
+    # asyncio callbacks
+
+    def connection_made(self, transport: asyncio.BaseTransport) -> None:
+        assert isinstance(transport, asyncio.Transport)
+        self.transport = transport
+        peer = transport.get_extra_info("peername")
+        self.peer = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
+        self.session.source = f"tcp {self.peer}"
+        server = self.server
+        server.open.add(self)
+        if server.stopping:
+            self._close_with(replies.SHUTTING_DOWN)
+        elif len(server.connections) >= self.limits.max_clients:
+            log.warning("refused %s: %d clients already", self.peer, len(server.connections))
+            self._close_with(replies.too_many_clients(self.limits.max_clients))
+        else:
+            server.connections.add(self)
+            server.world.set_client_count(len(server.connections))
+            log.info("client %s connected", self.peer)
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        self._cancel_timers()
+        self.closing = True
+        self.server.watch.close(self.session)
+        if self.pending is not None:
+            self.pending.cancel()
+        server = self.server
+        server.open.discard(self)
+        if self in server.connections:
+            server.connections.discard(self)
+            server.world.set_client_count(len(server.connections))
+            log.info("client %s left", self.peer)
+        if not self.closed.done():
+            self.closed.set_result(None)
+
+    def data_received(self, data: bytes) -> None:
+        if self.closing:
+            return
+        buffer = self.buffer + data if self.buffer else data
+        if self.waiting:
+            self.buffer = buffer  # reading is paused; the wake-up goes on from here
+            return
+        self._consume(buffer)
+
+    def eof_received(self) -> bool:
+        self.eof = True
+        if self.closing:
+            return False  # done lingering: asyncio closes the transport
+        if not self.waiting:
+            self._close()
+        return True  # keep the write side open until the replies are out
+
+    # The watch stream (c2rviz.watch) writes only while the write buffer is low.
+
+    def pause_writing(self) -> None:
+        self.stream.pause()
+
+    def resume_writing(self) -> None:
+        self.stream.resume()
+
+    # line handling
+
+    def _consume(self, buffer: bytes) -> None:
+        """Run the complete lines in ``buffer``, one batch of them; keep the rest."""
+        cut = buffer.rfind(b"\n", 0, _BATCH_BYTES)
+        if cut < 0:
+            cut = buffer.find(b"\n")  # the first line is longer than a batch
+        if cut >= 0:
+            self.buffer = buffer[cut + 1 :]
+            if self.partial_timer is not None:  # the line it timed is finished
+                self.partial_timer.cancel()
+                self.partial_timer = None
+            self._run(self._decode(buffer[:cut]))
+        else:
+            self.buffer = buffer
+        if self.closing or self.waiting:
+            return  # while paused we do not read, so an unfinished line is not the client's fault
+        if b"\n" in self.buffer:  # more complete lines: let the other clients in first
+            self._yield([])
+        elif len(self.buffer) > self.limits.max_line:
+            self._close_with(replies.error(LineTooLong(self.limits.max_line)))
+        elif self.buffer and self.partial_timer is None:
+            self.partial_timer = asyncio.get_running_loop().call_later(
+                self.limits.partial_timeout_s, self._partial_timeout
+            )
+
+    def _decode(self, complete: bytes) -> list[Line]:
+        """Split complete lines; mark the undecodable and the over-long ones."""
+        max_line = self.limits.max_line
+        if complete.isascii():  # the usual case: one decode and one split for the batch
+            split = complete.decode("ascii").split("\n")
+            if len(complete) <= max_line or max(map(len, split)) <= max_line:
+                return split  # type: ignore[return-value]
+        elif len(complete) <= max_line:
+            try:
+                return complete.decode().split("\n")  # type: ignore[return-value]
+            except UnicodeDecodeError:
+                pass
+        lines: list[Line] = []
+        for raw in complete.split(b"\n"):
+            if len(raw) > max_line:
+                lines.append(LineTooLong(max_line))
+                break  # the connection closes here; nothing after it runs
+            try:
+                lines.append(raw.decode())
+            except UnicodeDecodeError:
+                lines.append(LineError(replies.NOT_UTF8))
+        return lines
+
+    def _run(self, lines: list[Line]) -> None:
+        """Answer ``lines`` in order, stopping at a reply that waits, bye, quit or a fatal line,
+        or after ``TURN_S`` of work (the rest runs after the other clients' turns)."""
+        out: list[str] = []
+        reply = out.append
+        run = self.session.run
+        session = self.session
+        skip_to = 0
+        started = time.perf_counter()
+        for i, line in enumerate(lines):
+            if i < skip_to:
+                continue  # answered as part of a run of plain `joints` lines
+            if i % _TURN_CHECK == _TURN_CHECK - 1 and time.perf_counter() - started > TURN_S:
+                self._write(out)
+                self._yield(lines[i:])
+                return
+            if line.__class__ is str and line.startswith(_PLAIN_JOINTS):
+                skip_to = self._joints_run(lines, i, out)
+                if skip_to > i:
+                    continue
+            try:
+                if line.__class__ is not str:
+                    raise line  # type: ignore[misc]
+                answer = run(line)  # type: ignore[arg-type]
+                if answer is None:
+                    continue
+                if answer.__class__ is not str:  # a reply that waits
+                    self._write(out)
+                    self._wait(answer, lines[i + 1 :])  # type: ignore[arg-type]
+                    return
+                reply(answer)  # type: ignore[arg-type]
+                if session.hangup is not None:
+                    self._write(out)
+                    self._hang_up(lines[i + 1 :])
+                    return
+            except ForeignProtocol:  # a browser, most likely: an HTTP answer it can show
+                self._write(out)
+                if not self.closing and self.transport is not None:
+                    self.transport.write(replies.not_http(self.server.viewer_url))
+                self._close()  # the rest of the request (its headers, a body) never runs
+                return
+            except LineTooLong as exc:
+                out.append(replies.error(exc))
+                self._write(out)
+                self._close()
+                return
+            except C2rvizError as exc:
+                reply(replies.error(exc))
+            except Exception:  # a bug must cost one reply, never the server
+                log.exception("internal error on %r from %s", line, self.peer)
+                reply(replies.error("internal error (see the server log)"))
+        self._write(out)
+
+    def _joints_run(self, lines: list[Line], start: int, out: list[str]) -> int:
+        """Answer the run of plain ``joints`` lines from ``start`` as a batch, if it checks
+        whole (``Session.joints_run``); return where the run ends (``start``: not taken)."""
+        end = start
+        texts = []
+        for line in itertools.islice(lines, start, None):
+            if line.__class__ is not str or not line.startswith(_PLAIN_JOINTS):  # type: ignore[union-attr]
+                break
+            text = line[line.index(" ") + 1 :]  # type: ignore[union-attr]
+            texts.append(text[:-1] if text.endswith("\r") else text)
+            end += 1
+        if end - start < 2 or not self.session.joints_run(texts):
+            return start
+        note = self.server.world.note
+        source = self.session.source
+        for line in itertools.islice(lines, start, end):
+            note(source, line, True)  # type: ignore[arg-type]
+        out.extend([replies.OK] * (end - start))
+        return end
+
+    def _hang_up(self, rest: list[Line]) -> None:
+        """After ``bye`` or ``quit``: close (``quit`` also stops the program)."""
+        if self.session.hangup == "quit":
+            self._write([replies.SHUTTING_DOWN] * self._unanswered(rest))
+            self.server.request_quit()  # before the close: a client seeing EOF sees it done
+        self._close()
+
+    def _wait(self, answer: Awaitable[str], rest: list[Line]) -> None:
+        """Stop reading until ``answer`` is ready; then reply and run ``rest``."""
+        self.backlog = rest
+        self._pause_reading()
+        pending = asyncio.ensure_future(answer)
+        self.pending = pending
+        pending.add_done_callback(self._answered)
+
+    def _answered(self, pending: asyncio.Future[str]) -> None:
+        if pending is not self.pending:
+            return
+        self.pending = None
+        if self.closing:
+            return
+        if pending.cancelled():
+            text = replies.SHUTTING_DOWN
+        elif isinstance(pending.exception(), C2rvizError):
+            text = replies.error(pending.exception())
+        elif pending.exception() is not None:
+            log.error("internal error from %s", self.peer, exc_info=pending.exception())
+            text = replies.error("internal error (see the server log)")
+        else:
+            text = pending.result()
+        self._write([text])
+        self._go_on()
+
+    def _yield(self, rest: list[Line]) -> None:
+        """Stop reading for a loop turn, so the other clients go first; then run ``rest``."""
+        self.backlog = rest
+        self._pause_reading()
+        self.yield_timer = asyncio.get_running_loop().call_soon(self._yielded)
+
+    def _yielded(self) -> None:
+        self.yield_timer = None
+        if not self.closing:
+            self._go_on()
+
+    def _go_on(self) -> None:
+        """Run the lines that waited, then what is buffered; resume reading when done."""
+        backlog, self.backlog = self.backlog, []
+        self._run(backlog)
+        if self.closing or self.waiting:
+            return
+        buffer, self.buffer = self.buffer, b""
+        self._consume(buffer)
+        if self.closing or self.waiting:
+            return
+        if self.eof:
+            self._close()
+        elif self.transport is not None:
+            self.transport.resume_reading()
+
+    def _pause_reading(self) -> None:
+        assert self.transport is not None
+        self.transport.pause_reading()
+
+    def _partial_timeout(self) -> None:
+        self.partial_timer = None
+        if self.buffer and not self.closing:
+            self._close_with(replies.incomplete_line(self.limits.partial_timeout_s))
+
+    # output and closing
+
+    def _write(self, out: list[str]) -> None:
+        if not out or self.closing or self.transport is None or self.transport.is_closing():
+            return
+        self.transport.write(("\n".join(out) + "\n").encode())
+        unread = self.transport.get_write_buffer_size()
+        if unread > self.limits.max_unread + (STREAM_ALLOWANCE_BYTES if self.stream.used else 0):
+            log.warning("closing %s: %d bytes of replies unread", self.peer, unread)
+            self.closing = True
+            self.transport.abort()
+
+    def _close_with(self, text: str) -> None:
+        self._write([text])
+        self._close()
+
+    def _close(self) -> None:
+        """Send what is queued, then close.
+
+        A socket closed with input still unread sends RST, and RST throws away
+        replies not yet delivered. So unless the client has finished sending, we
+        half-close (FIN after the replies) and read and drop its input until it
+        closes too, for at most ``_LINGER_S``.
+        """
+        self.closing = True
+        self.buffer = b""
+        self._cancel_timers()
+        transport = self.transport
+        if transport is None or transport.is_closing():
+            return
+        if self.eof:
+            transport.close()  # nothing more will come: nothing to linger for
+            return
+        transport.write_eof()
+        transport.resume_reading()
+        self.linger_timer = asyncio.get_running_loop().call_later(_LINGER_S, transport.abort)
+
+    def _cancel_timers(self) -> None:
+        for timer in (self.yield_timer, self.partial_timer, self.linger_timer):
+            if timer is not None:
+                timer.cancel()
+        self.yield_timer = self.partial_timer = self.linger_timer = None
+
+    def shutdown(self) -> None:
+        """The program is stopping: answer what was read, then close."""
+        if self.closing:
+            return
+        waited = self.pending is not None
+        self._write([replies.SHUTTING_DOWN] * (waited + self._unanswered(self.backlog)))
+        self.backlog = []
+        if self.pending is not None:
+            self.pending.cancel()
+        self._close()
+
+    def _unanswered(self, rest: list[Line]) -> int:
+        """How many of ``rest`` and the complete lines still buffered would get a reply."""
+        cut = self.buffer.rfind(b"\n")
+        buffered = self._decode(self.buffer[:cut]) if cut >= 0 else []
+        return sum(map(_is_command, chain(rest, buffered)))
+
+
+def _is_command(line: Line) -> bool:
+    """True for a line that would get a reply (not blank, not only a comment)."""
+    if line.__class__ is not str:
+        return True
+    try:
+        return parse_line(line) is not None  # type: ignore[arg-type]
+    except C2rvizError:
+        return True
+
+
+# How a controller streaming setpoints writes them: the registry's spellings of `joints`.
+_PLAIN_JOINTS = tuple(f"{name} " for name in (VERBS["joints"].name, *VERBS["joints"].aliases))
+_BATCH_BYTES = 8192  # complete lines run per client per loop turn
+TURN_S = 0.002  # work per client per loop turn [s]: then the others go first
+_TURN_CHECK = 32  # lines between looks at the clock
+_LINGER_S = 2.0  # after the last reply, how long a closing client's input is read and dropped
+
+
+class CommandServer:
+    """Listens for TCP clients and runs each one's lines against one ``World``."""
+
+    def __init__(
+        self,
+        world: World,
+        limits: ServerLimits | None = None,
+        on_quit: Callable[[], None] | None = None,
+        robot: str | None = None,
+        viewer_url: str | None = None,
+    ) -> None:
+        """Set up the server; ``start`` makes it listen.
+
+        Args:
+            world: The shared state every client acts on.
+            limits: What one client may cost.
+            on_quit: Called once when a client sends ``quit``.
+            robot: The robot its clients drive until they say ``robot NAME`` (None:
+                the world's default).
+            viewer_url: The page's address, told to a browser that opens the
+                command port (None: no viewer). The attribute may be set later,
+                once the viewer is up.
+        """
+        self.world = world
+        self.viewer_url = viewer_url
+        self.limits = limits if limits is not None else ServerLimits()
+        self.on_quit = on_quit
+        self.robot = robot
+        self.connections: set[Connection] = set()  # the clients being served
+        self.open: set[Connection] = set()  # those and the refused ones, until their socket closes
+        self.stopping = False
+        self.quit_requested = False
+        self.watch = WatchHub.of(world)  # `watch` streams count time from here
+        self._server: asyncio.Server | None = None
+
+    async def start(self, host: str = "127.0.0.1", port: int = 0) -> tuple[str, int]:
+        """Start listening; return the address actually bound (port 0 picks one)."""
+        loop = asyncio.get_running_loop()
+        self._server = await loop.create_server(lambda: Connection(self), host, port)
+        bound = self._server.sockets[0].getsockname()
+        return bound[0], bound[1]
+
+    def request_quit(self) -> None:
+        if not self.quit_requested:
+            self.quit_requested = True
+            log.info("quit requested by a client")
+            if self.on_quit is not None:
+                self.on_quit()
+
+    async def stop(self, grace_s: float = 1.0) -> None:
+        """Stop accepting, answer and close every client, free the port."""
+        self.stopping = True
+        if self._server is not None:
+            self._server.close()
+        for connection in list(self.connections):
+            connection.shutdown()
+        if self.open:  # each gets its last replies and then closes, or is cut off
+            await asyncio.wait([c.closed for c in self.open], timeout=grace_s)
+        left = list(self.open)
+        for connection in left:
+            if connection.transport is not None:
+                connection.transport.abort()
+        if left:  # let connection_lost run, so every socket is closed when we return
+            await asyncio.wait([c.closed for c in left], timeout=1.0)
+        if self._server is not None:
+            await self._server.wait_closed()

@@ -1,0 +1,132 @@
+"""What the world hands to views and other observers: its effects, in SI units.
+
+The world calls an ``Observer``'s methods on every accepted change, on the
+asyncio thread; they must return at once (a real view stores the latest state
+and renders it on its own schedule). An observer overrides what it cares
+about; the rest are no-ops. A ``Scene`` is the observer that is a view: it also
+has a lifecycle (``start``, ``stop``) and may serve a page (``url``).
+``RecordingScene`` is the stand-in for tests, ``NullScene`` the one for running
+without a viewer (``--no-viewer``).
+"""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import pinocchio as pin
+
+    from ..collision.workcell import WorkcellObject
+    from .world import World
+
+__all__ = ["MAX_MARKERS", "Marker", "NullScene", "Observer", "RecordingScene", "Scene"]
+
+MAX_MARKERS = 1000
+"""Markers kept at once per robot; beyond it the oldest goes first, so a flood of
+``mark`` costs neither the server's memory nor the page's frame rate. Every holder
+of markers keeps them in a ``deque(maxlen=MAX_MARKERS)``."""
+
+
+@dataclass(frozen=True, slots=True)
+class Marker:
+    """A marker in the world frame (the root of the robot's model).
+
+    Attributes:
+        position: x, y, z [m].
+        wxyz: Orientation as a unit quaternion.
+        rgb: Colour, each channel 0..1.
+        shape: One of ``protocol.MARKER_SHAPES``.
+    """
+
+    position: tuple[float, float, float]
+    wxyz: tuple[float, float, float, float]
+    rgb: tuple[float, float, float]
+    shape: str
+
+
+class Observer:
+    """Receives the world's effects; every method is called on the asyncio thread."""
+
+    def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
+        """Robot ``robot``'s chain is now at ``q`` [rad or m], at clock time ``t`` [s]."""
+
+    def on_marker(self, robot: str, marker: Marker) -> None:
+        """One more marker (past ``MAX_MARKERS``, the oldest is gone)."""
+
+    def on_clear_markers(self, robot: str) -> None:
+        """Every marker of ``robot`` is gone."""
+
+    def on_clients(self, count: int) -> None:
+        """``count`` TCP clients are connected."""
+
+    def on_command(self, source: str, line: str, accepted: bool) -> None:
+        """``source`` sent ``line``; ``accepted`` False if it was refused."""
+
+    def on_tool(self, robot: str, tool: pin.SE3) -> None:
+        """``robot``'s tool point is now ``tool`` (relative to its end-effector link)."""
+
+    def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
+        """``robot``'s workcell objects are now ``objects`` (placements in its base frame)."""
+
+    def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
+        """``robot``'s colliding pairs are now ``pairs`` (link or object names)."""
+
+
+class Scene(Observer):
+    """An observer that is a view: it starts with the world and stops with the program."""
+
+    url: str | None = None
+    """Where a person can look at it, if anywhere."""
+
+    def start(self, world: World, loop: asyncio.AbstractEventLoop) -> None:
+        """Begin showing ``world``; page input goes through ``loop`` (the asyncio thread's)."""
+
+    def stop(self) -> None:
+        """Stop and free what it holds (ports, threads); later calls do nothing."""
+
+
+class NullScene(Scene):
+    """A scene that draws nothing (``--no-viewer``)."""
+
+
+@dataclass
+class RecordingScene(Scene):
+    """A scene that remembers what it was told; no drawing."""
+
+    joints: list[tuple[float, ...]] = field(default_factory=list)
+    times: list[float] = field(default_factory=list)
+    """The clock time [s] of each entry of ``joints``."""
+    markers: list[Marker] = field(default_factory=list)
+    clears: int = 0
+    client_counts: list[int] = field(default_factory=list)
+    commands: list[str] = field(default_factory=list)
+    refused: list[str] = field(default_factory=list)
+    objects: dict[str, list[str]] = field(default_factory=dict)
+    collisions: list[tuple[str, list[tuple[str, str]]]] = field(default_factory=list)
+
+    def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
+        self.joints.append(tuple(q))
+        self.times.append(t)
+
+    def on_marker(self, robot: str, marker: Marker) -> None:
+        self.markers.append(marker)
+        del self.markers[:-MAX_MARKERS]
+
+    def on_clear_markers(self, robot: str) -> None:
+        self.markers.clear()
+        self.clears += 1
+
+    def on_clients(self, count: int) -> None:
+        self.client_counts.append(count)
+
+    def on_command(self, source: str, line: str, accepted: bool) -> None:
+        (self.commands if accepted else self.refused).append(line)
+
+    def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
+        self.objects[robot] = [obj.name for obj in objects]
+
+    def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
+        self.collisions.append((robot, list(pairs)))

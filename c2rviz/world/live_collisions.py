@@ -1,0 +1,108 @@
+"""Which pairs collide as the arms are shown, told to the observers when it changes.
+
+``Contacts`` belongs to the ``World``. Each robot's ``CollisionModel`` (coal,
+through Pinocchio) is built the first time something needs it — a workcell
+object, ``collisions``, ``guard on``, or the program's start — and from then on
+every published pose marks the robot for a check, run at most once per frame
+on the asyncio loop: a flood of ``joints`` lines costs one check per frame, not
+one per line. A change of the colliding pairs reaches the observers as
+``on_collisions(robot, pairs)`` (the page turns links red, a watch stream says
+``event collision ...``).
+"""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import Callable, Iterable, Sequence
+from typing import TYPE_CHECKING
+
+from ..collision.model import CollisionModel, Pair
+from ..collision.workcell import MAX_OBJECTS
+from .effects import Observer
+
+if TYPE_CHECKING:
+    from .world import RobotState
+
+__all__ = ["Contacts"]
+
+
+class Contacts(Observer):
+    """The colliding pairs of every robot whose collision model is built."""
+
+    def __init__(
+        self,
+        states: dict[str, RobotState],
+        tell: Callable[[str, list[Pair]], None],
+        frame_s: float,
+        disabled: dict[str, Sequence[Pair]] | None = None,
+        max_objects: int = MAX_OBJECTS,
+    ) -> None:
+        """Set up.
+
+        Args:
+            states: The world's robots by name.
+            tell: Fans a robot's new colliding pairs out to the observers.
+            frame_s: Shortest time between two checks of a robot [s].
+            disabled: Pairs never checked, by robot (from an SRDF).
+            max_objects: Most workcell objects per robot.
+        """
+        self.states = states
+        self.tell = tell
+        self.frame_s = frame_s
+        self.disabled = disabled or {}
+        self.max_objects = max_objects
+        self.models: dict[str, CollisionModel] = {}
+        self.pairs: dict[str, list[Pair]] = {}
+        self._dirty: set[str] = set()
+        self._timer: asyncio.Handle | None = None
+
+    def model(self, robot: str) -> CollisionModel:
+        """The robot's collision model, built on first use (~10 ms for a bundled arm)."""
+        model = self.models.get(robot)
+        if model is None:
+            state = self.states[robot]
+            model = CollisionModel(
+                state.robot, disabled=self.disabled.get(robot, ()), max_objects=self.max_objects
+            )
+            self.models[robot] = model
+            self.pairs[robot] = []
+            self.changed(robot)
+        return model
+
+    def now(self, robot: str) -> list[Pair]:
+        """The colliding pairs as the robot is shown now (checked now if due)."""
+        if robot in self._dirty or robot not in self.models:
+            self.model(robot)
+            self._check([robot])
+        return self.pairs[robot]
+
+    def changed(self, robot: str) -> None:
+        """The robot's pose or its workcell changed: check it within a frame."""
+        self._dirty.add(robot)
+        if self._timer is None:
+            try:
+                loop = asyncio.get_running_loop()
+            except RuntimeError:
+                return  # no loop (a model used off the loop): checked when asked
+            self._timer = loop.call_later(self.frame_s, self._due)
+
+    def stop(self) -> None:
+        if self._timer is not None:
+            self._timer.cancel()
+            self._timer = None
+
+    def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
+        if robot in self.models:
+            self.changed(robot)
+
+    def _due(self) -> None:
+        self._timer = None
+        self._check(list(self._dirty))
+
+    def _check(self, robots: Iterable[str]) -> None:
+        for robot in robots:
+            self._dirty.discard(robot)
+            pairs = self.models[robot].colliding(self.states[robot].q)
+            if pairs != self.pairs[robot]:
+                self.pairs[robot] = pairs
+                self.tell(robot, pairs)

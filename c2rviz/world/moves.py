@@ -1,0 +1,255 @@
+"""Moves that take time: each robot's planned motion on the world's clock.
+
+``Travels`` belongs to the ``World``. A move to a target plans a ruckig
+trajectory (``motion.Motion``) from the arm's state now; a timer on the asyncio
+loop samples every moving robot once per frame (``1/hz``), publishes the pose
+through the world's fan-out, and settles the replies that wait for the arm:
+``ok`` on arrival, or an error when another command preempts or stops the
+move. Nothing here parses or checks a command: the session did.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..errors import MotionInterrupted
+from ..motion.line_play import LinePlay
+from ..motion.planner import Motion, MotionLimits
+from ..protocol import replies
+
+if TYPE_CHECKING:
+    from .world import RobotState
+
+__all__ = ["Travel", "Travels"]
+
+
+@dataclass(eq=False)
+class Travel:
+    """One robot's motion and who waits on it.
+
+    Attributes:
+        state: The robot that moves.
+        motion: The planner, sampled at the world's clock.
+        active: A plan runs (the timer samples it each frame).
+        synced: The planner stands where the robot is (instant commands, which may come
+            by the hundred thousand, only clear this; the next move re-syncs).
+        arrivals: Replies waiting for the arm to reach the running move's target.
+        rests: Replies waiting for the arm to come to rest (``wait``, ``stop``).
+        line: A straight-line path being played instead of ``motion``, if any.
+        stopping: The running move was stopped (``stop``): it ends at rest short of
+            its target. Cleared by the next move.
+    """
+
+    state: RobotState
+    motion: Motion
+    active: bool = False
+    synced: bool = True
+    line: LinePlay | None = None
+    stopping: bool = False
+    arrivals: list[asyncio.Future[str]] = field(default_factory=list)
+    rests: list[asyncio.Future[str]] = field(default_factory=list)
+
+
+class Travels:
+    """The motions of every robot of a world, and the frame timer that plays them."""
+
+    def __init__(
+        self,
+        publish: Callable[[RobotState, tuple[float, ...], float], None],
+        clock: Callable[[], float],
+        frame_s: float,
+    ) -> None:
+        """Set up.
+
+        Args:
+            publish: ``publish(state, q, t)`` shows a robot at ``q`` at time ``t``.
+            clock: The world's time base [s].
+            frame_s: Time between two samples of a moving arm [s].
+        """
+        self.publish = publish
+        self.clock = clock
+        self.frame_s = frame_s
+        self.by_robot: dict[str, Travel] = {}
+        self._timer: asyncio.Handle | None = None
+
+    def add(self, state: RobotState, limits: MotionLimits) -> Travel:
+        travel = self.by_robot[state.name] = Travel(state, Motion(limits, state.q))
+        return travel
+
+    # What the world does with a robot's target.
+
+    def preempt(self, travel: Travel, source: str) -> None:
+        """An instant command puts the arm somewhere now: the running move ends here."""
+        self._interrupt(travel, f"preempted by {source}")
+        travel.active = False
+        travel.synced = False
+        travel.line = None
+        _settle(travel.rests, replies.OK)
+
+    def go(
+        self, state: RobotState, q: Sequence[float], speed: float, source: str, wait: bool
+    ) -> asyncio.Future[str] | None:
+        """Travel to ``q`` at ``speed`` (0..1 of the limits) from the arm's state now.
+
+        Returns:
+            With ``wait``, a reply that comes on arrival (``ok``) or when the move is
+            preempted or stopped (an error); else None (``motion follow``).
+        """
+        travel = self.by_robot[state.name]
+        self._interrupt(travel, f"preempted by {source}")
+        t = self.clock()
+        if travel.line is not None:  # leaving a line: from where it is, at rest (see README)
+            travel.motion.jump(travel.line.sample(t), t)
+            travel.line = None
+        elif not travel.synced:
+            travel.motion.jump(state.q, t)
+        travel.synced = True
+        if wait:
+            travel.motion.move_to(q, t, speed)
+        else:
+            travel.motion.follow(q, t, speed)
+        state.target = travel.motion.target
+        self._run(travel)
+        if not wait:
+            return None
+        arrival: asyncio.Future[str] = asyncio.get_running_loop().create_future()
+        travel.arrivals.append(arrival)
+        if not travel.active:  # already there: nothing to wait for
+            _settle(travel.arrivals, replies.OK)
+        return arrival
+
+    def play_line(
+        self,
+        state: RobotState,
+        qs: np.ndarray,
+        times: Sequence[float],
+        ramp: tuple[float, float],
+        source: str,
+        wait: bool,
+    ) -> asyncio.Future[str] | None:
+        """Play the joint path ``qs`` (from where the arm is, at rest) along ``times`` [s],
+        eased in and out with the path-time acceleration and jerk ``ramp`` (``line_play``).
+
+        Returns:
+            As ``go``: with ``wait`` a reply on arrival, else None.
+        """
+        travel = self.by_robot[state.name]
+        self._interrupt(travel, f"preempted by {source}")
+        travel.line = LinePlay(self.clock(), times, qs, *ramp)
+        travel.synced = False
+        state.target = tuple(qs[-1].tolist())
+        travel.active = True
+        self._run(travel)
+        if not wait:
+            return None
+        arrival: asyncio.Future[str] = asyncio.get_running_loop().create_future()
+        travel.arrivals.append(arrival)
+        return arrival
+
+    def stop(self, state: RobotState, source: str) -> asyncio.Future[str] | None:
+        """Decelerate to rest; return the reply that comes at rest (None: at rest now)."""
+        travel = self.by_robot[state.name]
+        if not travel.active:
+            return None
+        self._interrupt(travel, f"motion stopped by {source}")
+        travel.stopping = True
+        if travel.line is not None:  # a line brakes on the line
+            travel.line.brake(self.clock())
+            state.target = travel.line.sample(travel.line.arrival)
+            return self.rest(state)
+        travel.motion.stop(self.clock())
+        state.target = travel.motion.target
+        return self.rest(state)
+
+    def rest(self, state: RobotState) -> asyncio.Future[str] | None:
+        """The reply that comes when the arm is at rest (None: it is now)."""
+        travel = self.by_robot[state.name]
+        if not travel.active:
+            return None
+        future: asyncio.Future[str] = asyncio.get_running_loop().create_future()
+        travel.rests.append(future)
+        return future
+
+    def seconds_left(self, state: RobotState) -> float:
+        """Time until the arm is at rest [s]; 0 when it is."""
+        travel = self.by_robot[state.name]
+        if not travel.active:
+            return 0.0
+        end = travel.line.arrival if travel.line is not None else travel.motion.arrival()
+        return max(end - self.clock(), 0.0)
+
+    def now(self, state: RobotState) -> tuple[float, ...]:
+        """Where the arm is at this instant (between two frames, too)."""
+        travel = self.by_robot[state.name]
+        if not travel.active:
+            return state.q
+        if travel.line is not None:
+            return travel.line.sample(self.clock())
+        return travel.motion.sample(self.clock())[0]
+
+    def stop_all(self) -> None:
+        """The program stops: no more frames."""
+        if self._timer is not None:
+            self._timer.cancel()
+            self._timer = None
+
+    # The frame timer.
+
+    def _run(self, travel: Travel) -> None:
+        travel.active = travel.line is not None or travel.motion.moving(self.clock())
+        if travel.active and self._timer is None:
+            self._timer = asyncio.get_running_loop().call_soon(self._tick)
+
+    def _tick(self) -> None:
+        """Sample every moving robot, publish it, settle the arrived; come back next frame."""
+        self._timer = None
+        t = self.clock()
+        due = math.inf
+        for travel in self.by_robot.values():
+            if not travel.active:
+                continue
+            line = travel.line
+            if line is not None:
+                q = line.sample(t)
+                end = line.arrival
+                if t >= end:  # at rest at the line's end: the planner stands there too
+                    travel.active, travel.line = False, None
+                    travel.motion.jump(q, t)
+                    travel.synced = True
+            else:
+                q = travel.motion.sample(t)[0]
+                end = travel.motion.arrival()
+                if not travel.motion.moving(t):
+                    travel.active = False
+            self.publish(travel.state, q, t)
+            if travel.active:
+                due = min(due, t + self.frame_s, end)
+            else:
+                _settle(travel.arrivals, replies.OK)
+                _settle(travel.rests, replies.OK)
+        if due < math.inf:
+            delay = max(due - self.clock(), 0.0)
+            self._timer = asyncio.get_running_loop().call_later(delay, self._tick)
+
+    @staticmethod
+    def _interrupt(travel: Travel, why: str) -> None:
+        """The running move ends (a new one, or a stop, follows): its waiters hear ``why``."""
+        travel.stopping = False
+        waiting, travel.arrivals = travel.arrivals, []
+        for future in waiting:
+            if not future.done():
+                future.set_exception(MotionInterrupted(why))
+
+
+def _settle(futures: list[asyncio.Future[str]], reply: str) -> None:
+    waiting = list(futures)
+    futures.clear()
+    for future in waiting:
+        if not future.done():
+            future.set_result(reply)
