@@ -15,7 +15,7 @@ For each robot it prints:
 
 Then, for a cell of two (the motoman at the origin, the Fanuc 1.5 m along x,
 facing it): the same guarded 90 degree move of the motoman checked against the
-other robot as it stands (``between.first_hit_between``).
+other robot as it stands (``collision.other_robots.first_hit_between``).
 
 Run: ``python benchmarks/collision_bench.py`` (``--quick`` for fewer repeats,
 ``--robots ur5 panda`` for example-robot-data arms, when installed).
@@ -130,9 +130,14 @@ def between_robots(repeats: int) -> None:
     )
     robot = world.state("a").robot
     path = segment(robot, [0.0] * robot.n, [math.pi / 2] + [0.0] * (robot.n - 1))
-    first_hit_between(world, "a", path)  # build both collision models first
-    took = best_of(repeats, lambda: first_hit_between(world, "a", path))
-    hit = first_hit_between(world, "a", path)
+    model, here = world.collision_model("a"), world.state("a").origin
+
+    def check() -> object:
+        return first_hit_between(model, here, world.others("a"), path)
+
+    check()  # build both collision models first
+    took = best_of(repeats, check)
+    hit = check()
     print(
         f"cell: motoman's guarded 90 deg move against a Fanuc 1.5 m away: "
         f"{took * 1e3:.2f} ms for {len(path)} points (first hit: {hit})"

@@ -37,6 +37,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from processes import launch_ours  # noqa: E402
 
 from c2rviz.robot.model import Robot  # noqa: E402
+from c2rviz.session import Services  # noqa: E402
 from c2rviz.view import adapter  # noqa: E402
 from c2rviz.view.viser_scene import ViserScene  # noqa: E402
 from c2rviz.world.effects import Marker  # noqa: E402
@@ -202,9 +203,9 @@ def send_cost() -> None:
     robot = Robot.from_urdf(ROOT / "robots/motoman_sia20d/robot.urdf", "base_link", "link_t")
     loop = asyncio.new_event_loop()
     world = World(robot)
-    scene = ViserScene(world, "127.0.0.1", 0, 100.0)
+    scene = ViserScene(Services(world), "127.0.0.1", 0, 100.0)
     world.add_observers([scene])
-    scene.start(world, loop)
+    scene.start(loop)
     scene.scheduler.stop()  # sends are timed by hand below
     try:
         markers = [

@@ -20,6 +20,7 @@ from importlib import import_module
 from typing import Any
 
 __all__ = [
+    "__version__",
     "C2rvizError",
     "CommandServer",
     "Marker",
@@ -30,7 +31,7 @@ __all__ = [
     "World",
     "parse_line",
 ]
-__version__ = "0.2.0"
+from .version import __version__
 
 _HOME = {
     "C2rvizError": "errors",

@@ -25,8 +25,9 @@ from typing import Any
 
 import pytest
 
-from c2rviz.app.config import ServerLimits
+from c2rviz.app.program import write_page
 from c2rviz.robot.model import Robot
+from c2rviz.session import ServerLimits, Services
 from c2rviz.transports.tcp_text import CommandServer
 from c2rviz.world.effects import RecordingScene
 from c2rviz.world.world import World
@@ -69,7 +70,8 @@ class ServerThread:
     def start(self) -> ServerThread:
         self.loop = asyncio.new_event_loop()
         self.world = World(self.robot, self.scene)
-        self.server = CommandServer(self.world, self.limits, on_quit=self.quit.set)
+        self.services = Services(self.world, limits=self.limits, exporters=(write_page,))
+        self.server = CommandServer(self.services, on_quit=self.quit.set)
         self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
         self.thread.start()
         self.host, self.port = self.call_async(self.server.start("127.0.0.1", 0))

@@ -21,8 +21,8 @@ from test_watch import read_until
 
 from c2rviz.app.cell import load_cell
 from c2rviz.app.cli import main
-from c2rviz.app.config import ServerLimits
 from c2rviz.errors import ConfigError
+from c2rviz.session import Services
 from c2rviz.transports.tcp_text import CommandServer
 from c2rviz.world.effects import RecordingScene
 from c2rviz.world.world import World
@@ -46,12 +46,13 @@ class CellThread:
             self.scene,
             origins=origins,
         )
+        self.services = Services(self.world)
         self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
         self.thread.start()
         self.servers: dict[str, CommandServer] = {}
         self.ports: dict[str, int] = {}
         for name in robots:
-            server = CommandServer(self.world, ServerLimits(), robot=name)
+            server = CommandServer(self.services, robot=name)
             _, port = self.run(server.start("127.0.0.1", 0))
             self.world.state(name).port = port
             self.servers[name], self.ports[name] = server, port

@@ -27,9 +27,10 @@ import pytest
 from c2rviz.app import cli, config
 from c2rviz.errors import LineTooLong
 from c2rviz.protocol import replies
+from c2rviz.protocol.framing import BATCH_BYTES
 from c2rviz.protocol.grammar import _MAX_INDEX_DIGITS
 from c2rviz.transports import tcp_text as server_module
-from c2rviz.transports.tcp_text import _BATCH_BYTES, _LINGER_S, TURN_S, CommandServer
+from c2rviz.transports.tcp_text import _LINGER_S, TURN_S, CommandServer
 from c2rviz.view.policy import DoorPolicy
 
 # A state away from home (so a stray home or joints shows) with long `where` replies.
@@ -57,6 +58,11 @@ def state(server):
 
 def client_count(server):
     return server.call(lambda: len(server.server.connections))
+
+
+def buffered(server) -> list[int]:
+    """Bytes each connection holds of an unfinished line (call on the server's loop)."""
+    return [len(c.framer.buffer) for c in server.server.connections]
 
 
 def wait_for(predicate, timeout=60.0):
@@ -190,11 +196,11 @@ def test_an_over_long_line_without_newline_is_refused_and_closed(live, connect):
 
     def watch():
         while sending.is_set():
-            sizes = server.call(lambda: [len(c.buffer) for c in server.server.connections])
+            sizes = server.call(lambda: buffered(server))
             held[0] = max(held[0], *sizes)
 
     client.send(b"x" * 1000)  # under the limit: held, waiting for its newline
-    wait_for(lambda: max(server.call(lambda: [len(c.buffer) for c in server.server.connections])))
+    wait_for(lambda: max(server.call(lambda: buffered(server))))
     watcher = threading.Thread(target=watch)
     watcher.start()
     sent = 1000
@@ -258,7 +264,7 @@ def test_a_partial_line_at_disconnect_is_discarded(live, connect, how):
     server, _bystander, check = live()
     client = connect(server)
     client.send("joints 0,0,0,0,0,0,0.5")  # would be valid with its newline
-    wait_for(lambda: max(server.call(lambda: [len(c.buffer) for c in server.server.connections])))
+    wait_for(lambda: max(server.call(lambda: buffered(server))))
     if how == "close":
         client.close()
     else:
@@ -272,7 +278,7 @@ def test_a_reset_mid_line_ends_quietly(live, connect):
     server, _bystander, check = live()
     client = connect(server)
     client.send("move 0 0.5")
-    wait_for(lambda: max(server.call(lambda: [len(c.buffer) for c in server.server.connections])))
+    wait_for(lambda: max(server.call(lambda: buffered(server))))
     client.sock.setsockopt(socket.SOL_SOCKET, socket.SO_LINGER, struct.pack("ii", 1, 0))
     client.close()  # RST, not FIN
     wait_for(lambda: client_count(server) == 1)
@@ -469,7 +475,7 @@ def test_a_long_batch_gives_way_to_another_client_after_its_time_slice(live, con
     flooder, reader = connect(server), connect(server)
     assert reader.ask("where") == WHERE  # both connections are set up on the server
     steps = [f"move 0 {1 + k / 500:.3f}" for k in range(1, 501)]  # 1.002 .. 2 rad
-    assert len("".join(line + "\n" for line in steps)) < _BATCH_BYTES  # one batch
+    assert len("".join(line + "\n" for line in steps)) < BATCH_BYTES  # one batch
     hold, held = threading.Event(), threading.Event()
 
     def block() -> None:  # the loop waits here while the lines arrive, in a known order
@@ -523,9 +529,9 @@ def test_the_limits_table_matches_the_code():
         assert [float(v) for v in allowed.split("..")] == [low, high]
         seen.add(field)
     assert seen == set(defaults)  # every limit is in the table
-    assert f"| {_BATCH_BYTES} | `server._BATCH_BYTES` |" in text
-    assert f"| {TURN_S * 1000:g} ms | `server.TURN_S` |" in text
-    assert f"| {_LINGER_S:g} s | `server._LINGER_S` |" in text
+    assert f"| {BATCH_BYTES} | `protocol.framing.BATCH_BYTES` |" in text
+    assert f"| {TURN_S * 1000:g} ms | `transports.tcp_text.TURN_S` |" in text
+    assert f"| {_LINGER_S:g} s | `transports.tcp_text._LINGER_S` |" in text
     assert f"| {_MAX_INDEX_DIGITS} | `protocol.grammar._MAX_INDEX_DIGITS` |" in text
     grace = inspect.signature(CommandServer.stop).parameters["grace_s"].default
     assert f"| {grace:g} s | `CommandServer.stop(grace_s)` |" in text

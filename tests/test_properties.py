@@ -23,7 +23,7 @@ from c2rviz.errors import C2rvizError, LineTooLong
 from c2rviz.protocol import replies
 from c2rviz.protocol.grammar import ForeignProtocol, parse_line
 from c2rviz.protocol.verbs.connection import Bye, Quit, Sleep
-from c2rviz.session.session import Session
+from c2rviz.session import Services, Session
 from c2rviz.world.world import World
 
 VERBS = [
@@ -187,10 +187,9 @@ def test_the_server_does_what_the_model_predicts(live, lines, seed):
     q, markers = server.call(lambda: (world.q, list(world.markers)))
     shadow.set_q(q)
     shadow.markers.extend(markers)
-    shadow.rng = np.random.default_rng(seed)
-    server.call(lambda: setattr(world, "rng", np.random.default_rng(seed)))
+    server.call(lambda: setattr(server.services, "rng", np.random.default_rng(seed)))
     data = b"\n".join(line.replace(b"\n", b"") for line in lines) + b"\n"
-    expected, closes = predict(data, Session(shadow))
+    expected, closes = predict(data, Session(Services(shadow, rng=np.random.default_rng(seed))))
     event(f"closes={closes}")
     event(f"ok replies: {min(sum(r.startswith('ok') for r in expected), 3)}")
     event(f"state changed: {shadow.q != q or shadow.markers != markers}")

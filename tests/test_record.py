@@ -29,7 +29,6 @@ from c2rviz.app.config import load_settings
 from c2rviz.clients import player
 from c2rviz.errors import ConfigError
 from c2rviz.observers.recorder import Recorder
-from c2rviz.observers.recordings import Recordings
 from c2rviz.observers.trail import DEFAULT_TRAIL_POINTS, TrailKeeper
 from c2rviz.world.world import World
 
@@ -39,7 +38,7 @@ FRAME_S = 0.01  # the world's frame at the default 100 Hz
 
 
 def record_into(server: ServerThread, folder: Path) -> None:
-    server.call(lambda: Recordings.of(server.world, folder))
+    server.call(lambda: setattr(server.services.recordings, "folder", folder))
 
 
 def markers(server: ServerThread) -> list[tuple]:
@@ -198,7 +197,7 @@ def test_a_write_error_stops_the_recording_and_the_server_goes_on(
     assert client.ask("record broken") == f"ok recording broken into {tmp_path.resolve()}"
 
     def break_the_files() -> None:
-        recorder = Recordings.of(server.world).current
+        recorder = server.services.recordings.current
         assert recorder is not None
         read_only = os.open(os.devnull, os.O_RDONLY)
         for file in (recorder._body, recorder._rows):  # as if the disk went away
@@ -308,7 +307,7 @@ def test_the_trail_follows_the_tool_along_a_move(server: ServerThread, connect):
     along = np.array(
         [(robot.base_placement * robot.ee_pose(q) * offset).translation for q in frames]
     )
-    keeper = server.call(lambda: TrailKeeper.of(server.world))
+    keeper = server.services.trails
     points = server.call(keeper.points, "motoman_sia20d")
     assert len(points) > 50  # at frame rate, not only the targets
     home = (robot.base_placement * robot.ee_pose(robot.home) * offset).translation
@@ -339,10 +338,10 @@ def tool(q) -> np.ndarray:
 
 def test_the_trail_stays_within_its_cap_and_keeps_its_extent():
     world = a_world()
-    keeper = TrailKeeper.of(world)
+    keeper = TrailKeeper(world)
     keeper.start("motoman_sia20d")
     first = keeper.points("motoman_sia20d")[0]
-    t0 = world.clock() + 100
+    t0 = world.clock.now() + 100
     most = 0
     for k in range(100_000):  # 100k frames, each a new place
         q = (0.5 * math.sin(k / 5000), 0.3 * math.sin(k / 777), 0, 0, 0, 0, 0)
@@ -359,9 +358,9 @@ def test_the_trail_stays_within_its_cap_and_keeps_its_extent():
 
 def test_a_flood_adds_one_trail_point_per_frame():
     world = a_world()
-    keeper = TrailKeeper.of(world)
+    keeper = TrailKeeper(world)
     keeper.start("motoman_sia20d")
-    t0 = world.clock() + 100
+    t0 = world.clock.now() + 100
     for k in range(1000):  # 1000 states within 0.1 s: ten frames
         keeper.on_joints("motoman_sia20d", (0, (k + 1) / 1000, 0, 0, 0, 0, 0), t0 + k * 1e-4)
     points = keeper.points("motoman_sia20d")
@@ -374,7 +373,7 @@ def test_thinning_at_any_cap(cap: int):
     world = a_world()
     keeper = TrailKeeper(world, cap)
     keeper.start("motoman_sia20d")
-    t0 = world.clock() + 100
+    t0 = world.clock.now() + 100
     sizes = []
     for k in range(10 * cap):
         q = (0, (k + 1) / (10 * cap), 0, 0, 0, 0, 0)  # the tool swings forward

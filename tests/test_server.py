@@ -296,10 +296,10 @@ RUNS = {
 def test_runs_of_joints_lines_answer_as_line_by_line(server, connect, name):
     """Plain joints lines read together are checked as one batch and only the last is
     shown; every reply, error and the final state equal running them one by one."""
-    from c2rviz.session.session import Session
+    from c2rviz.session import Services, Session
     from c2rviz.world.world import World
 
-    shadow = Session(World(server.robot))
+    shadow = Session(Services(World(server.robot)))
     expected = []
     for line in RUNS[name]:
         try:

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from c2rviz import tolerance
 from c2rviz.errors import JointLimitError
 from c2rviz.protocol import replies
-from c2rviz.session.session import Session
+from c2rviz.session import Services, Session
 from c2rviz.tolerance import LIMIT_TOLERANCE, limit_text, texts_apart, within_limit
 from c2rviz.world.world import World
 
@@ -54,7 +54,7 @@ def test_a_limit_printed_with_10_digits_is_within_it(name: str) -> None:
 def test_the_session_accepts_what_within_limit_accepts(monkeypatch: pytest.MonkeyPatch) -> None:
     """One tolerance: Session.to_si follows tolerance.within_limit, whatever its slack."""
     robot = load_robot()
-    session = Session(World(robot))
+    session = Session(Services(World(robot)))
     upper = robot.upper[1]
     assert session.to_si([1], [upper * (1 + 5e-10)]) == [upper]  # at the limit
     with pytest.raises(JointLimitError):

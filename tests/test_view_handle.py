@@ -27,7 +27,7 @@ def harness() -> Iterator[Callable[..., Harness]]:
     made: list[Harness] = []
 
     def make(world: World) -> Harness:
-        made.append(Harness(world))
+        made.append(Harness(world, rng=np.random.default_rng(5)))
         return made[-1]
 
     yield make
@@ -39,7 +39,7 @@ def cell() -> World:
     """Two copies of one arm, the second turned and shifted, its tool 10 cm out."""
     motoman = load_robot("motoman_sia20d")
     origins = {"b": pin.SE3(pin.rpy.rpyToMatrix(0.0, 0.0, 0.4), np.array([1.0, -0.3, 0.05]))}
-    world = World({"a": motoman, "b": motoman}, None, np.random.default_rng(5), origins=origins)
+    world = World({"a": motoman, "b": motoman}, origins=origins)
     world.set_tool("b", pin.SE3(pin.rpy.rpyToMatrix(0.0, 0.3, 0.0), np.array([0.0, 0.0, 0.1])))
     return world
 
@@ -97,7 +97,7 @@ def test_the_handle_stands_at_each_tool_point_and_a_drag_moves_that_arm(
 def test_an_unreachable_drag_leaves_the_arm_and_puts_the_handle_back(
     harness: Callable[..., Harness],
 ) -> None:
-    world = World(load_robot("motoman_sia20d"), None, np.random.default_rng(5))
+    world = World(load_robot("motoman_sia20d"))
     h = harness(world)
     tab = h.tab()
     state = world.state()
@@ -129,7 +129,7 @@ def test_an_unreachable_drag_leaves_the_arm_and_puts_the_handle_back(
 
 @pytest.mark.parametrize("bad", ["unknown-name", "nan", "not-unit", "extra-field"])
 def test_a_bad_drag_is_dropped(harness: Callable[..., Harness], bad: str) -> None:
-    world = World(load_robot("motoman_sia20d"), None, np.random.default_rng(5))
+    world = World(load_robot("motoman_sia20d"))
     h = harness(world)
     tab = h.tab()
     state = world.state()
@@ -157,7 +157,7 @@ def test_a_bad_drag_is_dropped(harness: Callable[..., Harness], bad: str) -> Non
 def test_a_held_handle_stays_in_the_hand_and_follows_the_arm_when_let_go(
     harness: Callable[..., Harness],
 ) -> None:
-    world = World(load_robot("motoman_sia20d"), None, np.random.default_rng(5))
+    world = World(load_robot("motoman_sia20d"))
     h = harness(world)
     tab = h.tab()
     state = world.state()

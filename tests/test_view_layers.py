@@ -12,8 +12,7 @@ import pytest
 from conftest import load_robot
 from viewer_tabs import Harness
 
-from c2rviz.observers.trail import TrailKeeper
-from c2rviz.session.session import Session
+from c2rviz.session import Services, Session
 from c2rviz.view.workcell_layer import COLLISION_RGBA
 from c2rviz.world.world import World
 
@@ -23,7 +22,7 @@ RED = tuple(int(round(255 * c)) for c in COLLISION_RGBA[:3])
 @pytest.fixture
 def h() -> Iterator[Harness]:
     origin = pin.SE3(pin.rpy.rpyToMatrix(0.0, 0.0, 0.4), np.array([0.3, -0.2, 0.1]))
-    world = World({"arm": load_robot()}, None, np.random.default_rng(7), origins={"arm": origin})
+    world = World({"arm": load_robot()}, origins={"arm": origin})
     harness = Harness(world)
     yield harness
     harness.close()
@@ -42,7 +41,7 @@ def placement(handle: Any) -> pin.SE3:
 
 
 def test_an_object_stands_at_its_world_place_and_goes_when_removed(h: Harness) -> None:
-    session = Session(h.world, source="test")
+    session = Session(h.services, source="test")
     run(h, session, "object table box 0.2,0.2,0.2 0,0.8,0.85,0,0,0")
     h.run(0.05)
     layer, view = h.scene.workcells["arm"], h.scene.views["arm"]
@@ -61,7 +60,7 @@ def test_an_object_stands_at_its_world_place_and_goes_when_removed(h: Harness) -
 
 
 def test_a_colliding_link_and_its_object_turn_red_and_the_panel_lists_them(h: Harness) -> None:
-    session = Session(h.world, source="test")
+    session = Session(h.services, source="test")
     session.set_degrees(True)
     run(h, session, "object table box 0.2,0.2,0.2 0,0.8,0.85,0,0,0")
     run(h, session, "j 90,60,0,0,0,0,0")
@@ -86,9 +85,9 @@ def test_the_trail_checkbox_runs_trail_on_and_the_node_holds_the_keepers_segment
     tab = h.tab()
     panel = h.scene.panels["arm"]
     tab.set(panel.trail, True)
-    keeper = TrailKeeper.of(h.world)
+    keeper = h.services.trails
     h.until(lambda: "arm" in keeper.trails, "the checkbox to turn the trail on")
-    session = Session(h.world, source="test")
+    session = Session(h.services, source="test")
     session.set_degrees(True)
     for line in ("j 30,20,0,0,0,0,0", "j 60,40,0,10,0,0,0", "j 0,0,0,0,0,0,0"):
         run(h, session, line)
@@ -108,13 +107,14 @@ def test_the_trail_checkbox_runs_trail_on_and_the_node_holds_the_keepers_segment
 
 
 def test_a_page_started_after_the_workcell_shows_its_objects_and_collisions() -> None:
-    world = World(load_robot(), None, np.random.default_rng(7))
-    session = Session(world, source="test")
+    world = World(load_robot())
+    services = Services(world, rng=np.random.default_rng(7))
+    session = Session(services, source="test")
     session.set_degrees(True)
     session.run("object table box 0.2,0.2,0.2 0,0.8,0.85,0,0,0")
     world.set_q(tuple(np.radians([90.0, 60.0, 0, 0, 0, 0, 0])))
     assert world.contacts.now(world.default)
-    h = Harness(world)
+    h = Harness(world, services=services)
     try:
         layer = h.scene.workcells[world.default]
         assert set(layer.objects) == {"table"}

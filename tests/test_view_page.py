@@ -24,10 +24,9 @@ from test_view_adapter import bad_messages
 from viewer_tabs import Harness, Tab
 from websockets.exceptions import InvalidStatus
 
-from c2rviz.app.config import ServerLimits, SessionDefaults
 from c2rviz.errors import MotionInterrupted
 from c2rviz.robot.model import Robot
-from c2rviz.session.session import Session
+from c2rviz.session import Services, Session, SessionDefaults
 from c2rviz.transports.tcp_text import CommandServer
 from c2rviz.view import adapter
 from c2rviz.view.panel import MAX_LABEL_CHARS, short_label
@@ -42,7 +41,7 @@ def harness() -> Iterator[Callable[..., Harness]]:
     made: list[Harness] = []
 
     def make(world: World | None = None, **kwargs: Any) -> Harness:
-        chosen = world if world is not None else World(load_robot(), None, np.random.default_rng(7))
+        chosen = world if world is not None else World(load_robot())
         made.append(Harness(chosen, **kwargs))
         return made[-1]
 
@@ -73,13 +72,8 @@ def test_a_cell_draws_every_robot_at_its_origin(harness: Callable[..., Harness])
         "right": pin.SE3(pin.rpy.rpyToMatrix(0.0, 0.0, np.pi), np.array([1.2, 0.0, 0.1])),
         "left copy": pin.SE3(np.eye(3), np.array([0.0, -1.5, 0.0])),
     }
-    world = World(
-        {"left": motoman, "right": fanuc, "left copy": motoman},
-        None,
-        np.random.default_rng(3),
-        origins=origins,
-    )
-    h = harness(world, title="twoarms")
+    world = World({"left": motoman, "right": fanuc, "left copy": motoman}, origins=origins)
+    h = harness(world, title="twoarms", rng=np.random.default_rng(3))
     tab = h.tab()
     rng = np.random.default_rng(4)
     for _ in range(5):
@@ -110,8 +104,8 @@ def test_a_cell_draws_every_robot_at_its_origin(harness: Callable[..., Harness])
 
 def test_a_cell_page_moves_the_robot_of_its_folder(harness: Callable[..., Harness]) -> None:
     motoman = load_robot("motoman_sia20d")
-    world = World({"a": motoman, "b": motoman}, None, np.random.default_rng(3))
-    h = harness(world)
+    world = World({"a": motoman, "b": motoman})
+    h = harness(world, rng=np.random.default_rng(3))
     tab = h.tab()
     tab.set(h.scene.panels["b"].sliders[0], 20.0)
     h.until(lambda: world.state("b").q[0] == pytest.approx(np.radians(20.0)), "robot b to move")
@@ -138,12 +132,12 @@ def consume(reply: Any) -> None:
 def test_the_ghost_stands_at_the_target_while_moving_and_stop_stops(
     harness: Callable[..., Harness],
 ) -> None:
-    world = World(load_robot(), None, defaults=SessionDefaults(motion="follow", speed=20.0))
-    h = harness(world)
+    world = World(load_robot())
+    h = harness(world, defaults=SessionDefaults(motion="follow", speed=20.0))
     tab = h.tab()
     panel, view = h.panel, h.scene.views[world.default]
     assert h.scene.sessions[world.default].motion == "follow"  # the page's moves travel
-    client = Session(world)
+    client = Session(h.services)
     client.set_degrees(True)
     client.motion = "on"
     arrival = h.call(lambda: client.run("move 0,1,2 90,60,-60"))
@@ -159,7 +153,7 @@ def test_the_ghost_stands_at_the_target_while_moving_and_stop_stops(
     assert panel.motion.value.startswith("moving, ") and panel.motion.value.endswith(" s left")
     assert [s.value for s in panel.sliders[:3]] == pytest.approx([90.0, 60.0, -60.0])
     tab.set(panel.buttons["stop"], True)  # the page's Stop, through the door
-    h.until(lambda: not world.state().travel.active and bool(arrived), "the arm to stop")
+    h.until(lambda: not world.moving(world.default) and bool(arrived), "the arm to stop")
     assert isinstance(arrived[0], MotionInterrupted)
     assert "motion stopped by page" in str(arrived[0])
     h.run(0.05)
@@ -173,10 +167,10 @@ def test_the_ghost_stands_at_the_target_while_moving_and_stop_stops(
 def test_a_slider_dragged_during_a_move_preempts_it(harness: Callable[..., Harness]) -> None:
     """The page is a client like any other: its slider's move takes over a TCP client's,
     which hears `preempted by page`; the arm goes on to the page's target."""
-    world = World(load_robot(), None, defaults=SessionDefaults(motion="on", speed=20.0))
-    h = harness(world)
+    world = World(load_robot())
+    h = harness(world, defaults=SessionDefaults(motion="on", speed=20.0))
     tab = h.tab()
-    client = Session(world, source="tcp 1")
+    client = Session(h.services, source="tcp 1")
     client.set_degrees(True)
     client.motion = "on"
     arrival = h.call(lambda: client.run("move 0,1 90,60"))
@@ -187,14 +181,14 @@ def test_a_slider_dragged_during_a_move_preempts_it(harness: Callable[..., Harne
     h.until(lambda: bool(arrived), "the client's reply")
     assert isinstance(arrived[0], MotionInterrupted)
     assert "preempted by page" in str(arrived[0])
-    h.until(lambda: not world.state().travel.active, "the page's move to end")
+    h.until(lambda: not world.moving(world.default), "the page's move to end")
     assert world.q[0] == pytest.approx(np.radians(-30.0))
     assert world.q[1] == pytest.approx(np.radians(60.0))  # `move` keeps the other targets
 
 
 def test_the_speed_slider_sets_the_page_sessions_speed(harness: Callable[..., Harness]) -> None:
-    world = World(load_robot(), None, defaults=SessionDefaults(motion="on"))
-    h = harness(world)
+    world = World(load_robot())
+    h = harness(world, defaults=SessionDefaults(motion="on"))
     tab = h.tab()
     session, panel = h.scene.sessions[world.default], h.panel
     tab.set(panel.speed, 35.0)
@@ -205,8 +199,8 @@ def test_the_speed_slider_sets_the_page_sessions_speed(harness: Callable[..., Ha
     assert session.speed == 35.0
     tab.wait(lambda: tab.values(panel.speed)[-1:] == [35.0], "the true speed back")
     tab.set(panel.sliders[0], 10.0)  # the page's move travels and the page does not wait
-    h.until(lambda: world.state().travel.active, "the move to start")
-    h.until(lambda: not world.state().travel.active, "the move to end", timeout_s=60)
+    h.until(lambda: world.moving(world.default), "the move to start")
+    h.until(lambda: not world.moving(world.default), "the move to end", timeout_s=60)
     assert world.q[0] == pytest.approx(np.radians(10.0))
 
 
@@ -295,10 +289,10 @@ def test_a_sliders_hint_gives_the_limits_as_limits_prints_them(
     the slider's hint; the slider itself stops at its last 0.1 step inside the limits."""
     from test_any_robot import LIMITS_URDF
 
-    world = World(Robot.from_urdf(LIMITS_URDF), None)
+    world = World(Robot.from_urdf(LIMITS_URDF))
     h = harness(world)
     tab = h.tab()
-    session = Session(world)
+    session = Session(h.services)
     session.set_degrees(True)
     limits = session.run("limits").removeprefix("ok ").split(",")
 
@@ -342,12 +336,13 @@ class LiveViewer:
     def __init__(self) -> None:
         self.loop = asyncio.new_event_loop()
         self.world = World(load_robot())
-        self.scene = ViserScene(self.world, "127.0.0.1", 0, 100.0)
+        self.services = Services(self.world)
+        self.scene = ViserScene(self.services, "127.0.0.1", 0, 100.0)
         self.world.add_observers([self.scene])
-        self.server = CommandServer(self.world, ServerLimits())
+        self.server = CommandServer(self.services)
         self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
         self.thread.start()
-        self.scene.start(self.world, self.loop)
+        self.scene.start(self.loop)
         started = asyncio.run_coroutine_threadsafe(self.server.start("127.0.0.1", 0), self.loop)
         self.port = started.result(timeout=10)[1]
 
@@ -421,7 +416,7 @@ def test_a_mark_flood_costs_o1_per_marker_and_the_page_gets_the_newest(
     """Marks in batches (a send between each, as under a flood): the buffer does not grow."""
     h = harness()
     tab = h.tab()
-    session = Session(h.world)
+    session = Session(h.services)
     figures, rss = {}, {}
     for batch in range(1, 61):
         h.call(lambda b=batch: [session.run(f"mark {b},{i},0,0,0,0") for i in range(1000)])
@@ -470,7 +465,7 @@ def test_a_tab_that_closes_mid_flood_leaves_the_others_served(
 ) -> None:
     h = harness()
     leaving, staying = h.tab(), h.tab()
-    session = Session(h.world)
+    session = Session(h.services)
     h.call(lambda: [session.run("mark") for _ in range(3000)])
     leaving.close()
     h.call(lambda: session.run("joints 0.1,0,0,0,0,0,0"))

@@ -27,7 +27,7 @@ RED = (1.0, 0.0, 0.0)
 
 @pytest.fixture
 def h() -> Iterator[Harness]:
-    harness = Harness(World(load_robot("motoman_sia20d"), None, np.random.default_rng(3)))
+    harness = Harness(World(load_robot("motoman_sia20d")), rng=np.random.default_rng(3))
     yield harness
     harness.close()
 

@@ -26,6 +26,7 @@ from viewer_tabs import Harness
 
 from c2rviz.robot.model import Robot
 from c2rviz.robot.visuals import load_link_geometry
+from c2rviz.session import Services
 from c2rviz.view import adapter
 from c2rviz.view.viser_scene import RECENT_COMMANDS, ViserScene
 from c2rviz.world.effects import Marker
@@ -38,7 +39,7 @@ def harness() -> Iterator[Callable[..., Harness]]:
 
     def make(robot: str | Robot = "motoman_sia20d", **kwargs: Any) -> Harness:
         chosen = load_robot(robot) if isinstance(robot, str) else robot
-        h = Harness(World(chosen, None, np.random.default_rng(7)), **kwargs)
+        h = Harness(World(chosen), rng=np.random.default_rng(7), **kwargs)
         made.append(h)
         return h
 
@@ -289,7 +290,7 @@ def test_the_panel_shows_clients_commands_and_the_pose(harness: Callable[..., Ha
     lines = [f"joint 0 {i}" for i in range(12)]
 
     def talk() -> None:
-        h.world.set_client_count(3)
+        h.services.count_clients("tcp", 3)
         for line in lines:
             h.world.note("tcp", line, True)
         h.world.note("tcp", "jump 3", False)
@@ -340,7 +341,7 @@ def _port_is_free(port: int) -> bool:
 
 
 def test_stop_frees_the_port() -> None:
-    scene = ViserScene(World(load_robot()), "127.0.0.1", 0, 100.0)
+    scene = ViserScene(Services(World(load_robot())), "127.0.0.1", 0, 100.0)
     port = int(scene.url.rsplit(":", 1)[1])
     assert not _port_is_free(port)
     scene.stop()
@@ -355,7 +356,7 @@ def test_url_reports_the_port_bound_when_the_asked_one_is_busy(
         busy.bind(("127.0.0.1", 0))
         busy.listen()
         taken = busy.getsockname()[1]
-        scene = ViserScene(World(load_robot()), "127.0.0.1", taken, 100.0)
+        scene = ViserScene(Services(World(load_robot())), "127.0.0.1", taken, 100.0)
         try:
             bound = int(scene.url.rsplit(":", 1)[1])
             assert scene.url.startswith("http://127.0.0.1:")
@@ -367,11 +368,11 @@ def test_url_reports_the_port_bound_when_the_asked_one_is_busy(
 
 def test_a_host_that_cannot_be_bound_fails_at_once() -> None:
     with pytest.raises(OSError):
-        ViserScene(World(load_robot()), "192.0.2.1", 0, 100.0)  # TEST-NET-1: not ours
+        ViserScene(Services(World(load_robot())), "192.0.2.1", 0, 100.0)  # TEST-NET-1: not ours
 
 
 def test_no_banner_on_stdout(capsys: pytest.CaptureFixture[str]) -> None:
-    scene = ViserScene(World(load_robot()), "127.0.0.1", 0, 100.0)
+    scene = ViserScene(Services(World(load_robot())), "127.0.0.1", 0, 100.0)
     scene.stop()
     assert capsys.readouterr().out == ""
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from conftest import ROOT, Client, ServerThread
 
-from c2rviz.observers.watch import STREAM_ALLOWANCE_BYTES, NotAConnection, WatchHub
+from c2rviz.observers.watch import STREAM_ALLOWANCE_BYTES, NotAConnection
 from c2rviz.protocol import replies
 from c2rviz.session.session import Session
 
@@ -105,7 +105,7 @@ def test_state_times_count_from_the_server_start_and_rise(server: ServerThread, 
     read_until(watcher, lambda line: line.endswith(f" {replies.numbers([0.49])},0,0,0,0,0,0"), seen)
     times = [t for t, _ in states(seen)]
     assert times == sorted(set(times))
-    now = server.call(lambda: server.world.clock() - server.server.watch.origin)
+    now = server.call(lambda: server.world.clock.now() - server.services.watch.origin)
     assert 0 <= times[0] <= times[-1] <= now
 
 
@@ -193,7 +193,7 @@ def test_bad_hz_is_refused_and_the_stream_does_not_start(server: ServerThread, c
 
 def test_the_page_has_no_stream_of_its_own(server: ServerThread):
     def watch_from_the_page() -> None:
-        WatchHub.of(server.world).watch(Session(server.world, "page"), None)
+        server.services.watch.watch(Session(server.services, "page"), None)
 
     with pytest.raises(NotAConnection, match="page has no stream of its own"):
         server.call(watch_from_the_page)
@@ -224,7 +224,7 @@ def _flood_past(server: ServerThread, flooder: Client, watcher: Client) -> None:
     assert flooder.ask("where") == "ok 0,0,0,0,0,0,0"
 
     def stream_state() -> tuple[int, bool]:
-        hub = server.server.watch
+        hub = server.services.watch
         (connection,) = [c for c in server.server.connections if hub.streams[c.session].active]
         assert connection.transport is not None
         return connection.transport.get_write_buffer_size(), connection.stream.paused

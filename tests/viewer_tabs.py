@@ -17,11 +17,13 @@ from collections.abc import Callable
 from typing import Any
 
 import msgspec
+import numpy as np
 import viser
 import zstandard
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import ClientConnection, connect
 
+from c2rviz.session import Services, SessionDefaults
 from c2rviz.view.viser_scene import ViserScene
 from c2rviz.world.world import World
 
@@ -134,13 +136,27 @@ class Tab:
 class Harness:
     """A real ``ViserScene``, its world and the asyncio loop they share (run from the test)."""
 
-    def __init__(self, world: World, hz: float = 100.0, port: int = 0, **options: Any) -> None:
+    def __init__(
+        self,
+        world: World,
+        hz: float = 100.0,
+        port: int = 0,
+        rng: np.random.Generator | None = None,
+        defaults: SessionDefaults | None = None,
+        services: Services | None = None,
+        **options: Any,
+    ) -> None:
         self.world = world
+        self.services = services or Services(
+            world,
+            rng=rng if rng is not None else np.random.default_rng(7),
+            defaults=defaults if defaults is not None else SessionDefaults(),
+        )
         self.robot = world.robot
         self.loop = asyncio.new_event_loop()
-        self.scene = ViserScene(world, "127.0.0.1", port, hz, **options)
+        self.scene = ViserScene(self.services, "127.0.0.1", port, hz, **options)
         self.world.add_observers([self.scene])
-        self.scene.start(self.world, self.loop)
+        self.scene.start(self.loop)
         self.panel = self.scene.panels[self.world.default]
         self.tabs: list[Tab] = []
         self.run(0.0)

@@ -12,8 +12,9 @@ from pathlib import Path
 from ..collision.geometry import read_srdf
 from ..errors import C2rvizError
 from ..robot.catalogue import catalogue, listing
-from .config import find_ini, load_settings, read_robots
-from .program import MOTION_FLAGS, members, serve
+from .config import MOTION_FLAGS, find_ini, load_settings, read_robots
+from .members import members
+from .program import serve
 
 __all__ = ["build_parser", "main"]
 
@@ -174,15 +175,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     overrides = {
         k: v
         for k, v in vars(args).items()
-        if k not in ("config", "verbose", "list_robots", "cell", *MOTION_FLAGS)
+        if k not in ("config", "verbose", "list_robots", *MOTION_FLAGS)
     }
+    overrides["motion_flags"] = tuple(
+        (k, getattr(args, k)) for k in MOTION_FLAGS if getattr(args, k) is not None
+    )
+    overrides["robot_flag"] = args.robot is not None
+    overrides["urdf_flag"] = args.urdf is not None
     try:
         if args.list_robots:
             ini = find_ini(args.config)
             print(listing(catalogue(read_robots(ini), ini).values()))
             return 0
         settings = load_settings(find_ini(args.config), overrides)
-        robots, cell = members(settings, args)
+        robots, cell = members(settings)
         if settings.srdf is not None:
             read_srdf(settings.srdf)  # a bad SRDF stops here, with its one sentence
     except C2rvizError as exc:

@@ -21,9 +21,11 @@ from ..errors import ConfigError
 from ..ini import INI_NAME, find_ini, number, read_ini
 from ..robot.catalogue import catalogue, find_robot
 from ..robot.sources import split_package_path
+from ..session.settings import ServerLimits, SessionDefaults
 
 __all__ = [
     "INI_NAME",
+    "MOTION_FLAGS",
     "ROBOT_KEYS",
     "ServerLimits",
     "SessionDefaults",
@@ -33,36 +35,6 @@ __all__ = [
     "load_settings",
     "read_robots",
 ]
-
-
-@dataclass(frozen=True)
-class ServerLimits:
-    """What one client may cost the server (README: "Limits")."""
-
-    max_line: int = 8192
-    """Longest line [bytes]; longer closes the connection."""
-    max_clients: int = 64
-    """Clients connected at once; one more is told so and closed."""
-    max_unread: int = 1 << 20
-    """Replies a client has not read [bytes]; more closes the connection."""
-    partial_timeout_s: float = 10.0
-    """How long a started line may stay unfinished [s]."""
-    max_sleep_s: float = 3600.0
-    """Longest ``sleep`` [s]."""
-
-
-@dataclass(frozen=True)
-class SessionDefaults:
-    """How a new connection starts (each may change its own with a command)."""
-
-    motion: str = "off"
-    """``off`` (moves shown at once, the seed's way), ``on`` or ``follow``."""
-    speed: float = 50.0
-    """Moves at this % of each joint's velocity limit (1..100)."""
-    guard: bool = False
-    """Refuse commands whose target or path collides."""
-    lspeed: float = 0.25
-    """``movel``'s tool speed [m/s] (as UR's movel)."""
 
 
 @dataclass(frozen=True)
@@ -141,6 +113,14 @@ class Settings:
     """Most workcell objects per robot."""
     srdf: Path | None = None
     """An SRDF whose ``disable_collisions`` pairs are never checked."""
+    cell: str | None = None
+    """Serve the robots of this cell (``--cell``): an ini section's name, or an ini file."""
+    motion_flags: tuple[tuple[str, str], ...] = ()
+    """``--max-velocity`` and the like as given, (key, text), over every robot's ini ones."""
+    robot_flag: bool = False
+    """``--robot`` was given."""
+    urdf_flag: bool = False
+    """``--urdf`` was given (the robot is then named by its model unless ``--robot`` is)."""
 
 
 # ini key -> (Settings or ServerLimits field, type, lowest allowed, highest allowed)
@@ -170,7 +150,9 @@ _TEXT_OPTIONS = (
     "viewer_origins",
 )
 _CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on")}
-_EXTRA_KEYS = ["tool", "max_velocity", "max_acceleration", "max_jerk"]
+MOTION_FLAGS = ("max_velocity", "max_acceleration", "max_jerk")
+"""Motion limits a flag may give every robot (over the ini's)."""
+_EXTRA_KEYS = ["tool", *MOTION_FLAGS]
 ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args", *_EXTRA_KEYS]
 _MEMBER_PLACE_KEYS = ("origin", "port")  # a cell member's, beside its robot keys (cell.py)
 _LIMIT_FIELDS = {f for f in ServerLimits.__dataclass_fields__}

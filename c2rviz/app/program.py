@@ -1,12 +1,9 @@
-"""The running program: the world, a command server per robot, the viewer, until quit.
-
-``members`` turns the settings (one robot, or a ``--cell``) into the robots to
-serve, with what the ini gives each (``furnish``); ``serve`` runs them.
+"""The running program: the world, its services, a command server per robot, the viewer,
+until quit, SIGINT or SIGTERM (``serve``; ``members`` says which robots).
 """
 
 from __future__ import annotations
 
-import argparse
 import asyncio
 import errno
 import ipaddress
@@ -14,28 +11,22 @@ import secrets
 import signal
 import sys
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-import pinocchio as pin
-
 from ..collision.geometry import read_srdf
-from ..collision.model import CollisionModel
 from ..errors import C2rvizError, ConfigError
-from ..motion.planner import MotionLimits
-from ..observers.recordings import Recordings
-from ..observers.trail import TrailKeeper
+from ..observers.recorder import Recorded
 from ..protocol.verbs.record import Record
-from ..robot.model import Robot
+from ..session.services import Services
 from ..transports.tcp_text import CommandServer
+from ..world.clock import Clock
 from ..world.effects import NullScene, Scene
+from ..world.state import RobotState
 from ..world.world import World
-from .cell import load_cell
 from .config import Settings
-from .robot_options import IniObject, ini_objects, limits_from, tool_from
+from .members import Member, furnish
 
-__all__ = ["MOTION_FLAGS", "Member", "members", "serve"]
+__all__ = ["serve", "write_page"]
 
 
 def _is_loopback(host: str) -> bool:
@@ -50,7 +41,15 @@ def _is_loopback(host: str) -> bool:
 _STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
-def _open_scene(settings: Settings, world: World, title: str | None) -> Scene:
+def write_page(recorded: Recorded, state: RobotState) -> Path:
+    """NAME.html of a finished recording (viser is loaded only now, in the recording's
+    thread, so a program without a viewer never loads it unless it records)."""
+    from ..view.record_page import write_html
+
+    return write_html(recorded, state)
+
+
+def _open_scene(settings: Settings, services: Services, title: str | None) -> Scene:
     if not settings.viewer:
         return NullScene()
     from ..view.policy import DoorPolicy
@@ -61,7 +60,12 @@ def _open_scene(settings: Settings, world: World, title: str | None) -> Scene:
         token = secrets.token_urlsafe(16)
     policy = DoorPolicy(settings.viewer_origins, token, settings.max_viewers)
     return ViserScene(
-        world, settings.viewer_host, settings.viewer_port, settings.hz, policy=policy, title=title
+        services,
+        settings.viewer_host,
+        settings.viewer_port,
+        settings.hz,
+        policy=policy,
+        title=title,
     )
 
 
@@ -75,21 +79,12 @@ def _cannot_listen(host: str, port: int, exc: OSError) -> str:
     return f"cannot listen for commands on {host}:{port}: {exc.strerror or exc}"
 
 
-@dataclass(frozen=True)
-class Member:
-    """One robot the program serves: its name, model, place in the world and port, and
-    what the ini gives it (``furnish``)."""
-
-    name: str
-    robot: Robot
-    origin: pin.SE3
-    port: int
-    limits: MotionLimits
-    tool: pin.SE3 | None = None
-    objects: tuple[IniObject, ...] = ()
-
-
-async def serve(settings: Settings, members: Sequence[Member], cell: str | None = None) -> int:
+async def serve(
+    settings: Settings,
+    members: Sequence[Member],
+    cell: str | None = None,
+    clock: Clock | None = None,
+) -> int:
     """Run the viewer and a command server per robot until ``quit``, SIGINT or SIGTERM.
 
     ``members`` are the robots, each by the name the user chose (``--robot kuka_lwr``,
@@ -102,23 +97,31 @@ async def serve(settings: Settings, members: Sequence[Member], cell: str | None 
     srdf = read_srdf(settings.srdf) if settings.srdf is not None else None
     world = World(
         {m.name: m.robot for m in members},
+        clock=clock,
         hz=settings.hz,
-        defaults=settings.session,
         origins={m.name: m.origin for m in members},
         limits={m.name: m.limits for m in members},
         disabled_pairs={members[0].name: srdf} if srdf is not None else None,
         max_objects=settings.max_objects,
     )
+    services = Services(
+        world,
+        limits=settings.limits,
+        defaults=settings.session,
+        record_dir=settings.record_dir,
+        trail_points=settings.trail_points,
+        exporters=(write_page,),
+    )
     try:
         for member in members:
-            _furnish(world, member)
-        _keep(world, settings)
+            furnish(world, member)
+        _record_from_start(services, settings)
     except C2rvizError as exc:
         print(f"c2rviz: {exc}", file=sys.stderr)
         return 2
     servers: list[CommandServer] = []
     for member in members:
-        server = CommandServer(world, settings.limits, on_quit=stop.set, robot=member.name)
+        server = CommandServer(services, on_quit=stop.set, robot=member.name)
         try:
             host, port = await server.start(settings.host, member.port)
         except OSError as exc:
@@ -129,7 +132,7 @@ async def serve(settings: Settings, members: Sequence[Member], cell: str | None 
         world.state(member.name).port = port
         servers.append(server)
     try:
-        scene = _open_scene(settings, world, cell)
+        scene = _open_scene(settings, services, cell)
     except (OSError, C2rvizError) as exc:
         problem = exc.strerror or exc if isinstance(exc, OSError) else exc
         print(
@@ -143,7 +146,7 @@ async def serve(settings: Settings, members: Sequence[Member], cell: str | None 
     world.add_observers([scene])  # no client is served before this: nothing awaited since
     for server in servers:
         server.viewer_url = scene.url
-    scene.start(world, loop)
+    scene.start(loop)
     for sig in _STOP_SIGNALS:
         loop.add_signal_handler(sig, stop.set)
     if cell is not None:
@@ -175,8 +178,8 @@ async def serve(settings: Settings, members: Sequence[Member], cell: str | None 
             loop.remove_signal_handler(sig)
         for server in servers:
             await server.stop()
-        world.close()
-        await _stop_recording(world)
+        services.close()
+        await _stop_recording(services)
         scene.stop()
     print("c2rviz: stopped", flush=True)
     return 0
@@ -197,106 +200,16 @@ def _banner(member: Member, host: str, port: int | None, in_cell: bool) -> None:
     )
 
 
-MOTION_FLAGS = ("max_velocity", "max_acceleration", "max_jerk")
-
-
-def _furnish(world: World, member: Member) -> None:
-    """Give a robot of the world its ini tool and objects (a bad object raises)."""
-    if member.tool is not None:
-        world.set_tool(member.name, member.tool)
-    for name, shape, size, placement, rgba, mesh in member.objects:
-
-        def add(model: CollisionModel) -> None:
-            model.set_object(name, shape, size, placement, rgba, mesh)  # noqa: B023 (run now)
-
-        world.edit_objects(member.name, add)
-
-
-def _member(
-    name: str,
-    robot: Robot,
-    origin: pin.SE3,
-    port: int,
-    section: str,
-    extras: tuple[tuple[str, str], ...],
-    ini: Path | None,
-    first: bool,
-    flags: dict[str, str],
-) -> Member:
-    given = {**dict(extras), **flags}
-    objects = tuple(ini_objects(ini, name, first)) if ini is not None else ()
-    return Member(
-        name,
-        robot,
-        origin,
-        port,
-        limits_from(section, given, robot),
-        tool_from(section, given),
-        objects,
-    )
-
-
-def members(settings: Settings, args: argparse.Namespace) -> tuple[list[Member], str | None]:
-    """The robots to serve: the cell's (``--cell``), or the one robot of the settings."""
-    flags = {k: getattr(args, k) for k in MOTION_FLAGS if getattr(args, k) is not None}
-    if args.cell is not None:
-        cell = load_cell(args.cell, settings.ini)
-        members: list[Member] = []
-        for part in cell.members:
-            found = part.entry
-            robot = Robot.from_urdf(
-                found.urdf,
-                found.base,
-                found.eelink,
-                package_paths=found.package_paths,
-                xacro_args=found.xacro_args,
-            )
-            x, y, z, roll, pitch, yaw = part.origin
-            origin = pin.SE3(pin.rpy.rpyToMatrix(roll, pitch, yaw), np.array([x, y, z]))
-            first = not members
-            members.append(
-                _member(
-                    part.name,
-                    robot,
-                    origin,
-                    part.port,
-                    found.name,
-                    part.extras,
-                    part.ini,
-                    first,
-                    flags,
-                )
-            )
-        return members, cell.name
-    assert settings.urdf is not None
-    robot = Robot.from_urdf(
-        settings.urdf,
-        settings.base,
-        settings.eelink,
-        package_paths=settings.package_paths,
-        xacro_args=settings.xacro_args,
-    )
-    # The name the user chose; a --urdf without --robot is named by its model.
-    name = robot.name if args.urdf is not None and args.robot is None else settings.robot
-    entry = settings.robots.get(settings.robot)
-    extras = entry.extras if entry is not None and args.urdf is None else ()
-    identity = pin.SE3.Identity()
-    member = _member(name, robot, identity, settings.port, name, extras, settings.ini, True, flags)
-    return [member], None
-
-
-def _keep(world: World, settings: Settings) -> None:
-    """Where recordings go and how long trails get; ``--record NAME`` begins now."""
-    TrailKeeper.of(world, settings.trail_points)
-    desk = Recordings.of(world, settings.record_dir)
+def _record_from_start(services: Services, settings: Settings) -> None:
+    """``--record NAME`` begins now."""
     if settings.record is not None:
         if Record.parse("record", [settings.record]).stop:  # the verb's rules for a name
             raise ConfigError("--record needs a name; 'stop' is not one")
-        desk.start(settings.record, world.default)
+        services.recordings.start(settings.record, services.world.default)
 
 
-async def _stop_recording(world: World) -> None:
-    desk = Recordings.of(world)
+async def _stop_recording(services: Services) -> None:
+    desk = services.recordings
     if desk.current is not None:
         done = await desk.stop("the program stopped")
         where = done.txt if done.error is None else f"{done.csv} ({done.error})"

@@ -9,47 +9,55 @@ robot as it stands now. Shapes are first compared by their bounding spheres
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import coal
 import numpy as np
 import pinocchio as pin
 
-if TYPE_CHECKING:
-    from ..world.world import World
+from .model import CollisionModel
 
-__all__ = ["first_hit_between"]
+__all__ = ["OtherRobot", "first_hit_between"]
+
+OtherRobot = tuple[str, CollisionModel, Sequence[float], pin.SE3]
+"""Another robot of the cell as it stands: name, collision model, joints [rad or m], origin."""
 
 
 def first_hit_between(
-    world: World, robot: str, path: Sequence[Sequence[float]]
+    model: CollisionModel,
+    origin: pin.SE3,
+    others: Sequence[OtherRobot],
+    path: Sequence[Sequence[float]],
 ) -> tuple[int, tuple[str, str]] | None:
-    """The first point of ``robot``'s ``path`` at which one of its links meets a link of
-    another robot of ``world``, and the pair (``link``, ``other_robot/link``); None if
-    none does (or the world has one robot)."""
-    state = world.state(robot)
-    others: list[tuple[str, Any, pin.SE3]] = []
-    for name, other in world.robots.items():
-        if name == robot:
-            continue
-        for link, geometry, placement in world.collision_model(name).link_shapes(other.q):
-            others.append((f"{name}/{link}", geometry, other.origin * placement))
-    if not others:
+    """The first point of a robot's ``path`` at which one of its links meets a link of
+    one of the ``others``, and the pair (``link``, ``other_robot/link``); None if none
+    does (or there are no others).
+
+    Args:
+        model: The moving robot's collision model.
+        origin: Where its root stands in the world (cell) frame.
+        others: The other robots of the cell as they stand.
+        path: The moving robot's chain values along its path [rad or m].
+    """
+    placed: list[tuple[str, Any, pin.SE3]] = [
+        (f"{name}/{link}", geometry, other_origin * placement)
+        for name, other_model, q, other_origin in others
+        for link, geometry, placement in other_model.link_shapes(q)
+    ]
+    if not placed:
         return None
-    model = world.collision_model(robot)
-    theirs = _spheres(others)
+    theirs = _spheres(placed)
     for index, q in enumerate(path):
         mine = [
-            (link, geometry, state.origin * placement)
-            for link, geometry, placement in model.link_shapes(q)
+            (link, shape, origin * placement) for link, shape, placement in model.link_shapes(q)
         ]
         ours = _spheres(mine)
         near = np.linalg.norm(ours[0][:, None, :] - theirs[0][None, :, :], axis=2) <= (
             ours[1][:, None] + theirs[1][None, :]
         )
         for i, j in zip(*np.nonzero(near)):
-            if _collide(mine[i], others[j]):
-                return index, (mine[i][0], others[j][0])
+            if _collide(mine[i], placed[j]):
+                return index, (mine[i][0], placed[j][0])
     return None
 
 

@@ -33,16 +33,14 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
-from typing import TYPE_CHECKING, TextIO
+from typing import TextIO
 
 import numpy as np
-import pinocchio as pin
 
 from ..protocol import replies
+from ..robot.frames import in_base, se3_pose, wxyz_se3
 from ..world.effects import Marker, Observer
-
-if TYPE_CHECKING:
-    from ..world.world import World
+from ..world.world import World
 
 __all__ = ["BUFFER_BYTES", "FLUSH_S", "Recorded", "Recorder"]
 
@@ -82,7 +80,7 @@ class Recorded:
     sources: tuple[str, ...]
     error: str | None = None
     html: Path | None = None
-    """The self-contained page (``record_html``), once written."""
+    """The self-contained page (``view.record_page``), once written."""
 
 
 def _numbers(values: Sequence[float]) -> str:
@@ -117,10 +115,10 @@ class Recorder(Observer):
         self.robot = robot
         self.name = name
         self.state = world.state(robot)
-        self.period_s = world.travels.frame_s
+        self.period_s = world.frame_s
         self.on_failed = on_failed
         self.started = datetime.now(timezone.utc)
-        self.t0 = world.clock()
+        self.t0 = world.clock.now()
         self.txt = folder / f"{name}.txt"
         self.csv = folder / f"{name}.csv"
         self.part = folder / f".{name}.txt.part"
@@ -151,7 +149,7 @@ class Recorder(Observer):
     @property
     def seconds(self) -> float:
         """How long it has been recording [s]."""
-        return self.world.clock() - self.t0
+        return self.world.clock.now() - self.t0
 
     # The world's effects.
 
@@ -171,12 +169,12 @@ class Recorder(Observer):
 
     def on_marker(self, robot: str, marker: Marker) -> None:
         if robot == self.robot and not self.closed:
-            self._catch_up(self.world.clock())
+            self._catch_up(self.world.clock.now())
             self._mark(marker)
 
     def on_clear_markers(self, robot: str) -> None:
         if robot == self.robot and not self.closed:
-            self._catch_up(self.world.clock())
+            self._catch_up(self.world.clock.now())
             # `clear` also homes the arm: put it back at once where it is (the home move,
             # if this clear came with one, follows as frames).
             self._write(self._body, f"clear\njoints {_numbers(self.state.q)}\n")
@@ -208,8 +206,7 @@ class Recorder(Observer):
     def _frame(self, q: Sequence[float], t: float) -> None:
         us = self._sleep_to(t)
         self._due = t + self.period_s
-        placement = self.state.robot.ee_pose(q) * self.state.tool
-        pose = replies.numbers([*placement.translation, *pin.rpy.matrixToRpy(placement.rotation)])
+        pose = replies.numbers(se3_pose(self.state.robot.ee_pose(q) * self.state.tool))
         self._write(self._body, f"joints {_numbers(q)}\n")  # exact: a replay is the same
         self._write(self._rows, f"{us / 1e6:.6f},{replies.numbers(q)},{pose}\n")
         self.frames += 1
@@ -229,11 +226,8 @@ class Recorder(Observer):
         if marker.shape != self._shape:
             self._shape = marker.shape
             lines.append(f"marker {marker.shape}\n")
-        w, x, y, z = marker.wxyz
-        in_world = pin.SE3(pin.Quaternion(w, x, y, z).toRotationMatrix(), np.array(marker.position))
-        pose = (self.state.origin * self.state.robot.base_placement).actInv(in_world)
-        rpy = pin.rpy.matrixToRpy(pose.rotation)
-        lines.append(f"mark {_numbers([*pose.translation, *rpy])}\n")
+        pose = se3_pose(in_base(self.state.base, wxyz_se3(marker.position, marker.wxyz)))
+        lines.append(f"mark {_numbers(pose)}\n")
         self._write(self._body, "".join(lines))
 
     def _write(self, file: TextIO, text: str) -> None:
@@ -269,7 +263,7 @@ class Recorder(Observer):
         """Write the last state and close the files (on the asyncio thread)."""
         if self.closed:
             return
-        now = self.world.clock()
+        now = self.world.clock.now()
         if self._pending is not None:
             self._frame(self._pending, min(now, self._due))
             self._pending = None

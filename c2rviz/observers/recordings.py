@@ -1,31 +1,26 @@
 """The recordings of a world: where they go, the one running, and the ``record`` errors.
 
-One recording at a time per world (``Recordings.of(world)``); it records the robot of
-the source that started it, from every source. Stopping returns a future that is done
-when the files are complete (the command file is put together in a thread).
+One recording at a time per world (the app makes one ``Recordings`` and hands it
+to the sessions); it records the robot of the source that started it, from every
+source. Stopping returns a future that is done when the files are complete (the
+command file is put together in a thread, then each exporter the app gave, such as
+the page ``NAME.html``, writes its file from the finished recording).
 """
 
 from __future__ import annotations
 
 import asyncio
 import logging
-import weakref
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
-from typing import TYPE_CHECKING
-
-import pinocchio as pin
 
 from ..errors import C2rvizError
-from ..robot.model import Robot
-from ..view.record_page import write_html
+from ..world.state import RobotState
+from ..world.world import World
 from .recorder import Recorded, Recorder
-from .watch import WatchHub
 
 log = logging.getLogger("c2rviz.record")
-
-if TYPE_CHECKING:
-    from ..world.world import World
 
 __all__ = [
     "DEFAULT_FOLDER",
@@ -34,11 +29,16 @@ __all__ = [
     "RecordFolderError",
     "RecordingError",
     "RecordingExists",
+    "Exporter",
     "Recordings",
 ]
 
 DEFAULT_FOLDER = Path("recordings")
 """Where recordings go unless told (``--record-dir``, ini ``record_dir``)."""
+
+Exporter = Callable[[Recorded, RobotState], Path]
+"""Writes one more file from a finished recording (blocking, run in a thread) and returns
+its path, such as ``view.record_page.write_html``'s NAME.html."""
 
 
 class RecordingError(C2rvizError):
@@ -82,27 +82,30 @@ class RecordFolderError(RecordingError):
         super().__init__(f"record: cannot record into {folder}: {why}")
 
 
-_DESKS: weakref.WeakKeyDictionary[World, Recordings] = weakref.WeakKeyDictionary()
-
-
 class Recordings:
     """The recordings of one world: the folder, the one running, the last one finished."""
 
-    def __init__(self, world: World, folder: Path = DEFAULT_FOLDER) -> None:
+    def __init__(
+        self,
+        world: World,
+        folder: Path = DEFAULT_FOLDER,
+        tell: Callable[[str], None] | None = None,
+        exporters: Sequence[Exporter] = (),
+    ) -> None:
+        """Set up.
+
+        Args:
+            world: What is recorded.
+            folder: Where recordings go (made when needed).
+            tell: Tells every watcher an event (``record-stopped NAME: WHY``).
+            exporters: What else is written from a finished recording (in order).
+        """
         self.world = world
         self.folder = folder
+        self.tell = tell
+        self.exporters = tuple(exporters)
         self.current: Recorder | None = None
         self.last: Recorded | None = None
-
-    @classmethod
-    def of(cls, world: World, folder: Path | None = None) -> Recordings:
-        """The desk of ``world`` (made on first use); ``folder`` sets where files go."""
-        desk = _DESKS.get(world)
-        if desk is None:
-            desk = _DESKS[world] = cls(world)
-        if folder is not None:
-            desk.folder = folder
-        return desk
 
     def start(self, name: str, robot: str, overwrite: bool = False) -> Recorder:
         """Begin recording ``robot`` as ``name``.
@@ -141,9 +144,8 @@ class Recordings:
             raise NotRecording()
         self._detach(recorder, why)
         recorder.stop()
-        state = recorder.state
         future = asyncio.ensure_future(
-            asyncio.to_thread(_finish, recorder, state.robot, state.origin)
+            asyncio.to_thread(_finish, recorder, recorder.state, self.exporters)
         )
         future.add_done_callback(self._finished)
         return future
@@ -164,14 +166,16 @@ class Recordings:
         self.current = None
         if recorder in self.world.observers:
             self.world.remove_observer(recorder)
-        WatchHub.of(self.world).event(f"record-stopped {recorder.name}: {why}")
+        if self.tell is not None:
+            self.tell(f"record-stopped {recorder.name}: {why}")
 
 
-def _finish(recorder: Recorder, robot: Robot, origin: pin.SE3) -> Recorded:
-    """NAME.txt put together, then NAME.html from the frames (blocking: for a thread)."""
+def _finish(recorder: Recorder, state: RobotState, exporters: Sequence[Exporter]) -> Recorded:
+    """NAME.txt put together, then each exporter's file (blocking: for a thread)."""
     recorded = recorder.finish()
-    try:
-        return replace(recorded, html=write_html(recorded, robot, origin))
-    except Exception as exc:  # the txt and csv stand; the page is a bonus
-        log.warning("recording %s: no page written: %s", recorded.name, exc)
-        return recorded
+    for export in exporters:
+        try:
+            recorded = replace(recorded, html=export(recorded, state))
+        except Exception as exc:  # the txt and csv stand; the rest is a bonus
+            log.warning("recording %s: no page written: %s", recorded.name, exc)
+    return recorded

@@ -1,6 +1,6 @@
 """The trail: the path of the tool point as the arm actually moves, kept for drawing.
 
-``TrailKeeper`` is one per world (``TrailKeeper.of(world)``), an observer that
+``TrailKeeper`` is one per world (the app makes it), an observer that
 keeps, for every robot whose trail is on, the tool point (the robot's ``tool`` on
 its end-effector link, as it is when the point is taken) in the robot's root frame
 [m] (the world frame for a robot at the world's origin; the page draws it under the
@@ -21,16 +21,13 @@ batch.
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..world.effects import Observer
-
-if TYPE_CHECKING:
-    from ..world.world import RobotState, World
+from ..world.state import RobotState
+from ..world.world import World
 
 __all__ = ["DEFAULT_TRAIL_POINTS", "MIN_TRAIL_POINTS", "RobotTrail", "TrailKeeper"]
 
@@ -99,9 +96,6 @@ class RobotTrail:
         self._count = len(older) + len(newer)
 
 
-_KEEPERS: weakref.WeakKeyDictionary[World, TrailKeeper] = weakref.WeakKeyDictionary()
-
-
 class TrailKeeper(Observer):
     """The trails of one world's robots (only those turned on are kept)."""
 
@@ -115,21 +109,13 @@ class TrailKeeper(Observer):
         self.changed = 0
         """Moves whenever a trail may look different (a point, on, off, clear)."""
 
-    @classmethod
-    def of(cls, world: World, cap: int | None = None) -> TrailKeeper:
-        """The keeper of ``world``, made on first use (with ``cap`` points per trail)."""
-        keeper = _KEEPERS.get(world)
-        if keeper is None:
-            keeper = _KEEPERS[world] = cls(world, DEFAULT_TRAIL_POINTS if cap is None else cap)
-        return keeper
-
     # What the `trail` verb does.
 
     def start(self, robot: str) -> None:
         """A fresh trail for ``robot``, from where the arm is now."""
         state = self.world.state(robot)
-        trail = RobotTrail(state, self.cap, self.world.travels.frame_s)
-        trail.add(state.q, self.world.clock())
+        trail = RobotTrail(state, self.cap, self.world.frame_s)
+        trail.add(state.q, self.world.clock.now())
         if not self.trails:
             self.world.add_observers([self])
         self.trails[robot] = trail
@@ -147,7 +133,7 @@ class TrailKeeper(Observer):
         trail = self.trails.get(robot)
         if trail is not None:
             trail.clear()
-            trail.add(self.world.state(robot).q, self.world.clock())
+            trail.add(self.world.state(robot).q, self.world.clock.now())
             self.changed += 1
 
     # What a view reads.

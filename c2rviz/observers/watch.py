@@ -21,30 +21,27 @@ Lines are written only while the socket's write buffer is below
 disconnected for it: at most ``STREAM_ALLOWANCE_BYTES`` of its buffer are stream
 lines, and the unread-replies limit does not count them.
 
-``WatchHub`` is one per world: the observer that fans the world's effects out to
-the active streams (it is in the world's observers only while someone watches,
-so an unwatched server pays nothing). ``WatchStream`` is one per connection.
+``WatchHub`` is one per world (the app makes it, and hands it to the sessions
+and the doors): the observer that fans the world's effects out to the active
+streams (it is in the world's observers only while someone watches, so an
+unwatched server pays nothing). ``WatchStream`` is one per connection.
 """
 
 from __future__ import annotations
 
 import asyncio
 import math
-import weakref
 from collections import deque
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Protocol
-
-import numpy as np
-import pinocchio as pin
+from typing import Protocol
 
 from ..errors import C2rvizError
 from ..protocol import replies
+from ..robot.frames import in_base, se3_pose, wxyz_se3
+from ..world.clock import Timer
 from ..world.effects import Marker, Observer
-
-if TYPE_CHECKING:
-    from ..session.session import Session
-    from ..world.world import World
+from ..world.state import RobotState
+from ..world.world import World
 
 __all__ = [
     "MAX_EVENTS",
@@ -52,6 +49,7 @@ __all__ = [
     "STREAM_HIGH_BYTES",
     "NotAConnection",
     "Sink",
+    "Watcher",
     "WatchHub",
     "WatchStream",
 ]
@@ -88,6 +86,20 @@ class Sink(Protocol):
     def closing(self) -> bool: ...
 
 
+class Watcher(Protocol):
+    """What a stream needs of the session it serves (``session.Session``)."""
+
+    source: str
+    state: RobotState
+
+    @property
+    def angle_scale(self) -> float: ...
+
+    def now(self) -> tuple[float, ...]: ...
+
+    def from_si(self, values: Sequence[float]) -> list[float]: ...
+
+
 class WatchStream:
     """One connection's stream: the latest state and the events not yet written.
 
@@ -96,7 +108,7 @@ class WatchStream:
     written at most once per ``period_s``.
     """
 
-    def __init__(self, hub: WatchHub, session: Session, sink: Sink) -> None:
+    def __init__(self, hub: WatchHub, session: Watcher, sink: Sink) -> None:
         self.hub = hub
         self.session = session
         self.sink = sink
@@ -112,7 +124,7 @@ class WatchStream:
         self._last_t = -math.inf  # clock time of the last state line [s]
         self._events: deque[tuple[int, str]] = deque()
         self._dropped = 0
-        self._handle: asyncio.Handle | asyncio.TimerHandle | None = None
+        self._handle: Timer | None = None
 
     def start(self, hz: float) -> None:
         """Stream at most ``hz`` states a second [1/s], beginning with the state now."""
@@ -124,7 +136,7 @@ class WatchStream:
             if transport is not None:
                 transport.set_write_buffer_limits(high=STREAM_HIGH_BYTES)
         self.active = True
-        self.state(self.session.now(), self.hub.world.clock(), self.hub.next_seq())
+        self.state(self.session.now(), self.hub.world.clock.now(), self.hub.next_seq())
 
     def stop(self) -> None:
         """Write nothing more (what is held is dropped)."""
@@ -144,7 +156,7 @@ class WatchStream:
         self._t = t
         self._seq = seq
         if self._handle is None and not self.paused:
-            self._handle = asyncio.get_running_loop().call_soon(self._flush)
+            self._handle = self.hub.world.clock.call_later(0.0, self._flush)
 
     def event(self, text: str, seq: int) -> None:
         events = self._events
@@ -153,7 +165,7 @@ class WatchStream:
             self._dropped += 1
         events.append((seq, text))
         if self._handle is None and not self.paused:
-            self._handle = asyncio.get_running_loop().call_soon(self._flush)
+            self._handle = self.hub.world.clock.call_later(0.0, self._flush)
 
     # Write flow control (forwarded by the connection).
 
@@ -166,7 +178,7 @@ class WatchStream:
     def resume(self) -> None:
         self.paused = False
         if self.active and self._handle is None and (self._q is not None or self._events):
-            self._handle = asyncio.get_running_loop().call_soon(self._flush)
+            self._handle = self.hub.world.clock.call_later(0.0, self._flush)
 
     def _flush(self) -> None:
         """Write the events, and the state when one is due; come back when the next is."""
@@ -186,7 +198,7 @@ class WatchStream:
         while events and (q is None or events[0][0] < self._seq):
             lines.append(events.popleft()[1])
         if q is not None:
-            now = self.hub.world.clock()
+            now = self.hub.world.clock.now()
             due = self._last_t + self.period_s
             if now >= due:
                 t = max(self._t, due)  # the state is the latest: the arm showed it at t
@@ -197,14 +209,10 @@ class WatchStream:
                 while events:
                     lines.append(events.popleft()[1])
             else:
-                loop = asyncio.get_running_loop()
-                self._handle = loop.call_later(due - now, self._flush)
+                self._handle = self.hub.world.clock.call_at(due, self._flush)
         if lines:
             lines.append("")
             transport.write("\n".join(lines).encode())
-
-
-_HUBS: weakref.WeakKeyDictionary[World, WatchHub] = weakref.WeakKeyDictionary()
 
 
 class WatchHub(Observer):
@@ -212,25 +220,16 @@ class WatchHub(Observer):
 
     def __init__(self, world: World) -> None:
         self.world = world
-        self.origin = world.clock()
+        self.origin = world.clock.now()
         """Clock time [s] that ``state`` lines count from (the server's start)."""
-        self.streams: dict[Session, WatchStream] = {}
+        self.streams: dict[Watcher, WatchStream] = {}
         self.active: list[WatchStream] = []
         self._seq = 0
-        self._moving: set[str] = set()  # robots seen travelling at their last state
-
-    @classmethod
-    def of(cls, world: World) -> WatchHub:
-        """The hub of ``world`` (made on first use; the server makes it as it starts)."""
-        hub = _HUBS.get(world)
-        if hub is None:
-            hub = _HUBS[world] = cls(world)
-        return hub
 
     @property
     def default_hz(self) -> float:
         """The frame rate [1/s]: a watcher's default."""
-        return 1.0 / self.world.travels.frame_s
+        return 1.0 / self.world.frame_s
 
     def next_seq(self) -> int:
         self._seq += 1
@@ -238,18 +237,18 @@ class WatchHub(Observer):
 
     # Connections.
 
-    def open(self, session: Session, sink: Sink) -> WatchStream:
+    def open(self, session: Watcher, sink: Sink) -> WatchStream:
         """The (idle) stream of a new connection."""
         stream = self.streams[session] = WatchStream(self, session, sink)
         return stream
 
-    def close(self, session: Session) -> None:
+    def close(self, session: Watcher) -> None:
         """The connection is gone."""
         stream = self.streams.pop(session, None)
         if stream is not None:
             self._deactivate(stream)
 
-    def watch(self, session: Session, hz: float | None) -> None:
+    def watch(self, session: Watcher, hz: float | None) -> None:
         """Start (or re-rate) ``session``'s stream.
 
         Raises:
@@ -261,11 +260,10 @@ class WatchHub(Observer):
         stream.start(self.default_hz if hz is None else hz)
         if stream not in self.active:
             if not self.active:
-                self._moving.clear()
                 self.world.add_observers([self])
             self.active.append(stream)
 
-    def unwatch(self, session: Session) -> bool:
+    def unwatch(self, session: Watcher) -> bool:
         """Stop ``session``'s stream; False if it was not watching."""
         stream = self.streams.get(session)
         if stream is None or not stream.active:
@@ -296,32 +294,27 @@ class WatchHub(Observer):
         for stream in self.active:
             if stream.robot == robot:
                 stream.state(values, t, seq)
-        travel = self.world.robots[robot].travel
-        if travel.active:
-            if robot not in self._moving:
-                self._moving.add(robot)
-        elif self._moving and robot in self._moving:
-            self._moving.discard(robot)
-            if travel.synced:  # it came to rest (not cut short by an instant command)
-                self.event("stopped" if travel.stopping else "arrived", robot)
 
     def on_marker(self, robot: str, marker: Marker) -> None:
         seq = self.next_seq()
-        state = self.world.robots[robot]
-        base = state.origin * state.robot.base_placement
-        w, x, y, z = marker.wxyz
-        rotation = pin.Quaternion(w, x, y, z).toRotationMatrix()
-        placement = base.actInv(pin.SE3(rotation, np.array(marker.position)))
-        rpy = pin.rpy.matrixToRpy(placement.rotation)
+        x, y, z, roll, pitch, yaw = se3_pose(
+            in_base(self.world.robots[robot].base, wxyz_se3(marker.position, marker.wxyz))
+        )
         rgb = replies.numbers(marker.rgb)
         for stream in self.active:
             if stream.robot == robot:
                 angle = stream.session.angle_scale
-                pose = replies.numbers([*placement.translation, *(rpy / angle)])
+                pose = replies.numbers([x, y, z, roll / angle, pitch / angle, yaw / angle])
                 stream.event(f"event marker {pose} {marker.shape} {rgb}", seq)
 
     def on_clear_markers(self, robot: str) -> None:
         self.event("clear", robot)
+
+    def on_arrived(self, robot: str) -> None:
+        self.event("arrived", robot)
+
+    def on_stopped(self, robot: str) -> None:
+        self.event("stopped", robot)
 
     def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
         self.event(f"collision {replies.pairs(pairs)}", robot)

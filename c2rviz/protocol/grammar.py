@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Sequence
 
 from ..errors import BadArguments, LineError, UnknownCommand, shown
 from .registry import LOOKUP, usage
@@ -34,6 +35,7 @@ __all__ = [
     "indices",
     "numbers",
     "numbers_arg",
+    "numbers_batch",
     "one_word",
     "parse_line",
 ]
@@ -98,6 +100,20 @@ def numbers(verb: str, text: str) -> tuple[float, ...]:
         big = next(item for item in text.split(",") if not math.isfinite(float(item)))
         raise BadArguments(verb, f"value {shown(big)} is not a finite number", usage(verb))
     return values
+
+
+def numbers_batch(texts: Sequence[str], n: int) -> list[float] | None:
+    """The values of several comma lists of exactly ``n`` decimals each, read in one go: the
+    hot path of a controller streaming ``joints`` lines. None when any list is not plainly
+    that (its line is then parsed alone, by ``numbers``, which says what is wrong)."""
+    joined = ",".join(texts)
+    commas = n - 1
+    if _NUMBER_CHARS_RE.fullmatch(joined) is None or any(t.count(",") != commas for t in texts):
+        return None
+    try:
+        return list(map(float, joined.split(",")))  # as ``numbers``: float() judges them
+    except ValueError:
+        return None  # an empty or malformed value: its line says which
 
 
 def indices(verb: str, text: str) -> tuple[int, ...]:

@@ -12,59 +12,27 @@ bad command never moves the robot partly.
 from __future__ import annotations
 
 import asyncio
-import itertools
 import math
-import re
 from collections.abc import Sequence
-from dataclasses import dataclass
-from operator import le, mul
 
-from ..app.config import ServerLimits
+import pinocchio as pin
+
 from ..collision.model import segment
 from ..collision.other_robots import first_hit_between
 from ..errors import C2rvizError, JointLimitError, PathCollides
 from ..protocol import replies
-from ..protocol.grammar import parse_line
+from ..protocol.grammar import numbers_batch, parse_line
 from ..protocol.registry import HANDLERS, Reply
-from ..robot.model import Robot
+from ..robot.frames import pose_se3, se3_pose
 from ..tolerance import within_limit
-from ..world.world import RobotState, World
+from ..world.moves import Travel
+from ..world.state import RobotState
+from .services import Services
+from .units import UnitTable
 
 __all__ = ["Session", "UnitTable"]
 
-_NUMBER_CHARS = re.compile(r"[0-9.,eE+-]*")  # as commands.numbers lets float() judge them
 _CADENCE_S = 0.02  # a pause this soon after the previous one's end continues its cadence
-
-
-@dataclass(frozen=True, slots=True)
-class UnitTable:
-    """The chain's limits in one unit mode, and the factor from it to SI.
-
-    Attributes:
-        scale: Per joint, SI value = client value * scale.
-        lower, upper: Limits in client units.
-        unit: Per joint, ``deg``, ``rad`` or ``m``.
-        identity: Every scale is 1 (radians and metres): client values are SI as they are.
-    """
-
-    scale: tuple[float, ...]
-    lower: tuple[float, ...]
-    upper: tuple[float, ...]
-    unit: tuple[str, ...]
-    identity: bool
-
-    @classmethod
-    def build(cls, robot: Robot, degrees: bool) -> UnitTable:
-        angle = math.pi / 180.0 if degrees else 1.0
-        scale = tuple(1.0 if p else angle for p in robot.prismatic)
-        angle_unit = "deg" if degrees else "rad"
-        return cls(
-            scale=scale,
-            lower=tuple(lo / s for lo, s in zip(robot.lower, scale)),
-            upper=tuple(hi / s for hi, s in zip(robot.upper, scale)),
-            unit=tuple("m" if p else angle_unit for p in robot.prismatic),
-            identity=all(s == 1.0 for s in scale),
-        )
 
 
 class Session:
@@ -72,7 +40,7 @@ class Session:
 
     Attributes:
         source: Who speaks (``tcp 127.0.0.1:5123``, ``page``), for notes and errors.
-        motion: ``off``, ``on`` or ``follow`` (``lang.motion.MOTION_MODES``).
+        motion: ``off``, ``on`` or ``follow`` (``protocol.verbs.motion.MOTION_MODES``).
         speed: Moves at this % of the joints' limits.
         guard: Refuse commands whose target or path collides.
         lspeed: ``movel``'s tool speed [m/s].
@@ -80,25 +48,22 @@ class Session:
             after this reply (and for ``quit`` stops the program).
     """
 
-    def __init__(
-        self,
-        world: World,
-        source: str = "tcp",
-        limits: ServerLimits | None = None,
-        robot: str | None = None,
-    ) -> None:
-        self.world = world
+    def __init__(self, services: Services, source: str = "tcp", robot: str | None = None) -> None:
+        """A session of ``source`` driving ``robot`` (None: the world's default robot)."""
+        self.services = services
+        self.world = services.world
         self.source = source
-        self.limits = limits if limits is not None else ServerLimits()
+        self.limits = services.limits
         self.degrees = False
         self.rgb: tuple[float, float, float] = (1.0, 0.0, 0.0)
         self.shape = "sphere"
         self.hangup: str | None = None
-        self._pause_end = -math.inf  # when the latest `after` was due [loop time, s]
-        self.motion = world.defaults.motion
-        self.speed = world.defaults.speed
-        self.guard = world.defaults.guard
-        self.lspeed = world.defaults.lspeed
+        self._pause_end = -math.inf  # when the latest `after` was due [clock s]
+        defaults = services.defaults
+        self.motion = defaults.motion
+        self.speed = defaults.speed
+        self.guard = defaults.guard
+        self.lspeed = defaults.lspeed
         self.select(robot)
 
     def select(self, name: str | None) -> None:
@@ -108,6 +73,7 @@ class Session:
             UnknownRobot: naming the robots there are; nothing changes.
         """
         self.state: RobotState = self.world.state(name)
+        self.travel: Travel = self.world.travel(self.state.name)
         self.robot = self.state.robot
         self.n = self.robot.n  # Robot.n is a property; this is read per command
         self._tables = (UnitTable.build(self.robot, False), UnitTable.build(self.robot, True))
@@ -142,7 +108,9 @@ class Session:
             points = path or segment(self.robot, self.now(), q)
         found = model.first_collision(points)
         if found is None and len(self.world.robots) > 1:
-            found = first_hit_between(self.world, self.state.name, points)
+            found = first_hit_between(
+                model, self.state.origin, self.world.others(self.state.name), points
+            )
         if found is not None:
             index, (first, second) = found
             raise PathCollides(first, second, index / max(len(points) - 1, 1), at_target)
@@ -155,33 +123,16 @@ class Session:
         reply and error is exactly as if they had been."""
         if self.motion != "off" or self.guard:
             return False
-        commas = self.n - 1
-        joined = ",".join(texts)
-        if _NUMBER_CHARS.fullmatch(joined) is None or any(t.count(",") != commas for t in texts):
-            return False
-        try:
-            flat = list(map(float, joined.split(",")))
-        except ValueError:
-            return False  # an empty or malformed value: its line says which
+        flat = numbers_batch(texts, self.n)
         table = self.table
-        if not (
-            math.isfinite(sum(flat))
-            and all(map(le, itertools.cycle(table.lower), flat))
-            and all(map(le, flat, itertools.cycle(table.upper)))
-        ):
+        if flat is None or not table.within(flat):
             return False
-        last = flat[-self.n :]
-        self.world.set_q(
-            last if table.identity else list(map(mul, last, table.scale)),
-            self.state.name,
-            self.source,
-        )
+        self.world.set_q(table.to_si(flat[-self.n :]), self.state.name, self.source)
         return True
 
     def now(self) -> tuple[float, ...]:
         """The robot's joints at this instant [rad or m] (mid-move too)."""
-        state = self.state
-        return self.world.travels.now(state) if state.travel.active else state.q
+        return self.world.travels.now(self.state) if self.travel.active else self.state.q
 
     def set_degrees(self, degrees: bool) -> None:
         self.degrees = degrees
@@ -219,16 +170,29 @@ class Session:
         counts from that one's end, so a timer that fires a little late does not
         make a replay drift: ``sleep`` keeps a script's cadence.
         """
-        loop = asyncio.get_running_loop()
-        now = loop.time()
+        clock = self.world.clock
+        now = clock.now()
         start = self._pause_end if 0.0 <= now - self._pause_end <= _CADENCE_S else now
         self._pause_end = start + seconds
-        future: asyncio.Future[str] = loop.create_future()
-        timer = loop.call_at(self._pause_end, _settle, future, reply)
+        future: asyncio.Future[str] = asyncio.get_running_loop().create_future()
+        timer = clock.call_at(self._pause_end, _settle, future, reply)
         future.add_done_callback(lambda _: timer.cancel())
         return future
 
     # The unit boundary.
+
+    def pose_se3(self, pose: Sequence[float]) -> pin.SE3:
+        """A pose as this source writes it (x, y, z [m]; roll, pitch, yaw in its angle unit)
+        as a placement."""
+        x, y, z, roll, pitch, yaw = pose
+        angle = self.angle_scale
+        return pose_se3((x, y, z, roll * angle, pitch * angle, yaw * angle))
+
+    def pose_text(self, placement: pin.SE3) -> str:
+        """A placement as this source reads a pose: ``x,y,z,roll,pitch,yaw`` in its units."""
+        x, y, z, roll, pitch, yaw = se3_pose(placement)
+        angle = self.angle_scale
+        return replies.numbers([x, y, z, roll / angle, pitch / angle, yaw / angle])
 
     def to_si(self, indices: Sequence[int], values: Sequence[float]) -> list[float]:
         """Check ``values`` (client units) against the limits; return them in SI.

@@ -1,9 +1,10 @@
-"""The TCP side: an asyncio line server in front of the shared world.
+"""The seed's door: the text protocol over TCP, an asyncio driver of the line framer.
 
-Each connection is an ``asyncio.Protocol``: it splits what arrives into lines,
-runs every complete line through its ``Session`` (the one way in), and answers
-all lines of one read (up to ``_BATCH_BYTES`` of them: a big read is run in
-batches, one loop turn each) with one write. A turn also ends after
+Each connection is an ``asyncio.Protocol``: its ``protocol.framing.LineFramer``
+cuts what arrives into lines, every complete line runs through the connection's
+``Session`` (the one way in), and all lines of one batch (up to the framer's
+``BATCH_BYTES`` of them: a big read is run in batches, one loop turn each) are
+answered with one write. A turn also ends after
 ``TURN_S`` of work, so a flood of costly lines (a ``mark`` computes forward
 kinematics) delays the other clients no more than a flood of cheap ones.
 Nothing here knows kinematics or drawing. The limits in ``config.ServerLimits``
@@ -17,23 +18,21 @@ import asyncio
 import itertools
 import logging
 import time
-from collections.abc import Awaitable, Callable
+from collections.abc import Awaitable, Callable, Sequence
 from itertools import chain
 
-from ..app.config import ServerLimits
-from ..errors import C2rvizError, LineError, LineTooLong
-from ..observers.watch import STREAM_ALLOWANCE_BYTES, WatchHub
+from ..errors import C2rvizError, LineTooLong
+from ..observers.watch import STREAM_ALLOWANCE_BYTES
 from ..protocol import replies
+from ..protocol.framing import Line, LineFramer
 from ..protocol.grammar import ForeignProtocol, parse_line
 from ..protocol.registry import VERBS
+from ..session.services import Services
 from ..session.session import Session
-from ..world.world import World
 
 __all__ = ["CommandServer", "Connection"]
 
 log = logging.getLogger("c2rviz.server")
-
-Line = str | C2rvizError  # a decoded line, or why it could not be one
 
 
 class Connection(asyncio.Protocol):
@@ -47,11 +46,11 @@ class Connection(asyncio.Protocol):
     def __init__(self, server: CommandServer) -> None:
         self.server = server
         self.limits = server.limits
-        self.session = Session(server.world, limits=server.limits, robot=server.robot)
+        self.session = Session(server.services, robot=server.robot)
         self.transport: asyncio.Transport | None = None
         self.peer = "?"
-        self.buffer = b""
-        self.backlog: list[Line] = []  # lines read but waiting behind a reply
+        self.framer = LineFramer(self.limits.max_line)
+        self.backlog: Sequence[Line] = []  # lines read but waiting behind a reply
         self.pending: asyncio.Future[str] | None = None  # the reply being waited for
         self.yield_timer: asyncio.Handle | None = None  # set while yielding to other clients
         self.partial_timer: asyncio.TimerHandle | None = None
@@ -59,7 +58,7 @@ class Connection(asyncio.Protocol):
         self.closing = False
         self.eof = False
         self.closed = asyncio.get_running_loop().create_future()
-        self.stream = server.watch.open(self.session, self)  # idle until `watch`
+        self.stream = server.services.watch.open(self.session, self)  # idle until `watch`
 
     @property
     def waiting(self) -> bool:
@@ -83,20 +82,20 @@ class Connection(asyncio.Protocol):
             self._close_with(replies.too_many_clients(self.limits.max_clients))
         else:
             server.connections.add(self)
-            server.world.set_client_count(len(server.connections))
+            server.count_clients()
             log.info("client %s connected", self.peer)
 
     def connection_lost(self, exc: Exception | None) -> None:
         self._cancel_timers()
         self.closing = True
-        self.server.watch.close(self.session)
+        self.server.services.watch.close(self.session)
         if self.pending is not None:
             self.pending.cancel()
         server = self.server
         server.open.discard(self)
         if self in server.connections:
             server.connections.discard(self)
-            server.world.set_client_count(len(server.connections))
+            server.count_clients()
             log.info("client %s left", self.peer)
         if not self.closed.done():
             self.closed.set_result(None)
@@ -104,11 +103,9 @@ class Connection(asyncio.Protocol):
     def data_received(self, data: bytes) -> None:
         if self.closing:
             return
-        buffer = self.buffer + data if self.buffer else data
-        if self.waiting:
-            self.buffer = buffer  # reading is paused; the wake-up goes on from here
-            return
-        self._consume(buffer)
+        self.framer.feed(data)
+        if not self.waiting:  # else reading is paused; the wake-up goes on from here
+            self._consume()
 
     def eof_received(self) -> bool:
         self.eof = True
@@ -128,54 +125,27 @@ class Connection(asyncio.Protocol):
 
     # line handling
 
-    def _consume(self, buffer: bytes) -> None:
-        """Run the complete lines in ``buffer``, one batch of them; keep the rest."""
-        cut = buffer.rfind(b"\n", 0, _BATCH_BYTES)
-        if cut < 0:
-            cut = buffer.find(b"\n")  # the first line is longer than a batch
-        if cut >= 0:
-            self.buffer = buffer[cut + 1 :]
+    def _consume(self) -> None:
+        """Run one batch of the complete lines the framer holds; keep the rest."""
+        framer = self.framer
+        lines = framer.take()
+        if lines is not None:
             if self.partial_timer is not None:  # the line it timed is finished
                 self.partial_timer.cancel()
                 self.partial_timer = None
-            self._run(self._decode(buffer[:cut]))
-        else:
-            self.buffer = buffer
+            self._run(lines)
         if self.closing or self.waiting:
             return  # while paused we do not read, so an unfinished line is not the client's fault
-        if b"\n" in self.buffer:  # more complete lines: let the other clients in first
+        if framer.has_line:  # more complete lines: let the other clients in first
             self._yield([])
-        elif len(self.buffer) > self.limits.max_line:
+        elif framer.too_long:
             self._close_with(replies.error(LineTooLong(self.limits.max_line)))
-        elif self.buffer and self.partial_timer is None:
+        elif framer.buffer and self.partial_timer is None:
             self.partial_timer = asyncio.get_running_loop().call_later(
                 self.limits.partial_timeout_s, self._partial_timeout
             )
 
-    def _decode(self, complete: bytes) -> list[Line]:
-        """Split complete lines; mark the undecodable and the over-long ones."""
-        max_line = self.limits.max_line
-        if complete.isascii():  # the usual case: one decode and one split for the batch
-            split = complete.decode("ascii").split("\n")
-            if len(complete) <= max_line or max(map(len, split)) <= max_line:
-                return split  # type: ignore[return-value]
-        elif len(complete) <= max_line:
-            try:
-                return complete.decode().split("\n")  # type: ignore[return-value]
-            except UnicodeDecodeError:
-                pass
-        lines: list[Line] = []
-        for raw in complete.split(b"\n"):
-            if len(raw) > max_line:
-                lines.append(LineTooLong(max_line))
-                break  # the connection closes here; nothing after it runs
-            try:
-                lines.append(raw.decode())
-            except UnicodeDecodeError:
-                lines.append(LineError(replies.NOT_UTF8))
-        return lines
-
-    def _run(self, lines: list[Line]) -> None:
+    def _run(self, lines: Sequence[Line]) -> None:
         """Answer ``lines`` in order, stopping at a reply that waits, bye, quit or a fatal line,
         or after ``TURN_S`` of work (the rest runs after the other clients' turns)."""
         out: list[str] = []
@@ -191,21 +161,21 @@ class Connection(asyncio.Protocol):
                 self._write(out)
                 self._yield(lines[i:])
                 return
-            if line.__class__ is str and line.startswith(_PLAIN_JOINTS):
-                skip_to = self._joints_run(lines, i, out)
-                if skip_to > i:
-                    continue
             try:
-                if line.__class__ is not str:
-                    raise line  # type: ignore[misc]
-                answer = run(line)  # type: ignore[arg-type]
+                if not isinstance(line, str):
+                    raise line
+                if line.startswith(_PLAIN_JOINTS):
+                    skip_to = self._joints_run(lines, i, out)
+                    if skip_to > i:
+                        continue
+                answer = run(line)
                 if answer is None:
                     continue
-                if answer.__class__ is not str:  # a reply that waits
+                if not isinstance(answer, str):  # a reply that waits
                     self._write(out)
-                    self._wait(answer, lines[i + 1 :])  # type: ignore[arg-type]
+                    self._wait(answer, lines[i + 1 :])
                     return
-                reply(answer)  # type: ignore[arg-type]
+                reply(answer)
                 if session.hangup is not None:
                     self._write(out)
                     self._hang_up(lines[i + 1 :])
@@ -228,34 +198,34 @@ class Connection(asyncio.Protocol):
                 reply(replies.error("internal error (see the server log)"))
         self._write(out)
 
-    def _joints_run(self, lines: list[Line], start: int, out: list[str]) -> int:
+    def _joints_run(self, lines: Sequence[Line], start: int, out: list[str]) -> int:
         """Answer the run of plain ``joints`` lines from ``start`` as a batch, if it checks
         whole (``Session.joints_run``); return where the run ends (``start``: not taken)."""
-        end = start
-        texts = []
+        run: list[str] = []
         for line in itertools.islice(lines, start, None):
-            if line.__class__ is not str or not line.startswith(_PLAIN_JOINTS):  # type: ignore[union-attr]
+            if not isinstance(line, str) or not line.startswith(_PLAIN_JOINTS):
                 break
-            text = line[line.index(" ") + 1 :]  # type: ignore[union-attr]
-            texts.append(text[:-1] if text.endswith("\r") else text)
-            end += 1
-        if end - start < 2 or not self.session.joints_run(texts):
+            run.append(line)
+        if len(run) < 2:
             return start
-        note = self.server.world.note
+        texts = [line[line.index(" ") + 1 :].removesuffix("\r") for line in run]
+        if not self.session.joints_run(texts):
+            return start
+        note = self.session.world.note
         source = self.session.source
-        for line in itertools.islice(lines, start, end):
-            note(source, line, True)  # type: ignore[arg-type]
-        out.extend([replies.OK] * (end - start))
-        return end
+        for line in run:
+            note(source, line, True)
+        out.extend([replies.OK] * len(run))
+        return start + len(run)
 
-    def _hang_up(self, rest: list[Line]) -> None:
+    def _hang_up(self, rest: Sequence[Line]) -> None:
         """After ``bye`` or ``quit``: close (``quit`` also stops the program)."""
         if self.session.hangup == "quit":
             self._write([replies.SHUTTING_DOWN] * self._unanswered(rest))
             self.server.request_quit()  # before the close: a client seeing EOF sees it done
         self._close()
 
-    def _wait(self, answer: Awaitable[str], rest: list[Line]) -> None:
+    def _wait(self, answer: Awaitable[str], rest: Sequence[Line]) -> None:
         """Stop reading until ``answer`` is ready; then reply and run ``rest``."""
         self.backlog = rest
         self._pause_reading()
@@ -281,7 +251,7 @@ class Connection(asyncio.Protocol):
         self._write([text])
         self._go_on()
 
-    def _yield(self, rest: list[Line]) -> None:
+    def _yield(self, rest: Sequence[Line]) -> None:
         """Stop reading for a loop turn, so the other clients go first; then run ``rest``."""
         self.backlog = rest
         self._pause_reading()
@@ -298,8 +268,7 @@ class Connection(asyncio.Protocol):
         self._run(backlog)
         if self.closing or self.waiting:
             return
-        buffer, self.buffer = self.buffer, b""
-        self._consume(buffer)
+        self._consume()
         if self.closing or self.waiting:
             return
         if self.eof:
@@ -313,7 +282,7 @@ class Connection(asyncio.Protocol):
 
     def _partial_timeout(self) -> None:
         self.partial_timer = None
-        if self.buffer and not self.closing:
+        if self.framer.buffer and not self.closing:
             self._close_with(replies.incomplete_line(self.limits.partial_timeout_s))
 
     # output and closing
@@ -341,7 +310,7 @@ class Connection(asyncio.Protocol):
         closes too, for at most ``_LINGER_S``.
         """
         self.closing = True
-        self.buffer = b""
+        self.framer.clear()
         self._cancel_timers()
         transport = self.transport
         if transport is None or transport.is_closing():
@@ -370,26 +339,23 @@ class Connection(asyncio.Protocol):
             self.pending.cancel()
         self._close()
 
-    def _unanswered(self, rest: list[Line]) -> int:
+    def _unanswered(self, rest: Sequence[Line]) -> int:
         """How many of ``rest`` and the complete lines still buffered would get a reply."""
-        cut = self.buffer.rfind(b"\n")
-        buffered = self._decode(self.buffer[:cut]) if cut >= 0 else []
-        return sum(map(_is_command, chain(rest, buffered)))
+        return sum(map(_is_command, chain(rest, self.framer.complete())))
 
 
 def _is_command(line: Line) -> bool:
     """True for a line that would get a reply (not blank, not only a comment)."""
-    if line.__class__ is not str:
+    if not isinstance(line, str):
         return True
     try:
-        return parse_line(line) is not None  # type: ignore[arg-type]
+        return parse_line(line) is not None
     except C2rvizError:
         return True
 
 
 # How a controller streaming setpoints writes them: the registry's spellings of `joints`.
 _PLAIN_JOINTS = tuple(f"{name} " for name in (VERBS["joints"].name, *VERBS["joints"].aliases))
-_BATCH_BYTES = 8192  # complete lines run per client per loop turn
 TURN_S = 0.002  # work per client per loop turn [s]: then the others go first
 _TURN_CHECK = 32  # lines between looks at the clock
 _LINGER_S = 2.0  # after the last reply, how long a closing client's input is read and dropped
@@ -400,8 +366,7 @@ class CommandServer:
 
     def __init__(
         self,
-        world: World,
-        limits: ServerLimits | None = None,
+        services: Services,
         on_quit: Callable[[], None] | None = None,
         robot: str | None = None,
         viewer_url: str | None = None,
@@ -409,8 +374,8 @@ class CommandServer:
         """Set up the server; ``start`` makes it listen.
 
         Args:
-            world: The shared state every client acts on.
-            limits: What one client may cost.
+            services: The world every client acts on, and what sessions share (its
+                ``limits`` say what one client may cost).
             on_quit: Called once when a client sends ``quit``.
             robot: The robot its clients drive until they say ``robot NAME`` (None:
                 the world's default).
@@ -418,17 +383,22 @@ class CommandServer:
                 command port (None: no viewer). The attribute may be set later,
                 once the viewer is up.
         """
-        self.world = world
+        self.services = services
+        self.world = services.world
         self.viewer_url = viewer_url
-        self.limits = limits if limits is not None else ServerLimits()
+        self.limits = services.limits
         self.on_quit = on_quit
         self.robot = robot
         self.connections: set[Connection] = set()  # the clients being served
         self.open: set[Connection] = set()  # those and the refused ones, until their socket closes
         self.stopping = False
         self.quit_requested = False
-        self.watch = WatchHub.of(world)  # `watch` streams count time from here
         self._server: asyncio.Server | None = None
+        self._door = f"tcp {id(self)}"
+
+    def count_clients(self) -> None:
+        """Tell the program how many clients this door serves now."""
+        self.services.count_clients(self._door, len(self.connections))
 
     async def start(self, host: str = "127.0.0.1", port: int = 0) -> tuple[str, int]:
         """Start listening; return the address actually bound (port 0 picks one)."""

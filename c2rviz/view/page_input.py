@@ -31,7 +31,6 @@ from typing import Any
 import viser
 
 from ..errors import C2rvizError, MotionInterrupted
-from ..observers.trail import TrailKeeper
 from ..session.session import Session
 from . import adapter
 from .markers import MarkerLayer
@@ -176,7 +175,7 @@ class PageInput:
 
     def _trail(self, panel: RobotPanel, session: Session, client: int, value: Any) -> None:
         self._line(session, "trail on" if value is True else "trail off")
-        on = session.state.name in TrailKeeper.of(session.world).trails
+        on = session.state.name in session.services.trails.trails
         adapter.set_gui_value(panel.trail, on, force=True)
 
     def _line(self, session: Session, line: str) -> bool:

@@ -28,6 +28,7 @@ from ..protocol.verbs.markers import Clear, Color, Mark, MarkerShape
 from ..robot.model import Robot
 from ..robot.visuals import load_link_geometry
 from ..world.effects import Marker
+from ..world.state import RobotState
 from . import adapter
 from .markers import MarkerLayer
 from .robot_view import RobotView
@@ -42,8 +43,10 @@ MAX_HTML_FRAMES = 20_000
 """Most frames kept in NAME.html (11 minutes at ``HTML_HZ``); a longer run is thinned."""
 
 
-def write_html(recorded: Recorded, robot: Robot, origin: pin.SE3) -> Path:
-    """Write NAME.html next to NAME.csv; blocking (for a thread). Returns its path."""
+def write_html(recorded: Recorded, state: RobotState) -> Path:
+    """Write NAME.html next to NAME.csv for the recording of ``state``'s robot; blocking
+    (for a thread). Returns its path (an ``observers.recordings.Exporter``)."""
+    robot, origin = state.robot, state.origin
     times, joints = _frames(recorded.csv, robot.n)
     server = adapter.start("127.0.0.1", 0)  # offline: nothing connects to it
     try:

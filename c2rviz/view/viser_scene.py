@@ -27,11 +27,10 @@ import numpy as np
 import pinocchio as pin
 
 from ..collision.workcell import WorkcellObject
-from ..observers.trail import TrailKeeper
 from ..robot.visuals import LinkGeometry, load_link_geometry
+from ..session.services import Services
 from ..session.session import Session
 from ..world.effects import Marker, Scene
-from ..world.world import World
 from . import adapter
 from .handle import ToolHandles
 from .markers import MarkerLayer
@@ -72,7 +71,7 @@ class ViserScene(Scene):
 
     def __init__(
         self,
-        world: World,
+        services: Services,
         host: str,
         port: int,
         hz: float,
@@ -80,10 +79,11 @@ class ViserScene(Scene):
         policy: DoorPolicy | None = None,
         title: str | None = None,
     ) -> None:
-        """Start the viser server on ``host:port`` (0 picks a free port) and draw ``world``.
+        """Start the viser server on ``host:port`` (0 picks a free port) and draw the world.
 
         Args:
-            world: The world to show (all of its robots).
+            services: The world to show (all of its robots), and what its page's sessions
+                share with every other source.
             host: Address to serve the page on.
             port: TCP port; when it is busy viser takes the next free one.
             hz: Most sends per second [1/s].
@@ -95,7 +95,8 @@ class ViserScene(Scene):
             adapter.ViserInternalsError: the installed viser lacks what the adapter uses.
         """
         _check_host(host)
-        self.world = world
+        self.services = services
+        self.world = world = services.world
         self.policy = policy if policy is not None else DoorPolicy()
         self.title = f"c2rviz — {title or ', '.join(world.robots)}"
         self.server = adapter.start(host, port, label=self.title, policy=self.policy)
@@ -110,7 +111,7 @@ class ViserScene(Scene):
         self._loop: asyncio.AbstractEventLoop | None = None
         self._dirty: set[str] = set(world.robots)
         self._commands: deque[tuple[str, bool]] = deque(maxlen=RECENT_COMMANDS)  # newest first
-        self._client_count = world.client_count
+        self._client_count = services.client_count
         self._state_dirty = True
         self._objects: dict[str, Sequence[WorkcellObject]] = {}  # to draw at the next send
         self._collisions: dict[str, Sequence[tuple[str, str]]] = {}
@@ -146,9 +147,9 @@ class ViserScene(Scene):
         self.panels: dict[str, RobotPanel] = {}
         self.sessions: dict[str, Session] = {}
         for name, state in world.robots.items():
-            session = Session(world, source="page", robot=name)
+            session = Session(self.services, source="page", robot=name)
             session.set_degrees(True)
-            session.motion = "off" if world.defaults.motion == "off" else "follow"
+            session.motion = "off" if self.services.defaults.motion == "off" else "follow"
             self.sessions[name] = session
             self.panels[name] = RobotPanel(server.gui, state, session.speed)
             self.page_input.add_robot(self.panels[name], session)
@@ -220,14 +221,12 @@ class ViserScene(Scene):
 
     # lifecycle
 
-    def start(self, world: World, loop: asyncio.AbstractEventLoop) -> None:
-        """Show ``world`` (the one given at construction); page input runs on ``loop``."""
-        if world is not self.world:
-            raise ValueError("a ViserScene shows the world it was made with")
+    def start(self, loop: asyncio.AbstractEventLoop) -> None:
+        """Show the world; page input runs on ``loop``."""
         self._loop = loop
         self.page_input.start(loop)
         self.handles.start(loop)
-        self._dirty.update(world.robots)
+        self._dirty.update(self.world.robots)
         self.scheduler.start(loop)
 
     def stop(self) -> None:
@@ -276,7 +275,7 @@ class ViserScene(Scene):
                     continue
                 view, panel = self.views[name], self.panels[name]
                 panel.show_pose(view.draw(state.q))
-                moving = state.travel.active
+                moving = world.moving(name)
                 view.show_target(state.target if moving else None)
                 panel.show_joints(state.target, busy)
                 panel.show_motion(moving, world.travels.seconds_left(state))
@@ -302,7 +301,7 @@ class ViserScene(Scene):
                 self.workcells[name].show_collisions(pairs)
                 self.panels[name].show_collisions(pairs)
         self._collisions.clear()
-        keeper = TrailKeeper.of(self.world)
+        keeper = self.services.trails
         if keeper.changed != self.trails.drawn:
             for name, panel in self.panels.items():
                 panel.show_trail(name in keeper.trails)

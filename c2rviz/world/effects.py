@@ -16,35 +16,14 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from .state import MAX_MARKERS, Marker
+
 if TYPE_CHECKING:
     import pinocchio as pin
 
     from ..collision.workcell import WorkcellObject
-    from .world import World
 
 __all__ = ["MAX_MARKERS", "Marker", "NullScene", "Observer", "RecordingScene", "Scene"]
-
-MAX_MARKERS = 1000
-"""Markers kept at once per robot; beyond it the oldest goes first, so a flood of
-``mark`` costs neither the server's memory nor the page's frame rate. Every holder
-of markers keeps them in a ``deque(maxlen=MAX_MARKERS)``."""
-
-
-@dataclass(frozen=True, slots=True)
-class Marker:
-    """A marker in the world frame (the root of the robot's model).
-
-    Attributes:
-        position: x, y, z [m].
-        wxyz: Orientation as a unit quaternion.
-        rgb: Colour, each channel 0..1.
-        shape: One of ``protocol.MARKER_SHAPES``.
-    """
-
-    position: tuple[float, float, float]
-    wxyz: tuple[float, float, float, float]
-    rgb: tuple[float, float, float]
-    shape: str
 
 
 class Observer:
@@ -58,6 +37,12 @@ class Observer:
 
     def on_clear_markers(self, robot: str) -> None:
         """Every marker of ``robot`` is gone."""
+
+    def on_arrived(self, robot: str) -> None:
+        """A move of ``robot`` came to rest at its target."""
+
+    def on_stopped(self, robot: str) -> None:
+        """A move of ``robot`` came to rest short of its target, after a ``stop``."""
 
     def on_clients(self, count: int) -> None:
         """``count`` TCP clients are connected."""
@@ -81,8 +66,9 @@ class Scene(Observer):
     url: str | None = None
     """Where a person can look at it, if anywhere."""
 
-    def start(self, world: World, loop: asyncio.AbstractEventLoop) -> None:
-        """Begin showing ``world``; page input goes through ``loop`` (the asyncio thread's)."""
+    def start(self, loop: asyncio.AbstractEventLoop) -> None:
+        """Begin showing the world it was made with; page input goes through ``loop`` (the
+        asyncio thread's)."""
 
     def stop(self) -> None:
         """Stop and free what it holds (ports, threads); later calls do nothing."""

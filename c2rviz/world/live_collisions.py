@@ -12,16 +12,13 @@ one per line. A change of the colliding pairs reaches the observers as
 
 from __future__ import annotations
 
-import asyncio
 from collections.abc import Callable, Iterable, Sequence
-from typing import TYPE_CHECKING
 
 from ..collision.model import CollisionModel, Pair
 from ..collision.workcell import MAX_OBJECTS
+from .clock import Clock, Timer
 from .effects import Observer
-
-if TYPE_CHECKING:
-    from .world import RobotState
+from .state import RobotState
 
 __all__ = ["Contacts"]
 
@@ -33,6 +30,7 @@ class Contacts(Observer):
         self,
         states: dict[str, RobotState],
         tell: Callable[[str, list[Pair]], None],
+        clock: Clock,
         frame_s: float,
         disabled: dict[str, Sequence[Pair]] | None = None,
         max_objects: int = MAX_OBJECTS,
@@ -42,19 +40,21 @@ class Contacts(Observer):
         Args:
             states: The world's robots by name.
             tell: Fans a robot's new colliding pairs out to the observers.
+            clock: The world's clock.
             frame_s: Shortest time between two checks of a robot [s].
             disabled: Pairs never checked, by robot (from an SRDF).
             max_objects: Most workcell objects per robot.
         """
         self.states = states
         self.tell = tell
+        self.clock = clock
         self.frame_s = frame_s
         self.disabled = disabled or {}
         self.max_objects = max_objects
         self.models: dict[str, CollisionModel] = {}
         self.pairs: dict[str, list[Pair]] = {}
         self._dirty: set[str] = set()
-        self._timer: asyncio.Handle | None = None
+        self._timer: Timer | None = None
 
     def model(self, robot: str) -> CollisionModel:
         """The robot's collision model, built on first use (~10 ms for a bundled arm)."""
@@ -81,10 +81,9 @@ class Contacts(Observer):
         self._dirty.add(robot)
         if self._timer is None:
             try:
-                loop = asyncio.get_running_loop()
+                self._timer = self.clock.call_later(self.frame_s, self._due)
             except RuntimeError:
                 return  # no loop (a model used off the loop): checked when asked
-            self._timer = loop.call_later(self.frame_s, self._due)
 
     def stop(self) -> None:
         if self._timer is not None:

@@ -14,7 +14,6 @@ import asyncio
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -22,9 +21,8 @@ from ..errors import MotionInterrupted
 from ..motion.line_play import LinePlay
 from ..motion.planner import Motion, MotionLimits
 from ..protocol import replies
-
-if TYPE_CHECKING:
-    from .world import RobotState
+from .clock import Clock, Timer
+from .state import RobotState
 
 __all__ = ["Travel", "Travels"]
 
@@ -62,21 +60,26 @@ class Travels:
     def __init__(
         self,
         publish: Callable[[RobotState, tuple[float, ...], float], None],
-        clock: Callable[[], float],
+        rested: Callable[[RobotState, bool], None],
+        clock: Clock,
         frame_s: float,
     ) -> None:
         """Set up.
 
         Args:
             publish: ``publish(state, q, t)`` shows a robot at ``q`` at time ``t``.
-            clock: The world's time base [s].
+            rested: ``rested(state, stopped)``: a move came to rest, at its target or
+                (``stopped``) short of it after a stop; not called for a move an
+                instant command cut short.
+            clock: The world's clock.
             frame_s: Time between two samples of a moving arm [s].
         """
         self.publish = publish
+        self.rested = rested
         self.clock = clock
         self.frame_s = frame_s
         self.by_robot: dict[str, Travel] = {}
-        self._timer: asyncio.Handle | None = None
+        self._timer: Timer | None = None
 
     def add(self, state: RobotState, limits: MotionLimits) -> Travel:
         travel = self.by_robot[state.name] = Travel(state, Motion(limits, state.q))
@@ -103,7 +106,7 @@ class Travels:
         """
         travel = self.by_robot[state.name]
         self._interrupt(travel, f"preempted by {source}")
-        t = self.clock()
+        t = self.clock.now()
         if travel.line is not None:  # leaving a line: from where it is, at rest (see README)
             travel.motion.jump(travel.line.sample(t), t)
             travel.line = None
@@ -141,7 +144,7 @@ class Travels:
         """
         travel = self.by_robot[state.name]
         self._interrupt(travel, f"preempted by {source}")
-        travel.line = LinePlay(self.clock(), times, qs, *ramp)
+        travel.line = LinePlay(self.clock.now(), times, qs, *ramp)
         travel.synced = False
         state.target = tuple(qs[-1].tolist())
         travel.active = True
@@ -160,10 +163,10 @@ class Travels:
         self._interrupt(travel, f"motion stopped by {source}")
         travel.stopping = True
         if travel.line is not None:  # a line brakes on the line
-            travel.line.brake(self.clock())
+            travel.line.brake(self.clock.now())
             state.target = travel.line.sample(travel.line.arrival)
             return self.rest(state)
-        travel.motion.stop(self.clock())
+        travel.motion.stop(self.clock.now())
         state.target = travel.motion.target
         return self.rest(state)
 
@@ -182,7 +185,7 @@ class Travels:
         if not travel.active:
             return 0.0
         end = travel.line.arrival if travel.line is not None else travel.motion.arrival()
-        return max(end - self.clock(), 0.0)
+        return max(end - self.clock.now(), 0.0)
 
     def now(self, state: RobotState) -> tuple[float, ...]:
         """Where the arm is at this instant (between two frames, too)."""
@@ -190,8 +193,8 @@ class Travels:
         if not travel.active:
             return state.q
         if travel.line is not None:
-            return travel.line.sample(self.clock())
-        return travel.motion.sample(self.clock())[0]
+            return travel.line.sample(self.clock.now())
+        return travel.motion.sample(self.clock.now())[0]
 
     def stop_all(self) -> None:
         """The program stops: no more frames."""
@@ -202,14 +205,14 @@ class Travels:
     # The frame timer.
 
     def _run(self, travel: Travel) -> None:
-        travel.active = travel.line is not None or travel.motion.moving(self.clock())
+        travel.active = travel.line is not None or travel.motion.moving(self.clock.now())
         if travel.active and self._timer is None:
-            self._timer = asyncio.get_running_loop().call_soon(self._tick)
+            self._timer = self.clock.call_later(0.0, self._tick)
 
     def _tick(self) -> None:
         """Sample every moving robot, publish it, settle the arrived; come back next frame."""
         self._timer = None
-        t = self.clock()
+        t = self.clock.now()
         due = math.inf
         for travel in self.by_robot.values():
             if not travel.active:
@@ -231,11 +234,11 @@ class Travels:
             if travel.active:
                 due = min(due, t + self.frame_s, end)
             else:
+                self.rested(travel.state, travel.stopping)
                 _settle(travel.arrivals, replies.OK)
                 _settle(travel.rests, replies.OK)
         if due < math.inf:
-            delay = max(due - self.clock(), 0.0)
-            self._timer = asyncio.get_running_loop().call_later(delay, self._tick)
+            self._timer = self.clock.call_at(max(due, self.clock.now()), self._tick)
 
     @staticmethod
     def _interrupt(travel: Travel, why: str) -> None:

@@ -6,67 +6,29 @@ units, to every observer (the scene, and later recorders and watch streams)
 through one fan-out. Nothing else writes the state.
 
 Each robot has a commanded ``target`` and the ``q`` shown now; without motion
-they are equal at once. ``clock`` is the time base [s] of every effect.
+they are equal at once. ``clock`` (``world.clock``) is the time of every effect.
 """
 
 from __future__ import annotations
 
-import asyncio
-import time
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
-from typing import TypeVar
 
-import numpy as np
 import pinocchio as pin
 
-from ..app.config import SessionDefaults
 from ..collision.model import CollisionModel, Pair
 from ..collision.workcell import MAX_OBJECTS
 from ..errors import UnknownRobot
-from ..ik.solver import IkSolver
 from ..motion.planner import MotionLimits, motion_limits
+from ..robot.frames import se3_wxyz
 from ..robot.model import Robot
-from .effects import MAX_MARKERS, Marker, Observer
+from .clock import Clock
+from .effects import Observer
 from .live_collisions import Contacts
 from .moves import Travel, Travels
+from .state import Marker, RobotState
 
 __all__ = ["RobotState", "World"]
-
-T = TypeVar("T")
-
-
-@dataclass(eq=False)
-class RobotState:
-    """One robot of the world.
-
-    Attributes:
-        name: The robot's name in this world (what ``robot NAME`` selects).
-        robot: Its model and chain.
-        q: The chain's values shown now [rad or m].
-        target: The values it was last commanded to [rad or m].
-        markers: Its markers, in the world frame, oldest first.
-        origin: Where its model's root stands in the world (the cell) frame.
-        port: The command port that drives it by default (None: not known here).
-        tool: The tool point (TCP) relative to the end-effector link.
-    """
-
-    name: str
-    robot: Robot
-    q: tuple[float, ...] = ()
-    target: tuple[float, ...] = ()
-    markers: deque[Marker] = field(default_factory=lambda: deque(maxlen=MAX_MARKERS))
-    origin: pin.SE3 = field(default_factory=pin.SE3.Identity)
-    port: int | None = None
-    tool: pin.SE3 = field(default_factory=pin.SE3.Identity)
-    travel: Travel = field(init=False, repr=False)
-    """Its motion (set by the world)."""
-
-    def __post_init__(self) -> None:
-        if not self.q:
-            self.q = self.target = self.robot.home
 
 
 class World:
@@ -76,11 +38,10 @@ class World:
         self,
         robots: Robot | Mapping[str, Robot],
         scene: Observer | None = None,
-        rng: np.random.Generator | None = None,
-        clock: Callable[[], float] = time.monotonic,
+        *,
+        clock: Clock | None = None,
         hz: float = 100.0,
         limits: Mapping[str, MotionLimits] | None = None,
-        defaults: SessionDefaults | None = None,
         origins: Mapping[str, pin.SE3] | None = None,
         disabled_pairs: Mapping[str, Sequence[Pair]] | None = None,
         max_objects: int = MAX_OBJECTS,
@@ -91,11 +52,9 @@ class World:
             robots: One robot (named by its model), or robots by name; the first is
                 the default a new session drives.
             scene: A first observer (usually the view).
-            rng: Random source for ``rand``.
-            clock: The time base [s].
+            clock: The clock every part asks (default: real time).
             hz: Samples per second of a moving arm [1/s].
             limits: Motion limits by robot name (default: from each URDF).
-            defaults: How a new session starts (motion mode, speed).
             origins: Where each robot's root stands in the world frame (default: at
                 the world's origin).
             disabled_pairs: Link pairs never checked for collision, by robot (an SRDF's).
@@ -106,22 +65,23 @@ class World:
         for name, origin in (origins or {}).items():
             self.state(name).origin = origin
         self.default = next(iter(self.robots))
+        self.clock = clock if clock is not None else Clock()
+        self.frame_s = 1.0 / hz
+        """Time between two samples of a moving arm [s of the clock]."""
         self.contacts = Contacts(
-            self.robots, self._tell_collisions, 1.0 / hz, dict(disabled_pairs or {}), max_objects
+            self.robots,
+            self._tell_collisions,
+            self.clock,
+            self.frame_s,
+            dict(disabled_pairs or {}),
+            max_objects,
         )
         self.observers: list[Observer] = [self.contacts]
         if scene is not None:
             self.observers.append(scene)
-        self.rng = rng if rng is not None else np.random.default_rng()
-        self.clock = clock
-        self.client_count = 0
-        self.defaults = defaults if defaults is not None else SessionDefaults()
-        self.travels = Travels(self._show, clock, 1.0 / hz)
-        self._solvers: dict[str, IkSolver] = {}
-        self._solver_thread = ThreadPoolExecutor(1, thread_name_prefix="c2rviz-ik")
+        self.travels = Travels(self._show, self._rested, self.clock, self.frame_s)
         for name, state in self.robots.items():
-            chosen = (limits or {}).get(name) or motion_limits(state.robot)
-            state.travel = self.travels.add(state, chosen)
+            self.travels.add(state, (limits or {}).get(name) or motion_limits(state.robot))
 
     def state(self, name: str | None = None) -> RobotState:
         """The robot called ``name`` (the default robot for None)."""
@@ -144,6 +104,24 @@ class World:
     def markers(self) -> deque[Marker]:
         return self.robots[self.default].markers
 
+    # Motion.
+
+    def travel(self, robot: str) -> Travel:
+        """The robot's motion: its planner and who waits on it."""
+        return self.travels.by_robot[robot]
+
+    def moving(self, robot: str) -> bool:
+        """The robot is travelling (a move in motion has not come to rest)."""
+        return self.travels.by_robot[robot].active
+
+    def motion_limits(self, robot: str) -> MotionLimits:
+        """The robot's velocity, acceleration and jerk limits."""
+        return self.travels.by_robot[robot].motion.limits
+
+    def now(self, robot: str) -> tuple[float, ...]:
+        """The robot's joints at this instant [rad or m] (mid-move too)."""
+        return self.travels.now(self.robots[robot])
+
     # Changes: each is checked before it gets here, then told to every observer.
 
     def set_q(self, q: Sequence[float], robot: str | None = None, source: str = "") -> None:
@@ -152,18 +130,26 @@ class World:
         A move running on that robot is preempted (its waiter is told by ``source``).
         """
         state = self.robots[self.default if robot is None else robot]
-        travel = state.travel
+        travel = self.travels.by_robot[state.name]
         if travel.active:
             self.travels.preempt(travel, source)
         travel.synced = False
         state.target = q = tuple(q)
-        self._show(state, q, self.clock())
+        self._show(state, q, self.clock.now())
 
     def _show(self, state: RobotState, q: tuple[float, ...], t: float) -> None:
         """The robot is seen at ``q`` at time ``t``: tell every observer."""
         state.q = q
         for observer in self.observers:
             observer.on_joints(state.name, q, t)
+
+    def _rested(self, state: RobotState, stopped: bool) -> None:
+        """A move came to rest (after a stop: ``stopped``): tell every observer."""
+        for observer in self.observers:
+            if stopped:
+                observer.on_stopped(state.name)
+            else:
+                observer.on_arrived(state.name)
 
     def ee_pose(self, robot: str | None = None) -> pin.SE3:
         """End-effector placement in the base frame, as the arm is now."""
@@ -185,12 +171,9 @@ class World:
             placement = pose
         else:
             in_base = state.robot.ee_pose(state.q) * state.tool if pose is None else pose
-            placement = state.origin * state.robot.base_placement * in_base
-        x, y, z, w = pin.Quaternion(placement.rotation).coeffs()
-        px, py, pz = placement.translation
-        marker = Marker(
-            (float(px), float(py), float(pz)), (float(w), float(x), float(y), float(z)), rgb, shape
-        )
+            placement = state.base * in_base
+        px, py, pz = map(float, placement.translation)
+        marker = Marker((px, py, pz), se3_wxyz(placement), rgb, shape)
         state.markers.append(marker)
         for observer in self.observers:
             observer.on_marker(state.name, marker)
@@ -215,25 +198,10 @@ class World:
         for observer in self.observers:
             observer.on_tool(state.name, tool)
 
-    # Inverse kinematics, solved off the event loop.
-
-    def ik_solver(self, robot: str) -> IkSolver:
-        """The robot's IK solver (built on first use; used on the solver thread only)."""
-        solver = self._solvers.get(robot)
-        if solver is None:
-            solver = self._solvers[robot] = IkSolver(self.state(robot).robot)
-        return solver
-
-    def solve(self, fn: Callable[[], T]) -> asyncio.Future[T]:
-        """Run ``fn`` (an IK solve or a line plan) on the one solver thread: the event loop
-        goes on serving other clients meanwhile, and solves never overlap."""
-        return asyncio.get_running_loop().run_in_executor(self._solver_thread, fn)
-
     def close(self) -> None:
         """The program stops: no more frames, checks or solves."""
         self.travels.stop_all()
         self.contacts.stop()
-        self._solver_thread.shutdown(wait=False, cancel_futures=True)
 
     # The workcell and collisions.
 
@@ -251,12 +219,21 @@ class World:
             observer.on_objects(robot, objects)
         self.contacts.changed(robot)
 
+    def others(self, robot: str) -> list[tuple[str, CollisionModel, tuple[float, ...], pin.SE3]]:
+        """Every other robot of the world as it stands: its name, collision model, joints
+        [rad or m] and origin (for a robot's path checked against the rest of a cell)."""
+        return [
+            (name, self.collision_model(name), state.q, state.origin)
+            for name, state in self.robots.items()
+            if name != robot
+        ]
+
     def _tell_collisions(self, robot: str, pairs: list[Pair]) -> None:
         for observer in self.observers:
             observer.on_collisions(robot, pairs)
 
-    def set_client_count(self, count: int) -> None:
-        self.client_count = count
+    def tell_clients(self, count: int) -> None:
+        """``count`` clients are connected through the doors now."""
         for observer in self.observers:
             observer.on_clients(count)
 

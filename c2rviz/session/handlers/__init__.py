@@ -1,9 +1,32 @@
-"""What every verb does: one module of ``@handler`` functions per concern.
+"""What every verb does: one module of ``@handler`` functions per family of verbs, each
+mirroring its ``protocol.verbs`` module.
 
-Importing this package registers every handler in ``registry.HANDLERS``; the
-verbs themselves are declared in ``commands`` and ``lang``.
+Importing this package registers every handler in ``registry.HANDLERS`` (the
+``session`` package does, so a session can run every verb).
 """
 
-from . import cartesian, cell, motion, record, seed, workcell
+from . import (
+    cartesian,
+    cell,
+    connection,
+    joints,
+    markers,
+    motion,
+    observe,
+    queries,
+    record,
+    workcell,
+)
 
-__all__ = ["cartesian", "cell", "motion", "record", "seed", "workcell"]
+__all__ = [
+    "cartesian",
+    "cell",
+    "connection",
+    "joints",
+    "markers",
+    "motion",
+    "observe",
+    "queries",
+    "record",
+    "workcell",
+]

@@ -50,4 +50,4 @@ def target(session: Session, command: Target) -> str:
 @handler(Status)
 def status(session: Session, command: Status) -> str:
     left = session.world.travels.seconds_left(session.state)
-    return replies.ok(f"moving {left:.3f}" if session.state.travel.active else "idle")
+    return replies.ok(f"moving {left:.3f}" if session.travel.active else "idle")

@@ -1,4 +1,4 @@
-"""What the verbs that keep and share do: ``watch``, ``unwatch``, ``trail``, ``record``."""
+"""What ``record`` does: start, stop and ask about the recording."""
 
 from __future__ import annotations
 
@@ -6,12 +6,8 @@ import asyncio
 from typing import TYPE_CHECKING
 
 from ...observers.recorder import Recorded
-from ...observers.recordings import Recordings
-from ...observers.trail import TrailKeeper
-from ...observers.watch import WatchHub
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
-from ...protocol.verbs.observe import Trail, Unwatch, Watch
 from ...protocol.verbs.record import Record
 
 if TYPE_CHECKING:
@@ -20,37 +16,9 @@ if TYPE_CHECKING:
 __all__: list[str] = []
 
 
-@handler(Watch)
-def watch(session: Session, command: Watch) -> str:
-    WatchHub.of(session.world).watch(session, command.hz)
-    return replies.OK
-
-
-@handler(Unwatch)
-def unwatch(session: Session, command: Unwatch) -> str:
-    WatchHub.of(session.world).unwatch(session)
-    return replies.OK
-
-
-@handler(Trail)
-def trail(session: Session, command: Trail) -> str:
-    keeper = TrailKeeper.of(session.world)
-    robot = session.state.name
-    if command.action is None:
-        on = robot in keeper.trails
-        return replies.ok(f"on {len(keeper.trails[robot])}" if on else "off")
-    if command.action == "on":
-        keeper.start(robot)
-    elif command.action == "off":
-        keeper.stop(robot)
-    else:
-        keeper.clear(robot)
-    return replies.OK
-
-
 @handler(Record)
 def record(session: Session, command: Record) -> Reply:
-    desk = Recordings.of(session.world)
+    desk = session.services.recordings
     if command.stop:
         return _stopped(desk.stop(f"stopped by {session.source}"))
     if command.name is None:

@@ -4,9 +4,6 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-import numpy as np
-import pinocchio as pin
-
 from ...protocol import replies
 from ...protocol.registry import handler
 from ...protocol.verbs.workcell import Collisions, Guard, ObjectEdit, Objects
@@ -24,10 +21,7 @@ def object_edit(session: Session, command: ObjectEdit) -> str:
 
     def edit(model: CollisionModel) -> None:
         if shape != "remove":
-            x, y, z, roll, pitch, yaw = command.pose
-            angle = session.angle_scale
-            rotation = pin.rpy.rpyToMatrix(roll * angle, pitch * angle, yaw * angle)
-            model.set_object(name, shape, command.size, pin.SE3(rotation, np.array([x, y, z])))
+            model.set_object(name, shape, command.size, session.pose_se3(command.pose))
         elif name == "all":
             model.remove_all()
         else:

@@ -1,0 +1,64 @@
+"""What the question verbs do: where, pose, limits, names, version, help."""
+
+from __future__ import annotations
+
+import hashlib
+from typing import TYPE_CHECKING
+
+from ...protocol import replies
+from ...protocol.registry import handler
+from ...protocol.verbs.queries import Help, Limits, Names, Pose, Version, Where
+from ...version import __version__
+
+if TYPE_CHECKING:
+    from ..session import Session
+
+__all__: list[str] = []
+
+
+@handler(Where)
+def where(session: Session, command: Where) -> str:
+    return replies.ok(replies.numbers(session.from_si(session.now())))
+
+
+@handler(Pose)
+def pose(session: Session, command: Pose) -> str:
+    placement = session.robot.ee_pose(session.now()) * session.state.tool
+    return replies.ok(session.pose_text(placement))
+
+
+@handler(Limits)
+def limits(session: Session, command: Limits) -> str:
+    table = session.table
+    ranges = [
+        f"{replies.limit(lo)}..{replies.limit(hi)} {unit}"
+        for lo, hi, unit in zip(table.lower, table.upper, table.unit)
+    ]
+    if command.all:
+        motion = session.travel.motion.limits
+        ranges = [
+            f"{text} v={replies.numbers([v / s])} a={replies.numbers([a / s])} "
+            f"j={replies.numbers([j / s])}"
+            for text, v, a, j, s in zip(
+                ranges, motion.velocity, motion.acceleration, motion.jerk, table.scale
+            )
+        ]
+    return replies.ok(",".join(ranges))
+
+
+@handler(Names)
+def names(session: Session, command: Names) -> str:
+    return replies.ok(f"{session.state.name} {','.join(session.robot.joint_names)}")
+
+
+@handler(Version)
+def version(session: Session, command: Version) -> str:
+    source = session.robot.source
+    digest = hashlib.sha256(source.xml.encode()).hexdigest()[:12]
+    name = source.path.name if source.path is not None else "(urdf text)"
+    return replies.ok(f"c2rviz {__version__} {name} sha256:{digest}")
+
+
+@handler(Help)
+def help_(session: Session, command: Help) -> str:
+    return replies.help_reply()
