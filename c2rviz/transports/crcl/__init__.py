@@ -18,6 +18,7 @@ converts. No sockets, no asyncio, no clocks here.
 
 from __future__ import annotations
 
+from .binding import RecordField, record_fields
 from .commands import (
     Command,
     ConfigureJointReport,
@@ -222,6 +223,7 @@ __all__ = [
     "PoseAndSet",
     "PoseStatus",
     "PoseTolerance",
+    "RecordField",
     "Program",
     "RotAccelAbsolute",
     "RotAccelRelative",
@@ -266,6 +268,7 @@ __all__ = [
     "parse_instance",
     "parse_program",
     "parse_status",
+    "record_fields",
     "pose_rotation",
     "pose_to_matrix",
     "torque_factor",

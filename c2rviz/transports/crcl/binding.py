@@ -26,21 +26,26 @@ from .errors import CrclError, CrclValueError, UnknownCrclType
 from .scalars import COMMAND_ID, Scalar
 
 __all__ = [
+    "MANY",
+    "ONE",
+    "OPTIONAL",
     "XSI_NAMESPACE",
     "Nested",
+    "RecordField",
     "known_types",
     "Record",
     "many",
     "one",
     "opt",
     "read_record",
+    "record_fields",
     "write_record",
 ]
 
 XSI_NAMESPACE: Final = "http://www.w3.org/2001/XMLSchema-instance"
 _XSI_TYPE: Final = "{" + XSI_NAMESPACE + "}type"
 _KEY: Final = "crcl"
-_ONE, _OPT, _MANY = 0, 1, 2
+ONE, OPTIONAL, MANY = "one", "optional", "many"
 
 
 class Nested:
@@ -75,39 +80,56 @@ class Nested:
 
 
 @dataclass(frozen=True)
-class _Field:
+class RecordField:
+    """One element of a record's type, as declared (``record_fields`` lists them).
+
+    Attributes:
+        name: The dataclass field.
+        tag: The element's name.
+        codec: A ``Scalar`` for text, a ``Nested`` for a child record.
+        kind: ``ONE`` (required), ``OPTIONAL`` (None when absent) or ``MANY`` (a tuple).
+        min_count: The fewest occurrences allowed.
+    """
+
     name: str
     tag: str
     codec: Scalar | Nested
-    kind: int
+    kind: str
     min_count: int
 
 
 def one(tag: str, codec: Scalar | Nested) -> Any:
     """A required element ``tag`` (exactly once)."""
-    return field(metadata={_KEY: (tag, codec, _ONE, 1)})
+    return field(metadata={_KEY: (tag, codec, ONE, 1)})
 
 
 def opt(tag: str, codec: Scalar | Nested) -> Any:
     """An optional element ``tag`` (at most once); the field is ``None`` when absent."""
-    return field(default=None, metadata={_KEY: (tag, codec, _OPT, 0)})
+    return field(default=None, metadata={_KEY: (tag, codec, OPTIONAL, 0)})
 
 
 def many(tag: str, codec: Scalar | Nested, min_count: int = 0) -> Any:
     """A repeated element ``tag`` (``min_count`` or more times), held as a tuple."""
     if min_count:
-        return field(metadata={_KEY: (tag, codec, _MANY, min_count)})
-    return field(default=(), metadata={_KEY: (tag, codec, _MANY, 0)})
+        return field(metadata={_KEY: (tag, codec, MANY, min_count)})
+    return field(default=(), metadata={_KEY: (tag, codec, MANY, 0)})
 
 
-_SPECS: dict[type, tuple[_Field, ...]] = {}
-_BY_TAG: dict[type, dict[str, _Field]] = {}
+_SPECS: dict[type, tuple[RecordField, ...]] = {}
+_BY_TAG: dict[type, dict[str, RecordField]] = {}
 
 
-def _spec(cls: type) -> tuple[_Field, ...]:
+def record_fields(cls: type) -> tuple[RecordField, ...]:
+    """The elements of a ``Record`` class, in the schema's sequence order."""
+    return _spec(cls)
+
+
+def _spec(cls: type) -> tuple[RecordField, ...]:
     spec = _SPECS.get(cls)
     if spec is None:
-        spec = tuple(_Field(f.name, *f.metadata[_KEY]) for f in fields(cls) if _KEY in f.metadata)
+        spec = tuple(
+            RecordField(f.name, *f.metadata[_KEY]) for f in fields(cls) if _KEY in f.metadata
+        )
         _SPECS[cls] = spec
         _BY_TAG[cls] = {f.tag: f for f in spec}
     return spec
@@ -135,8 +157,8 @@ class Record:
         """Rules between fields (a subclass's hook); raise ``CrclValueError``."""
 
 
-def _checked(f: _Field, value: Any) -> Any:
-    if f.kind == _MANY:
+def _checked(f: RecordField, value: Any) -> Any:
+    if f.kind == MANY:
         if not isinstance(value, (tuple, list)):
             raise CrclValueError(f"must be a sequence of {f.tag} values, got {value!r}")
         if len(value) < f.min_count:
@@ -145,7 +167,7 @@ def _checked(f: _Field, value: Any) -> Any:
         same = isinstance(value, tuple) and all(a is b for a, b in zip(items, value))
         return value if same else items
     if value is None:
-        if f.kind == _ONE:
+        if f.kind == ONE:
             raise CrclValueError("is required")
         return None
     return _checked_one(f.codec, value)
@@ -197,7 +219,7 @@ def _read_fields(cls: type[Record], element: etree._Element) -> Record:
                 continue
             expected = ", ".join(by_tag) or "no child elements"
             raise CrclValueError(f"unexpected element <{tag}> (expected: {expected})")
-        if f.kind == _MANY:
+        if f.kind == MANY:
             items = values.setdefault(f.name, [])
             label = f"{tag}[{len(items) + 1}]"
         elif f.name in values:
@@ -208,17 +230,17 @@ def _read_fields(cls: type[Record], element: etree._Element) -> Record:
             value = _read_value(f.codec, child)
         except CrclError as error:
             raise error.within(label) from None
-        if f.kind == _MANY:
+        if f.kind == MANY:
             items.append(value)
         else:
             values[f.name] = value
     for f in _spec(cls):
         if f.name not in values:
-            if f.kind == _ONE:
+            if f.kind == ONE:
                 raise CrclValueError(f"missing required element <{f.tag}>")
-            if f.kind == _MANY:
+            if f.kind == MANY:
                 values[f.name] = ()
-        elif f.kind == _MANY:
+        elif f.kind == MANY:
             values[f.name] = tuple(values[f.name])
     return cls(**values)
 
@@ -265,7 +287,7 @@ def write_record(
         value = getattr(record, f.name)
         if value is None:
             continue
-        for item in value if f.kind == _MANY else (value,):
+        for item in value if f.kind == MANY else (value,):
             if isinstance(f.codec, Nested):
                 write_record(item, f.tag, out, f.codec)
             else:

@@ -287,6 +287,7 @@ class DocumentSplitter:
 
     def _enter(self, state: int, item: int, pos: int, back: int) -> None:
         self._state, self._item, self._pos, self._back = state, item, pos, back
+        self._quote = b""
 
     def _scan_start_tag(self, out: list[bytes | CrclFramingError]) -> bool:
         """Find the ``>`` ending a start tag, outside quoted values; False: wait."""

@@ -61,6 +61,7 @@ class Scalar:
         format: Value -> text, already escaped for XML content.
         collapse: Whether leading/trailing whitespace is dropped before ``parse``
             (every type but xs:string).
+        choices: The allowed values of an enumeration; empty for other types.
     """
 
     kind: str
@@ -68,6 +69,7 @@ class Scalar:
     check: Callable[[Any], Any]
     format: Callable[[Any], str]
     collapse: bool = True
+    choices: tuple[str, ...] = ()
 
     def read(self, text: str) -> Any:
         """The value an element's text stands for (range checks come with ``check``)."""
@@ -210,7 +212,7 @@ def enumeration(*choices: str) -> Scalar:
             raise CrclValueError(f"{value!r} is not one of: {listed}")
         return str(value)
 
-    return Scalar("enumeration", parse, check, str)
+    return Scalar("enumeration", parse, check, str, choices=choices)
 
 
 DOUBLE = number()
