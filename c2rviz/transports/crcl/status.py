@@ -18,6 +18,7 @@ from typing import Final, cast
 
 from .binding import Nested, Record, many, one, opt, read_record, write_record
 from .documents import ROOT_ATTRIBUTES, XML_DECLARATION
+from .errors import CrclValueError
 from .hardened import parse_xml
 from .primitives import (
     JointPositionsTolerances,
@@ -111,6 +112,11 @@ class JointStatuses(Record):
 
     XSI_TYPE = "JointStatusesType"
     statuses: tuple[JointStatus, ...] = many("JointStatus", Nested(JointStatus), min_count=1)
+
+    def _check(self) -> None:
+        numbers = [status.joint_number for status in self.statuses]
+        if len(set(numbers)) != len(numbers):
+            raise CrclValueError(f"joint numbers {numbers}: each joint is reported at most once")
 
 
 @dataclass(frozen=True, kw_only=True)

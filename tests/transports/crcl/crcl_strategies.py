@@ -18,6 +18,7 @@ from c2rviz.transports.crcl import (
     ActuateJoints,
     ConfigureJointReports,
     CrclStatus,
+    JointStatuses,
     MoveThroughTo,
     Pose,
     PoseAndSet,
@@ -124,6 +125,9 @@ def _fixed(cls: type[Record], values: dict[str, Any]) -> dict[str, Any]:
     if cls is ConfigureJointReports:
         reports = {report.joint_number: report for report in values["reports"]}
         values["reports"] = tuple(reports[number] for number in sorted(reports))
+    if cls is JointStatuses:
+        statuses = {status.joint_number: status for status in values["statuses"]}
+        values["statuses"] = tuple(statuses.values())
     if cls is ActuateJoints:
         joints = {joint.joint_number: joint for joint in values["joints"]}
         values["joints"] = tuple(joints.values())
