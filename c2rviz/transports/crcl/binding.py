@@ -97,6 +97,15 @@ class RecordField:
     kind: str
     min_count: int
 
+    def __post_init__(self) -> None:  # what the reader and writer ask for each element
+        object.__setattr__(self, "many", self.kind == MANY)
+        object.__setattr__(self, "open", f"<{self.tag}>")
+        object.__setattr__(self, "close", f"</{self.tag}>")
+
+    many: bool = field(init=False)
+    open: str = field(init=False)
+    close: str = field(init=False)
+
 
 def one(tag: str, codec: Scalar | Nested) -> Any:
     """A required element ``tag`` (exactly once)."""
@@ -117,6 +126,7 @@ def many(tag: str, codec: Scalar | Nested, min_count: int = 0) -> Any:
 
 _SPECS: dict[type, tuple[RecordField, ...]] = {}
 _BY_TAG: dict[type, dict[str, RecordField]] = {}
+_WRITING: dict[type, tuple[tuple[Any, ...], ...]] = {}
 
 
 def record_fields(cls: type) -> tuple[RecordField, ...]:
@@ -127,9 +137,10 @@ def record_fields(cls: type) -> tuple[RecordField, ...]:
 def _spec(cls: type) -> tuple[RecordField, ...]:
     spec = _SPECS.get(cls)
     if spec is None:
-        spec = tuple(
-            RecordField(f.name, *f.metadata[_KEY]) for f in fields(cls) if _KEY in f.metadata
-        )
+        undeclared = [f.name for f in fields(cls) if _KEY not in f.metadata]
+        if undeclared:
+            raise TypeError(f"{cls.__name__} fields {undeclared} are not declared elements")
+        spec = tuple(RecordField(f.name, *f.metadata[_KEY]) for f in fields(cls))
         _SPECS[cls] = spec
         _BY_TAG[cls] = {f.tag: f for f in spec}
     return spec
@@ -204,7 +215,9 @@ def _is_command(cls: type) -> bool:
 
 
 def _read_fields(cls: type[Record], element: etree._Element) -> Record:
-    _spec(cls)
+    """The record ``element`` holds, each value checked as read; ``__init__`` is bypassed
+    because everything it would check (values, counts, classes) is checked here."""
+    spec = _spec(cls)
     by_tag = _BY_TAG[cls]
     values: dict[str, Any] = {}
     for child in element:
@@ -219,38 +232,43 @@ def _read_fields(cls: type[Record], element: etree._Element) -> Record:
                 continue
             expected = ", ".join(by_tag) or "no child elements"
             raise CrclValueError(f"unexpected element <{tag}> (expected: {expected})")
-        if f.kind == MANY:
+        if f.many:
             items = values.setdefault(f.name, [])
             label = f"{tag}[{len(items) + 1}]"
         elif f.name in values:
             raise CrclValueError(f"<{tag}> appears more than once (at most once)")
         else:
             label = tag
+        codec = f.codec
         try:
-            value = _read_value(f.codec, child)
+            if isinstance(codec, Nested):
+                value: Any = read_record(codec, child)
+            elif len(child):
+                raise CrclValueError(f"must hold a {codec.kind} value, not elements")
+            else:
+                value = codec.check(codec.read(child.text or ""))
         except CrclError as error:
             raise error.within(label) from None
-        if f.kind == MANY:
+        if f.many:
             items.append(value)
         else:
             values[f.name] = value
-    for f in _spec(cls):
-        if f.name not in values:
+    for f in spec:
+        value = values.get(f.name)
+        if value is None:
             if f.kind == ONE:
                 raise CrclValueError(f"missing required element <{f.tag}>")
-            if f.kind == MANY:
-                values[f.name] = ()
-        elif f.kind == MANY:
-            values[f.name] = tuple(values[f.name])
-    return cls(**values)
-
-
-def _read_value(codec: Scalar | Nested, element: etree._Element) -> Any:
-    if isinstance(codec, Nested):
-        return read_record(codec, element)
-    if len(element):
-        raise CrclValueError(f"must hold a {codec.kind} value, not elements")
-    return codec.read(element.text or "")
+            values[f.name] = () if f.many else None
+            value = ()
+        elif f.many:
+            values[f.name] = tuple(value)
+        if f.many and len(value) < f.min_count:
+            problem = f"needs at least {f.min_count} {f.tag}, got {len(value)}"
+            raise CrclValueError(problem).within(f.tag)
+    record = object.__new__(cls)
+    record.__dict__.update(values)
+    record._check()
+    return record
 
 
 def _peek_command_id(element: etree._Element) -> int | None:
@@ -283,15 +301,25 @@ def write_record(
         out.append(f'<{tag}{attributes} xsi:type="{cls.XSI_TYPE}">')
     else:
         out.append(f"<{tag}{attributes}>")
-    for f in _spec(cls):
-        value = getattr(record, f.name)
+    fields_of = record.__dict__
+    plan = _WRITING.get(cls)
+    if plan is None:
+        plan = _WRITING[cls] = tuple(
+            (f.name, f.tag, f.codec if isinstance(f.codec, Nested) else None, f.many,
+             f.open, f.close, f.codec.format if isinstance(f.codec, Scalar) else str)
+            for f in _spec(cls)
+        )  # fmt: skip
+    for name, child, nested, repeated, opening, closing, text in plan:
+        value = fields_of[name]
         if value is None:
             continue
-        for item in value if f.kind == MANY else (value,):
-            if isinstance(f.codec, Nested):
-                write_record(item, f.tag, out, f.codec)
-            else:
-                out.append(f"<{f.tag}>{f.codec.format(item)}</{f.tag}>")
+        if nested is not None:
+            for item in value if repeated else (value,):
+                write_record(item, child, out, nested)
+        elif repeated:
+            out.extend(opening + text(item) + closing for item in value)
+        else:
+            out.append(opening + text(value) + closing)
     out.append(f"</{tag}>")
 
 

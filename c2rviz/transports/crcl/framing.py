@@ -35,7 +35,17 @@ from typing import Final
 
 from .errors import CrclFramingError
 from .hardened import MAX_DOCUMENT_BYTES
-from .markup import BOM, CONTROL, NAME, NOT_SPACE, TAG_STOP, declaration_at, root_at, shown_at
+from .markup import (
+    BOM,
+    CONTROL,
+    NAME,
+    NOT_SPACE,
+    TAG_STOP,
+    TOKEN,
+    declaration_at,
+    root_at,
+    shown_at,
+)
 from .markup import starts as _starts
 
 __all__ = ["CRCL_ROOTS", "DocumentSplitter"]
@@ -183,7 +193,9 @@ class DocumentSplitter:
                 self._item = -1
                 self._pos, self._state = (i, _BETWEEN) if declaration or root else (i + 1, _RESYNC)
             elif state == _CONTENT:
-                i = buf.find(b"<", pos)
+                if self._skim(out):
+                    continue
+                i = buf.find(b"<", self._pos)
                 if i < 0:
                     self._pos = len(buf)
                     return
@@ -256,6 +268,28 @@ class DocumentSplitter:
                 self._start = i
             self._root_tag = True
             self._enter(_START_TAG, i, i + 1, _CONTENT)
+        return True
+
+    def _skim(self, out: list[bytes | CrclFramingError]) -> bool:
+        """Step over whole tags, comments, CDATA and PIs with one regex each (the common
+        case); True if that closed the root. Anything else, or a piece not all here
+        yet, is left to the state machine."""
+        buf, pos, depth = self._buf, self._pos, self._depth
+        while depth > 0:
+            i = buf.find(b"<", pos)  # text is skipped by memchr, not by the regex
+            token = TOKEN.match(buf, i) if i >= 0 else None
+            if token is None:
+                break
+            pos = token.end()
+            kind = token.lastgroup
+            if kind == "end":
+                depth -= 1
+            elif kind == "start" and buf[pos - 2] != _SLASH:
+                depth += 1
+        self._pos, self._depth = pos, depth
+        if depth:
+            return False
+        self._close_tag(out, pos)
         return True
 
     def _markup_inside(self, out: list[bytes | CrclFramingError], i: int) -> bool:

@@ -20,6 +20,7 @@ __all__ = [
     "NOT_SPACE",
     "SPACE",
     "TAG_STOP",
+    "TOKEN",
     "declaration_at",
     "root_at",
     "shown_at",
@@ -30,6 +31,12 @@ NOT_SPACE: Final = re.compile(rb"[^ \t\r\n]")
 CONTROL: Final = re.compile(rb"[\x00-\x08\x0b\x0c\x0e-\x1f]")
 """Bytes XML 1.0 never allows (C0 controls but tab, LF, CR): binary data."""
 TAG_STOP: Final = re.compile(rb"[>\"']")
+TOKEN: Final = re.compile(
+    rb"<(?:(?P<end>/[^>]*>)|(?P<start>[A-Za-z_:\x80-\xff](?:[^>\"']|\"[^\"]*\"|'[^']*')*>)"
+    rb"|!--.*?-->|!\[CDATA\[.*?\]\]>|\?.*?\?>)",
+    re.DOTALL,
+)
+"""One whole tag (group ``end`` or ``start``), comment, CDATA section or PI."""
 NAME: Final = re.compile(rb"<([A-Za-z_:\x80-\xff][^ \t\r\n/>!?<\"'=]*)")
 MAX_NAME: Final = 256
 SPACE: Final = b" \t\r\n"

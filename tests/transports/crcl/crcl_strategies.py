@@ -48,15 +48,12 @@ __all__ = ["commands", "pose_axes", "record_of", "statuses", "xml_text"]
 # Every character XML 1.0 can carry (surrogates, U+FFFE/U+FFFF and C0 controls out).
 xml_text = st.text(
     alphabet=st.characters(
-        blacklist_categories=("Cs",),
-        blacklist_characters="".join(map(chr, [*range(9), 11, 12, *range(14, 32)]))
-        + "\ufffe\uffff",
+        exclude_categories=["Cs"],
+        exclude_characters="".join(map(chr, [*range(9), 11, 12, *range(14, 32)])) + "\ufffe\uffff",
     ),
     max_size=12,
 )
-_word = st.text(
-    alphabet=st.characters(whitelist_categories=("L", "N", "P", "S")), min_size=1, max_size=6
-)
+_word = st.text(alphabet=st.characters(categories=["L", "N", "P", "S"]), min_size=1, max_size=6)
 _SCALARS: dict[int, st.SearchStrategy[Any]] = {
     id(DOUBLE): st.floats(allow_nan=False, allow_infinity=False),
     id(POSITIVE): st.floats(min_value=0.0, exclude_min=True, allow_infinity=False),
@@ -90,9 +87,9 @@ def pose_axes(draw: st.DrawFn) -> tuple[Vector, Vector]:
     u = (z[1] * helper[2] - z[2] * helper[1], z[2] * helper[0] - z[0] * helper[2],
          z[0] * helper[1] - z[1] * helper[0])  # fmt: skip
     norm_u = math.sqrt(sum(v * v for v in u))
-    u = tuple(v / norm_u for v in u)
-    w = (z[1] * u[2] - z[2] * u[1], z[2] * u[0] - z[0] * u[2], z[0] * u[1] - z[1] * u[0])
-    x = tuple(math.cos(c) * p + math.sin(c) * q for p, q in zip(u, w))
+    e = [v / norm_u for v in u]
+    w = (z[1] * e[2] - z[2] * e[1], z[2] * e[0] - z[0] * e[2], z[0] * e[1] - z[1] * e[0])
+    x = [math.cos(c) * p + math.sin(c) * q for p, q in zip(e, w)]
     scale_x, scale_z = draw(st.sampled_from([1.0, 0.5, 3.0])), draw(st.sampled_from([1.0, 2.0]))
     return Vector(*(scale_x * v for v in x)), Vector(*(scale_z * v for v in z))
 

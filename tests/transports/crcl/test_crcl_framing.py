@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import cast
+
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -130,7 +132,7 @@ def test_bad_streams(stream: bytes, expected: list[object]) -> None:
                 assert item == want, chunking
             else:
                 assert isinstance(item, CrclFramingError), (chunking, item)
-                recoverable, words = want  # type: ignore[misc]
+                recoverable, words = cast(tuple[bool, str], want)
                 assert item.recoverable is recoverable and words in str(item), (chunking, item)
                 assert item.command_id is None
         closing = [e for e in errors(out) if not e[0]]
