@@ -231,7 +231,7 @@ def _read_fields(cls: type[Record], element: etree._Element) -> Record:
             if tag == "Name":
                 continue
             expected = ", ".join(by_tag) or "no child elements"
-            raise CrclValueError(f"unexpected element <{tag}> (expected: {expected})")
+            raise CrclValueError(f"unexpected element <{tag[:40]}> (expected: {expected})")
         if f.many:
             items = values.setdefault(f.name, [])
             label = f"{tag}[{len(items) + 1}]"

@@ -110,10 +110,12 @@ class ConfigureJointReports(MiddleCommand):
 
     def _check(self) -> None:
         numbers = [report.joint_number for report in self.reports]
-        if any(a >= b for a, b in zip(numbers, numbers[1:])):
-            raise CrclValueError(
-                f"joint numbers {numbers} must be increasing, each joint at most once"
-            )
+        for before, after in zip(numbers, numbers[1:]):
+            if before >= after:
+                raise CrclValueError(
+                    f"joint {after} comes after joint {before}: joint numbers must be "
+                    "increasing, each joint at most once"
+                )
 
 
 @dataclass(frozen=True, kw_only=True)

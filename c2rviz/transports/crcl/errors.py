@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from c2rviz.errors import C2rvizError
+from c2rviz.errors import C2rvizError, shown
 
 __all__ = [
     "CrclError",
@@ -107,4 +107,4 @@ class UnknownCrclType(CrclError):
         else:
             choices = f"one of the {len(self.known)} CRCL types, e.g. " + ", ".join(self.known[:4])
         hint = f"; did you mean {' or '.join(suggestions)}?" if suggestions else ""
-        super().__init__(f"unknown xsi:type {xsi_type!r} ({choices}){hint}")
+        super().__init__(f"unknown xsi:type {shown(xsi_type)} ({choices}){hint}")

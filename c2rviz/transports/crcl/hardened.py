@@ -83,12 +83,12 @@ def parse_xml(
     try:
         root = etree.fromstring(doc, _parser())
     except etree.XMLSyntaxError as error:
-        raise CrclSyntaxError(f"malformed XML: {error.msg}") from None
+        raise CrclSyntaxError(f"malformed XML: {error.msg[:160]}") from None
     if root.getroottree().docinfo.doctype:
         raise CrclSyntaxError("DOCTYPE refused: CRCL documents may not have a DOCTYPE")
     tag = root.tag
     local = tag.rpartition("}")[2] if isinstance(tag, str) else ""
     if local not in roots:
         expected = " or ".join(f"<{name}>" for name in roots)
-        raise CrclSyntaxError(f"root element <{local}> is not {expected}")
+        raise CrclSyntaxError(f"root element <{local[:40]}> is not {expected}")
     return root

@@ -54,8 +54,8 @@ def read_program(doc: bytes, *, max_bytes: int = MAX_PROGRAM_BYTES) -> Program:
     tags = [tag for tag in tags if tag != "Name"]
     if tags and (tags[0] != "InitCanon" or tags[-1] != "EndCanon"):
         raise CrclSyntaxError(
-            f"a CRCLProgram runs from <InitCanon> to <EndCanon>: it starts with <{tags[0]}> "
-            f"and ends with <{tags[-1]}>"
+            f"a CRCLProgram runs from <InitCanon> to <EndCanon>: it starts with "
+            f"<{tags[0][:40]}> and ends with <{tags[-1][:40]}>"
         )
     return cast(Program, read_record(_PROGRAM, root))
 

@@ -114,9 +114,14 @@ class JointStatuses(Record):
     statuses: tuple[JointStatus, ...] = many("JointStatus", Nested(JointStatus), min_count=1)
 
     def _check(self) -> None:
-        numbers = [status.joint_number for status in self.statuses]
-        if len(set(numbers)) != len(numbers):
-            raise CrclValueError(f"joint numbers {numbers}: each joint is reported at most once")
+        seen: set[int] = set()
+        for status in self.statuses:
+            if status.joint_number in seen:
+                raise CrclValueError(
+                    f"joint {status.joint_number} appears twice: each joint is reported at "
+                    "most once"
+                )
+            seen.add(status.joint_number)
 
 
 @dataclass(frozen=True, kw_only=True)

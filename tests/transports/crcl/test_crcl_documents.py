@@ -523,7 +523,7 @@ BAD = [
         ),
         CrclValueError,
         4,
-        "must be increasing",
+        "joint 1 comes after joint 3: joint numbers must be increasing",
     ),  # fmt: skip
 ]
 

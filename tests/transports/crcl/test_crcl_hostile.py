@@ -13,6 +13,7 @@ from lxml import etree
 
 from c2rviz.transports.crcl import (
     MAX_DOCUMENT_BYTES,
+    CrclError,
     CrclFramingError,
     CrclSyntaxError,
     CrclValueError,
@@ -203,3 +204,20 @@ def test_a_message_that_looks_like_markup_is_just_text() -> None:
     assert b"<!DOCTYPE" not in doc
     assert parse_command(doc) == command
     assert DocumentSplitter().feed(doc) == [doc]
+
+
+@pytest.mark.parametrize(
+    "doc",
+    [
+        message_doc("x").replace(b"MessageType", b"M" * 500_000),
+        message_doc("x").replace(b"<Message>x</Message>", b"<" + b"W" * 500_000 + b"/>"),
+        message_doc("x").replace(b"<Message>x</Message>", b"<a" + b"b" * 500_000 + b">"),
+        b"<" + b"R" * 500_000 + b"/>",
+        message_doc("x").replace(b"<Message>x", b"<Message>" + b"<a>" * 50_000 + b"</a>" * 50_000),
+    ],
+    ids=["long-xsi-type", "long-element-name", "long-malformed", "long-root", "deep-nesting"],
+)
+def test_huge_names_and_depths_give_short_messages(doc: bytes) -> None:
+    with pytest.raises(CrclError) as caught:
+        parse_command(doc)
+    assert len(str(caught.value)) < 300

@@ -164,7 +164,9 @@ def test_status_values_are_checked() -> None:
         CommandStatus(command_id=1, status_id=1, state="CRCL_Bored")
     with pytest.raises(CrclValueError, match="JointStatus: needs at least 1 JointStatus, got 0"):
         JointStatuses(())
-    with pytest.raises(CrclValueError, match="each joint is reported at most once"):
+    with pytest.raises(
+        CrclValueError, match="joint 2 appears twice: each joint is reported at most once"
+    ):
         JointStatuses((JointStatus(joint_number=2), JointStatus(joint_number=2)))
     with pytest.raises(CrclValueError, match="cannot be written in XML"):
         CommandStatus(command_id=1, status_id=1, state="CRCL_Error", description="bad \x07 byte")
