@@ -6,8 +6,9 @@ tuple), each naming its element and its codec: a ``Scalar`` for text or a ``Nest
 a child record. Field order is the schema's sequence order, base type first, and the
 writer follows it, so what is written is valid against the schema; the reader accepts
 the children in any order (documented leniency) but refuses unknown, repeated or missing
-ones. Every record checks its values when built (``__post_init__``), whether the reader
-or the program builds it: an invalid record cannot exist, so it cannot be written.
+ones. Every record is checked when built: by ``__post_init__`` when code builds it, by
+the reader as it reads each value (the same checks, made once): an invalid record
+cannot exist, so it cannot be written.
 
 ``Name`` (the optional first element of every CRCL type) is read into a field only
 where a record declares one (commands); elsewhere it is accepted and ignored.
@@ -16,7 +17,6 @@ where a record declares one (commands); elsewhere it is accepted and ignored.
 from __future__ import annotations
 
 import difflib
-from collections.abc import Sequence
 from dataclasses import dataclass, field, fields
 from typing import Any, ClassVar, Final
 
@@ -32,7 +32,6 @@ __all__ = [
     "XSI_NAMESPACE",
     "Nested",
     "RecordField",
-    "known_types",
     "Record",
     "many",
     "one",
@@ -321,8 +320,3 @@ def write_record(
         else:
             out.append(opening + text(value) + closing)
     out.append(f"</{tag}>")
-
-
-def known_types(codec: Nested) -> Sequence[str]:
-    """The ``xsi:type`` names a ``Nested`` accepts, in declaration order."""
-    return tuple(codec.by_type)
