@@ -1,0 +1,123 @@
+"""CRCL's units to SI, and CRCL poses to rotation matrices and back (numpy only).
+
+CRCL documents carry values in the units their connection has set; c2rviz computes
+in SI (meters, radians, newtons, newton-meters). Each factor here is how many SI units
+one CRCL unit is: ``value_si = value * LENGTH_FACTORS[unit]``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Final
+
+import numpy as np
+from numpy.typing import NDArray
+
+from .errors import CrclValueError
+from .primitives import Point, Pose, Vector
+
+__all__ = [
+    "ANGLE_FACTORS",
+    "FORCE_FACTORS",
+    "LENGTH_FACTORS",
+    "TORQUE_FACTORS",
+    "angle_factor",
+    "force_factor",
+    "length_factor",
+    "matrix_to_pose",
+    "pose_rotation",
+    "pose_to_matrix",
+    "torque_factor",
+]
+
+LENGTH_FACTORS: Final[Mapping[str, float]] = {"meter": 1.0, "millimeter": 1e-3, "inch": 0.0254}
+"""Meters per CRCL length unit (the inch is 25.4 mm exactly)."""
+
+ANGLE_FACTORS: Final[Mapping[str, float]] = {"radian": 1.0, "degree": math.pi / 180.0}
+"""Radians per CRCL angle unit."""
+
+FORCE_FACTORS: Final[Mapping[str, float]] = {
+    "newton": 1.0,
+    "pound": 4.4482216152605,  # pound-force: 0.45359237 kg * 9.80665 m/s^2
+    "ounce": 4.4482216152605 / 16.0,
+}
+"""Newtons per CRCL force unit."""
+
+TORQUE_FACTORS: Final[Mapping[str, float]] = {
+    "newtonMeter": 1.0,
+    "footPound": 4.4482216152605 * 0.3048,
+}
+"""Newton-meters per CRCL torque unit."""
+
+
+def _factor(table: Mapping[str, float], unit: str, what: str) -> float:
+    factor = table.get(unit)
+    if factor is None:
+        raise CrclValueError(f"unknown {what} unit {unit!r} (choose from: {', '.join(table)})")
+    return factor
+
+
+def length_factor(unit: str) -> float:
+    """Meters per ``unit`` (``meter``, ``millimeter`` or ``inch``)."""
+    return _factor(LENGTH_FACTORS, unit, "length")
+
+
+def angle_factor(unit: str) -> float:
+    """Radians per ``unit`` (``radian`` or ``degree``)."""
+    return _factor(ANGLE_FACTORS, unit, "angle")
+
+
+def force_factor(unit: str) -> float:
+    """Newtons per ``unit`` (``newton``, ``pound`` or ``ounce``)."""
+    return _factor(FORCE_FACTORS, unit, "force")
+
+
+def torque_factor(unit: str) -> float:
+    """Newton-meters per ``unit`` (``newtonMeter`` or ``footPound``)."""
+    return _factor(TORQUE_FACTORS, unit, "torque")
+
+
+def pose_rotation(pose: Pose) -> NDArray[np.float64]:
+    """The rotation matrix of a pose's tool frame in the base frame.
+
+    Its columns are the x, y and z axes: z is ``ZAxis`` normalised, x is ``XAxis`` made
+    exactly orthogonal to z (Gram-Schmidt; a ``Pose`` is only ever a hair off) and
+    normalised, y is z cross x.
+    """
+    z = np.array([pose.z_axis.i, pose.z_axis.j, pose.z_axis.k], dtype=float)
+    z /= np.linalg.norm(z)
+    x = np.array([pose.x_axis.i, pose.x_axis.j, pose.x_axis.k], dtype=float)
+    x -= np.dot(x, z) * z
+    x /= np.linalg.norm(x)
+    return np.column_stack((x, np.cross(z, x), z))
+
+
+def pose_to_matrix(pose: Pose, length_unit: str = "meter") -> NDArray[np.float64]:
+    """The 4x4 homogeneous transform of a pose, its translation in meters.
+
+    Args:
+        pose: A pose in ``length_unit``.
+        length_unit: The unit its point is in.
+    """
+    matrix = np.eye(4)
+    matrix[:3, :3] = pose_rotation(pose)
+    factor = length_factor(length_unit)
+    matrix[:3, 3] = (pose.point.x * factor, pose.point.y * factor, pose.point.z * factor)
+    return matrix
+
+
+def matrix_to_pose(matrix: NDArray[np.float64], length_unit: str = "meter") -> Pose:
+    """The CRCL pose of a homogeneous transform (translation in meters), in ``length_unit``.
+
+    Raises:
+        CrclValueError: The matrix's rotation columns are not orthogonal directions.
+    """
+    factor = length_factor(length_unit)
+    x, y, z = (float(value) / factor for value in matrix[:3, 3])
+    rotation = matrix[:3, :3]
+    return Pose(
+        Point(x, y, z),
+        Vector(*(float(value) for value in rotation[:, 0])),
+        Vector(*(float(value) for value in rotation[:, 2])),
+    )
