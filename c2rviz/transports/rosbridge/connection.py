@@ -40,17 +40,40 @@ class Connection:
         self.level = "error"
         self.outboxes: dict[str, Outbox] = {}
         self.advertised: dict[str, str] = {}
+        self.stopping = False
+        self._serving: asyncio.Future[None] | None = None
 
     async def run(self) -> None:
+        """Serve the connection's frames in order until it closes or the server stops."""
         try:
             async for frame in self.websocket:
-                if isinstance(frame, bytes):
-                    problem = "binary frames (CBOR, BSON) are not read: send JSON text frames"
-                    await self.refuse(RosbridgeError(problem))
-                else:
-                    await self.handle(frame)
+                if self.stopping:
+                    break
+                self._serving = asyncio.ensure_future(self.handle(frame))
+                try:
+                    await self._serving
+                except asyncio.CancelledError:
+                    if self.stopping:
+                        break
+                    raise
+                finally:
+                    self._serving = None
         except ConnectionClosed:
             pass
+
+    def stop(self) -> None:
+        """Give up the request being served (a service call that waits) and read no more."""
+        self.stopping = True
+        if self._serving is not None:
+            self._serving.cancel()
+
+    async def handle(self, frame: str | bytes) -> None:
+        """Serve one frame; any error becomes a status (and a failed service_response)."""
+        if isinstance(frame, bytes):
+            problem = "binary frames (CBOR, BSON) are not read: send JSON text frames"
+            await self.refuse(RosbridgeError(problem))
+        else:
+            await self.handle_text(frame)
 
     async def close(self) -> None:
         """Stop every subscription of the connection (at its end)."""
@@ -62,8 +85,7 @@ class Connection:
                 log.exception("rosbridge: unsubscribing %s failed", outbox.spelling)
             await outbox.close()
 
-    async def handle(self, text: str) -> None:
-        """Serve one frame; any error becomes a status (and a failed service_response)."""
+    async def handle_text(self, text: str) -> None:
         op: protocol.Op | None = None
         try:
             op = protocol.parse_frame(text)

@@ -92,8 +92,14 @@ class RosbridgeServer:
         return str(bound[0]), int(bound[1])
 
     async def stop(self) -> None:
-        """Close every connection (code 1001) and the listening socket; idempotent."""
+        """Close every connection (code 1001) and the listening socket; idempotent.
+
+        A request still being served (a service call that waits on a motion) is
+        given up: its client gets no answer, the connection closes.
+        """
         if self._server is not None:
+            for connection in self._connections:
+                connection.stop()
             self._server.close()
             await self._server.wait_closed()
             self._server = None
@@ -162,6 +168,8 @@ class RosbridgeServer:
         self._connections.add(connection)
         try:
             await connection.run()
+            if connection.stopping:  # as websockets closes the others when the server stops
+                await websocket.close(CloseCode.GOING_AWAY)
         finally:
             self._connections.discard(connection)
             await connection.close()

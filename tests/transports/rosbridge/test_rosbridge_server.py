@@ -65,6 +65,11 @@ BAD_FRAMES = [
         "compression 'cbor' is not served",
     ),
     (
+        '{"op": "subscribe", "id": "s5", "topic": "/inbox"}',
+        "s5",
+        "subscribe /inbox: /inbox is not published here",
+    ),
+    (
         '{"op": "publish", "id": "p1", "topic": "/inbox", "msg": {"data": 5}}',
         "p1",
         "publish /inbox: std_msgs/msg/String: data must be a string",
@@ -168,6 +173,14 @@ def test_subscribe_receives_the_topic_in_the_spelling_asked(
     subscribe(client, rosbridge, "counter", id="c")
     rosbridge.call(rosbridge.bridge.tick)
     assert receive(client) == {"op": "publish", "topic": "counter", "msg": {"data": "1"}}
+
+
+def test_a_delivery_from_another_thread_arrives(
+    rosbridge: ServerThread, client: ClientConnection
+) -> None:
+    subscribe(client, rosbridge, "/counter")
+    rosbridge.bridge.tick()  # on this thread, not the server's loop
+    assert receive(client)["msg"] == {"data": "1"}
 
 
 def test_a_latched_topic_comes_at_once(rosbridge: ServerThread, client: ClientConnection) -> None:
@@ -325,6 +338,22 @@ def test_with_a_token_a_connection_needs_it(rosbridge: ServerThread) -> None:
         assert refused.value.response.status_code == 403
     with connect(rosbridge.url + "?token=s3cret") as ws:
         assert command(ws, "hi")["result"] is True
+
+
+def test_stop_gives_up_a_service_call_that_waits(bridge: CounterBridge) -> None:
+    server = ServerThread(bridge, RosbridgePolicy())
+    server.call(bridge.release.clear)
+    with connect(server.url) as ws:
+        ws.send(
+            json.dumps(
+                {"op": "call_service", "service": "/c2rviz/command", "args": {"command": "hold"}}
+            )
+        )
+        assert bridge.calls.get(timeout=WAIT_S) == "hold"
+        server.stop()  # within WAIT_S, or it raises
+        with pytest.raises(ConnectionClosed) as closed:
+            ws.recv(timeout=WAIT_S)
+        assert closed.value.rcvd is not None and closed.value.rcvd.code == 1001
 
 
 def test_the_port_is_free_after_stop(bridge: CounterBridge) -> None:
