@@ -142,8 +142,10 @@ class RosbridgeServer:
 
     def _screen(self, connection: ServerConnection, request: Request) -> Response | None:
         """Refuse a browser from a foreign origin, or a request without the token (HTTP 403)."""
-        origin = request.headers.get("Origin")
-        if not self.policy.origin_ok(origin):
+        origins = request.headers.get_all("Origin")
+        origin = origins[0] if len(origins) == 1 else None
+        if len(origins) > 1 or not self.policy.origin_ok(origin):
+            origin = ", ".join(origins)
             self.stats["refused origin"] += 1
             log.warning(
                 "rosbridge: refused a websocket from origin %r: allowed are %s",

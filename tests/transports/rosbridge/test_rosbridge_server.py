@@ -330,6 +330,13 @@ def test_a_browser_from_a_foreign_origin_is_refused_with_403(
     assert rosbridge.server.stats["refused origin"] == 1
 
 
+def test_two_origin_headers_are_refused(rosbridge: ServerThread) -> None:
+    headers = [("Origin", "http://localhost"), ("Origin", "https://evil.example.com")]
+    with pytest.raises(InvalidStatus) as refused:
+        connect(rosbridge.url, additional_headers=headers)
+    assert refused.value.response.status_code == 403
+
+
 @pytest.mark.parametrize("policy", [RosbridgePolicy(token="s3cret")])
 def test_with_a_token_a_connection_needs_it(rosbridge: ServerThread) -> None:
     for url in (rosbridge.url, rosbridge.url + "?token=wrong"):
