@@ -1,0 +1,236 @@
+"""One rosbridge client: its frames served in order, its subscriptions and advertisements.
+
+Each frame is read by ``protocol.parse_frame`` and served by one method; a
+request that waits (a publish taken by the session, a service call) holds the
+connection's later requests, never another connection's. Every error becomes a
+``status`` naming it, with the request's ``id`` (and, for ``call_service``, a
+``service_response`` with ``result: false``); the connection goes on.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from typing import TYPE_CHECKING
+
+from websockets.asyncio.server import ServerConnection
+from websockets.exceptions import ConnectionClosed
+
+from ...errors import C2rvizError
+from . import protocol, rosapi
+from .outbox import Outbox
+from .protocol import LEVELS, SUPPORTED_OPS, FrameId, RosbridgeError, resolve_name
+
+if TYPE_CHECKING:
+    from .server import RosbridgeServer
+
+__all__ = ["Connection"]
+
+log = logging.getLogger("c2rviz.rosbridge")
+
+
+class Connection:
+    """One client: its status level, subscriptions and advertised topics."""
+
+    def __init__(self, server: RosbridgeServer, websocket: ServerConnection) -> None:
+        self.server, self.websocket = server, websocket
+        self.bridge, self.policy = server.bridge, server.policy
+        host, port = websocket.remote_address[:2]
+        self.source = f"rosbridge {host}:{port}"
+        self.level = "error"
+        self.outboxes: dict[str, Outbox] = {}
+        self.advertised: dict[str, str] = {}
+        self.stopping = False
+        self._serving: asyncio.Future[None] | None = None
+
+    async def run(self) -> None:
+        """Serve the connection's frames in order until it closes or the server stops."""
+        try:
+            async for frame in self.websocket:
+                if self.stopping:
+                    break
+                self._serving = asyncio.ensure_future(self.handle(frame))
+                try:
+                    await self._serving
+                except asyncio.CancelledError:
+                    if self.stopping:
+                        break
+                    raise
+                finally:
+                    self._serving = None
+        except ConnectionClosed:
+            pass
+
+    def stop(self) -> None:
+        """Give up the request being served (a service call that waits) and read no more."""
+        self.stopping = True
+        if self._serving is not None:
+            self._serving.cancel()
+
+    async def handle(self, frame: str | bytes) -> None:
+        """Serve one frame; any error becomes a status (and a failed service_response)."""
+        if isinstance(frame, bytes):
+            problem = "binary frames (CBOR, BSON) are not read: send JSON text frames"
+            await self.refuse(RosbridgeError(problem))
+        else:
+            await self.handle_text(frame)
+
+    async def close(self) -> None:
+        """Stop every subscription of the connection (at its end)."""
+        outboxes, self.outboxes = list(self.outboxes.values()), {}
+        for outbox in outboxes:
+            try:
+                self.bridge.unsubscribe(outbox.handle)
+            except Exception:
+                log.exception("rosbridge: unsubscribing %s failed", outbox.spelling)
+            await outbox.close()
+
+    async def handle_text(self, text: str) -> None:
+        op: protocol.Op | None = None
+        try:
+            op = protocol.parse_frame(text)
+            await self.serve(op)
+        except (asyncio.CancelledError, ConnectionClosed):
+            raise
+        except RosbridgeError as error:
+            await self.refuse(error)
+        except C2rvizError as error:
+            await self.refuse(error, op)
+        except Exception:
+            log.exception("rosbridge: %s failed on %s", self.source, text[:200])
+            await self.refuse(C2rvizError("internal error in c2rviz (see its log)"), op)
+
+    async def serve(self, op: protocol.Op) -> None:
+        if isinstance(op, protocol.Subscribe):
+            await self.subscribe(op)
+        elif isinstance(op, protocol.Unsubscribe):
+            await self.unsubscribe(op)
+        elif isinstance(op, protocol.Advertise):
+            await self.advertise(op)
+        elif isinstance(op, protocol.Unadvertise):
+            if self.advertised.pop(op.topic, None) is None:
+                await self.status("warning", f"unadvertise: {op.topic} is not advertised", op.id)
+        elif isinstance(op, protocol.Publish):
+            await self.bridge.publish(self.source, resolve_name(op.topic), op.msg)
+        elif isinstance(op, protocol.CallService):
+            await self.call_service(op)
+        elif isinstance(op, protocol.SetLevel):
+            self.level = op.level
+        else:
+            served = ", ".join(SUPPORTED_OPS)
+            problem = f"is not served by c2rviz (it serves: {served})"
+            raise RosbridgeError(problem, op.id, op.op)
+
+    def topic_type(self, op: str, topic: str, id: FrameId) -> str:
+        """The type of ``topic`` (as spelled), or an error naming the topics there are."""
+        topics = dict(self.server.graph().topics)
+        kind = topics.get(resolve_name(topic))
+        if kind is None:
+            raise RosbridgeError(f"no topic {topic} (topics: {', '.join(sorted(topics))})", id, op)
+        return kind
+
+    def room(self, op: str, id: FrameId, used: int, what: str) -> None:
+        """Refuse one more subscription or advertisement past the connection's limit."""
+        limit = self.policy.max_subscriptions
+        if used >= limit:
+            problem = f"too many {what} on this connection (limit {limit}); un{op} some first"
+            raise RosbridgeError(problem, id, op)
+
+    async def subscribe(self, op: protocol.Subscribe) -> None:
+        if op.compression != "none":
+            problem = f"compression {op.compression!r} is not served: c2rviz sends JSON ('none')"
+            raise RosbridgeError(problem, op.id, "subscribe")
+        kind = self.topic_type("subscribe", op.topic, op.id)
+        if op.type is not None and op.type != kind:
+            raise RosbridgeError(f"{op.topic} has type {kind}, not {op.type}", op.id, "subscribe")
+        outbox = self.outboxes.get(op.topic)
+        if outbox is None or op.id not in outbox.requests:
+            used = sum(len(o.requests) for o in self.outboxes.values())
+            self.room("subscribe", op.id, used, "subscriptions")
+        length = min(op.queue_length, self.policy.max_queue_length)
+        if length < op.queue_length:
+            text = f"subscribe: queue_length {op.queue_length} cut to {length}"
+            await self.status("warning", text, op.id)
+        if outbox is not None:
+            outbox.request(op.id, op.throttle_rate_ms, length)
+            return
+        server = self.server
+        outbox = Outbox(
+            op.topic, self.websocket.send, server.encode, server.stats, server.sent_probe
+        )
+        outbox.request(op.id, op.throttle_rate_ms, length)
+        outbox.handle = self.bridge.subscribe(resolve_name(op.topic), outbox.deliver)
+        self.outboxes[op.topic] = outbox
+        outbox.start()
+
+    async def unsubscribe(self, op: protocol.Unsubscribe) -> None:
+        outbox = self.outboxes.get(op.topic)
+        if outbox is None or (op.id is not None and op.id not in outbox.requests):
+            which = "" if op.id is None else f" with id {op.id!r}"
+            await self.status(
+                "warning", f"unsubscribe: no subscription to {op.topic}{which}", op.id
+            )
+            return
+        outbox.drop(op.id)
+        if not outbox.requests:
+            del self.outboxes[op.topic]
+            self.bridge.unsubscribe(outbox.handle)
+            await outbox.close()
+
+    async def advertise(self, op: protocol.Advertise) -> None:
+        kind = self.topic_type("advertise", op.topic, op.id)
+        if op.type != kind:
+            raise RosbridgeError(f"{op.topic} has type {kind}, not {op.type}", op.id, "advertise")
+        if op.topic not in self.advertised:
+            self.room("advertise", op.id, len(self.advertised), "advertised topics")
+        self.advertised[op.topic] = kind
+
+    async def call_service(self, op: protocol.CallService) -> None:
+        name = resolve_name(op.service)
+        graph = self.server.graph()
+        try:
+            if rosapi.is_rosapi(name):
+                values = rosapi.answer(name, op.args, graph)
+            elif name in dict(graph.services):
+                values = await self.bridge.call_service(self.source, name, op.args)
+            else:
+                known = sorted([s for s, _ in graph.services] + list(rosapi.ROSAPI_SERVICES))
+                problem = f"no service {op.service} (services: {', '.join(known)})"
+                raise RosbridgeError(problem, op.id, "call_service")
+        except (asyncio.CancelledError, ConnectionClosed):
+            raise
+        except Exception as error:
+            if not isinstance(error, C2rvizError):
+                log.exception("rosbridge: %s failed on call_service %s", self.source, name)
+                error = C2rvizError("internal error in c2rviz (see its log)")
+            text = (
+                str(error)
+                if isinstance(error, RosbridgeError)
+                else f"call_service {op.service}: {error}"
+            )
+            self.server.stats["errors"] += 1
+            await self.send(protocol.service_response(op.id, op.service, text, False))
+            await self.status("error", text, op.id)
+            return
+        await self.send(protocol.service_response(op.id, op.service, values, True))
+
+    async def refuse(self, error: C2rvizError, op: protocol.Op | None = None) -> None:
+        """Answer a refused request: a status error (and a failed service_response)."""
+        self.server.stats["errors"] += 1
+        if isinstance(error, RosbridgeError):
+            id, text = error.id, str(error)
+            if error.op == "call_service" and error.service is not None:
+                await self.send(protocol.service_response(id, error.service, text, False))
+        else:
+            id = op.id if op is not None else None
+            what = protocol.op_name(op) if op is not None else "request"
+            target = getattr(op, "topic", None) or getattr(op, "service", None)
+            text = f"{what} {target}: {error}" if target else f"{what}: {error}"
+        await self.status("error", text, id)
+
+    async def status(self, level: str, text: str, id: FrameId) -> None:
+        if LEVELS.index(level) <= LEVELS.index(self.level):
+            await self.send(protocol.status(level, text, id))
+
+    async def send(self, text: str) -> None:
+        await self.websocket.send(text)

@@ -1,0 +1,125 @@
+"""Who may open the rosbridge websocket, and the limits it keeps (pure, no I/O).
+
+Browsers send ``Origin`` with every websocket they open and do not hold
+websockets to the same-origin rule, so any web page the user visits could
+drive the robot through rosbridge unless the server checks that header. A
+browser's connection is let in from a loopback page (``http(s)://localhost``,
+``127.0.0.1`` or ``[::1]``, any port: a roslibjs dashboard served locally) or
+from an origin the user lists; a connection without ``Origin`` is not from a
+browser (roslibpy, a script) and is let in. With a token set, every
+connection needs ``?token=<token>`` in its URL. A host name that resolves to
+127.0.0.1 is not enough (DNS rebinding): the loopback names are fixed.
+"""
+
+from __future__ import annotations
+
+import hmac
+from dataclasses import dataclass
+from urllib.parse import parse_qs, urlsplit
+
+from ...errors import C2rvizError
+
+__all__ = ["LOOPBACK_HOSTS", "PolicyError", "RosbridgePolicy", "normalize_origin"]
+
+LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "[::1]")
+
+
+class PolicyError(C2rvizError):
+    """A rosbridge setting that cannot work (an origin that is not one, a limit below 1)."""
+
+    def __init__(self, name: str, value: object, expected: str) -> None:
+        self.name, self.value = name, value
+        shown = repr(str(value)[:60])
+        super().__init__(f"rosbridge {name} {shown} is not {expected}")
+
+
+def normalize_origin(origin: str) -> str | None:
+    """``scheme://host:port`` in lower case with the port spelled out, or None.
+
+    None for anything but an ``http``/``https`` origin (``null``, a path, ...).
+    """
+    try:
+        parts = urlsplit(origin.strip())
+        port = parts.port
+    except ValueError:
+        return None
+    if (
+        parts.scheme not in ("http", "https")
+        or not parts.hostname
+        or parts.path not in ("", "/")
+        or parts.query
+        or parts.fragment
+        or "@" in parts.netloc
+    ):
+        return None
+    host = f"[{parts.hostname}]" if ":" in parts.hostname else parts.hostname
+    return f"{parts.scheme}://{host}:{port or (443 if parts.scheme == 'https' else 80)}"
+
+
+@dataclass(frozen=True)
+class RosbridgePolicy:
+    """What the rosbridge websocket lets in, and how much.
+
+    Attributes:
+        extra_origins: Browser origins allowed besides loopback pages, e.g.
+            ``https://dashboard.example.org`` (the viewer's ``--viewer-origin`` list).
+        token: When set, a connection needs ``?token=<token>`` in its URL.
+        max_frame_bytes: Largest frame a client may send [bytes]; a larger one
+            closes the connection with code 1009 (message too big). 1 MiB holds
+            a JointTrajectory of several thousand points.
+        max_connections: Clients connected at once; one more is closed with
+            code 1013 (try again later).
+        max_subscriptions: Subscriptions (by id) per connection, and as many
+            advertised topics; one more is answered with a status error.
+        max_queue_length: Largest ``queue_length`` a subscription gets; a
+            larger request is cut to it (with a status warning).
+        compression: Offer permessage-deflate; off by default (it costs CPU
+            per subscriber and frames are small on loopback).
+    """
+
+    extra_origins: tuple[str, ...] = ()
+    token: str | None = None
+    max_frame_bytes: int = 1 << 20
+    max_connections: int = 32
+    max_subscriptions: int = 64
+    max_queue_length: int = 100
+    compression: bool = False
+
+    def __post_init__(self) -> None:
+        for origin in self.extra_origins:
+            if normalize_origin(origin) is None:
+                raise PolicyError("origin", origin, "scheme://host[:port] (http or https)")
+        if self.token is not None and not (
+            self.token and self.token.isascii() and self.token.isprintable()
+        ):
+            raise PolicyError("token", self.token, "non-empty printable ASCII")
+        for name in ("max_frame_bytes", "max_connections", "max_subscriptions"):
+            if getattr(self, name) < 1:
+                raise PolicyError(name.replace("_", " "), getattr(self, name), "at least 1")
+        if self.max_queue_length < 0:
+            raise PolicyError("max queue length", self.max_queue_length, "at least 0")
+
+    def origins(self) -> list[str]:
+        """The allowed browser origins, for a refusal's message."""
+        loopback = [f"http(s)://{host}:<any port>" for host in LOOPBACK_HOSTS]
+        extra = sorted({o for o in map(normalize_origin, self.extra_origins) if o})
+        return loopback + extra
+
+    def origin_ok(self, origin: str | None) -> bool:
+        """Whether a connection with this ``Origin`` header (None: no header) may open."""
+        if origin is None:
+            return True  # not a browser: browsers always send Origin on a websocket
+        normal = normalize_origin(origin)
+        if normal is None:
+            return False
+        host = normal.split("://", 1)[1].rsplit(":", 1)[0]
+        if host in LOOPBACK_HOSTS:
+            return True
+        return normal in {normalize_origin(o) for o in self.extra_origins}
+
+    def token_ok(self, path: str) -> bool:
+        """Whether the request target ``path`` carries the token (or none is needed)."""
+        if self.token is None:
+            return True
+        given = parse_qs(urlsplit(path).query, keep_blank_values=True).get("token", [])
+        return any(hmac.compare_digest(g.encode(), self.token.encode()) for g in given)
