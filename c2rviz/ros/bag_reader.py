@@ -23,7 +23,7 @@ memory stays flat however long the bag.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Sequence
+from collections.abc import Generator, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -50,7 +50,12 @@ JOINT_STATE_TYPES = ("sensor_msgs/msg/JointState", "sensor_msgs/JointState")
 _SUFFIXES = (".mcap", ".db3", ".bag")
 _KINDS = "a rosbag2 folder (with metadata.yaml), an .mcap or .db3 file, or a ROS 1 .bag"
 # rosbags' words for a file that is not a bag at all (the rest means damaged).
-_NOT_A_BAG = ("magic is invalid", "seems to be empty", "profile is not", "unrecognized storage")
+_NOT_A_BAG = (
+    "file magic is invalid",
+    "seems to be empty",
+    "profile is not",
+    "unrecognized storage",
+)
 
 
 def _classify(path: Path, exc: BaseException) -> BagError:
@@ -60,7 +65,8 @@ def _classify(path: Path, exc: BaseException) -> BagError:
         return NotABag(str(path), f"is a folder without metadata.yaml; give {_KINDS}")
     if any(words in text.lower() for words in _NOT_A_BAG):
         return NotABag(str(path), f"is not a bag ({text.rstrip('.')}); give {_KINDS}")
-    return BagCorrupted(str(path), f"is truncated or damaged: {text}")
+    hint = " (`mcap recover` can save what it holds)" if "end magic" in text else ""
+    return BagCorrupted(str(path), f"is truncated or damaged: {text}{hint}")
 
 
 class JointStateBag:
@@ -148,7 +154,7 @@ class JointStateBag:
 
     def samples(
         self, chain_names: Sequence[str], start_s: float = 0.0, duration_s: float | None = None
-    ) -> Iterator[tuple[float, tuple[float, ...]]]:
+    ) -> Generator[tuple[float, tuple[float, ...]], None, None]:
         """Yield ``(t_s, positions)`` of the span, lazily: t [s from the bag's start],
         the chain's positions [rad or m] in chain order. Raises as ``check`` does."""
         return self._scan(chain_names, start_s, duration_s, [])
@@ -184,7 +190,7 @@ class JointStateBag:
         start_s: float,
         duration_s: float | None,
         warnings: list[str],
-    ) -> Iterator[tuple[float, tuple[float, ...]]]:
+    ) -> Generator[tuple[float, tuple[float, ...]], None, None]:
         start, stop = self._span(start_s, duration_s)
         decoder = JointStateDecoder()
         chain = tuple(chain_names)

@@ -124,8 +124,8 @@ class BagWriter:
         self.encoder = CdrEncoder(self.typestore)
         self._connections: dict[str, tuple[Connection, str]] = {}
         self._static: dict[str, messages.Msg] = {}  # /tf_static so far, by child frame
-        self._writer = Writer(self.path, version=9, storage_plugin=StoragePlugin.MCAP)
         try:
+            self._writer = Writer(self.path, version=9, storage_plugin=StoragePlugin.MCAP)
             self._writer.open()
         except WriterError:
             raise BagError(str(self.path), "exists already; give a new name") from None
@@ -150,14 +150,15 @@ class BagWriter:
         """
         if self.closed:
             return
+        data = memoryview(self.encoder.encode(msgtype, message))  # first: it checks the type
+        if t_s < 0:
+            raise MessageError(f"bag time {t_s} s is negative")
+        log_ns = messages.nanoseconds(t_s)  # the header stamps' own rounding
         known = self._connections.get(topic)
         if known is None or known[1] != msgtype:
             known = self._connect(topic, msgtype)
-        data = memoryview(self.encoder.encode(msgtype, message))
-        if t_s < 0:
-            raise MessageError(f"bag time {t_s} s is negative")
         try:
-            self._writer.write(known[0], round(t_s * 1e9), data)
+            self._writer.write(known[0], log_ns, data)
         except OSError as exc:
             self._fail(exc)
             return
@@ -168,12 +169,9 @@ class BagWriter:
             raise MessageError(
                 f"topic {topic} carries {self._connections[topic][1]}, not {msgtype}"
             )
-        try:
-            connection = self._writer.add_connection(
-                topic, msgtype, typestore=self.typestore, offered_qos_profiles=[qos_for(topic)]
-            )
-        except KeyError:
-            raise MessageError(f"unknown message type {msgtype!r}") from None
+        connection = self._writer.add_connection(
+            topic, msgtype, typestore=self.typestore, offered_qos_profiles=[qos_for(topic)]
+        )
         self._connections[topic] = (connection, msgtype)
         return self._connections[topic]
 

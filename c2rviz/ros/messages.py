@@ -44,6 +44,7 @@ __all__ = [
     "joint_state",
     "marker",
     "marker_array",
+    "nanoseconds",
     "object_marker",
     "stamp",
     "string",
@@ -78,15 +79,28 @@ _NAMESPACE = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 _INT32 = 2**31
 
 
-def stamp(t_s: float) -> Msg:
-    """``builtin_interfaces/msg/Time`` for ``t_s`` [s], to the nearest nanosecond.
+def nanoseconds(t_s: float) -> int:
+    """``t_s`` [s] to the nearest nanosecond [ns], exact to the float's last digit.
+
+    (``round(t_s * 1e9)`` would lose up to 128 ns on epoch times: the product
+    passes 2**53.)
 
     Raises:
         MessageError: ``t_s`` is not finite or outside the int32 seconds of ROS time.
     """
     if not math.isfinite(t_s) or not -_INT32 <= t_s < _INT32:
         raise MessageError(f"time {t_s!r} s is not a ROS time (finite, within +-2**31 s)")
-    sec, nanosec = divmod(round(t_s * 1e9), 1_000_000_000)
+    sec = math.floor(t_s)
+    return sec * 1_000_000_000 + round((t_s - sec) * 1e9)
+
+
+def stamp(t_s: float) -> Msg:
+    """``builtin_interfaces/msg/Time`` for ``t_s`` [s], to the nearest nanosecond.
+
+    Raises:
+        MessageError: ``t_s`` is not finite or outside the int32 seconds of ROS time.
+    """
+    sec, nanosec = divmod(nanoseconds(t_s), 1_000_000_000)
     return {"sec": sec, "nanosec": nanosec}
 
 
