@@ -24,10 +24,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Generator, Iterator, Sequence
+from math import isfinite
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 from rosbags.highlevel import AnyReader
 
 from .errors import (
@@ -194,7 +194,7 @@ class JointStateBag:
         start, stop = self._span(start_s, duration_s)
         decoder = JointStateDecoder()
         chain = tuple(chain_names)
-        where: dict[tuple[str, ...], np.ndarray | None] = {}  # names -> chain's indices
+        where: dict[tuple[str, ...], list[int] | None] = {}  # names -> chain's indices
         extra: dict[str, None] = {}
         previous_stamp, skipped, sent = -(2**63), 0, 0
         first_skipped: tuple[float, tuple[str, ...]] | None = None
@@ -216,9 +216,9 @@ class JointStateBag:
                 skipped += 1
                 first_skipped = first_skipped or (t_s, names)
                 continue
-            values = positions[index]
-            if not np.isfinite(values).all():
-                k = int(np.flatnonzero(~np.isfinite(values))[0])
+            values = tuple([positions[k] for k in index])
+            if not all(map(isfinite, values)):
+                k = next(k for k, value in enumerate(values) if not isfinite(value))
                 raise BadSample(
                     path, f"joint {chain[k]!r} is {values[k]} at {t_s:.6f} s (not a finite number)"
                 )
@@ -226,7 +226,7 @@ class JointStateBag:
                 raise StampsBackwards(path, t_s, stamp_ns / 1e9, previous_stamp / 1e9)
             previous_stamp = stamp_ns
             sent += 1
-            yield t_s, tuple(values.tolist())
+            yield t_s, values
         if not sent and first_skipped is not None:  # names, but none of the chain's
             raise MissingJoint(path, chain[0], *first_skipped)
         if not sent:
@@ -249,7 +249,7 @@ class JointStateBag:
 
     def _decode(
         self, decoder: JointStateDecoder, raw: bytes, t_s: float
-    ) -> tuple[int, tuple[str, ...], np.ndarray]:
+    ) -> tuple[int, tuple[str, ...], tuple[float, ...]]:
         try:
             decoded = decoder.decode(raw) if self._cdr else None
             if decoded is not None:
@@ -261,7 +261,8 @@ class JointStateBag:
             ) from None
         stamp = message.header.stamp
         names = tuple(message.name)
-        return stamp.sec * 1_000_000_000 + stamp.nanosec, names, np.asarray(message.position)
+        positions = tuple(float(value) for value in message.position)
+        return stamp.sec * 1_000_000_000 + stamp.nanosec, names, positions
 
 
 def _choose(path: Path, reader: AnyReader, topic: str | None) -> str:
@@ -281,7 +282,7 @@ def _choose(path: Path, reader: AnyReader, topic: str | None) -> str:
 
 def _chain_index(
     path: str, chain: tuple[str, ...], names: tuple[str, ...], t_s: float
-) -> np.ndarray | None:
+) -> list[int] | None:
     """Where each chain joint is in ``names``; None if it names none of them."""
     position = {name: k for k, name in enumerate(names)}
     missing = [name for name in chain if name not in position]
@@ -289,4 +290,4 @@ def _chain_index(
         return None
     if missing:
         raise MissingJoint(path, missing[0], t_s, names)
-    return np.array([position[name] for name in chain], dtype=int)
+    return [position[name] for name in chain]

@@ -3,7 +3,8 @@
 Pure: bytes in, values out. A player reads hundreds of thousands of these, and
 nearly all repeat the previous message's joint names: ``JointStateDecoder``
 compares the names' bytes with the last ones it parsed and reuses the parsed
-names when they match, and takes the positions as a numpy view. Little-endian
+names when they match, and unpacks the positions with a ``struct`` kept per
+count (for a handful of joints, several times quicker than numpy). Little-endian
 CDR only (what every ROS 2 publisher on x86 and ARM sends); ``decode`` returns
 None for anything else so the caller can fall back on a general deserializer.
 """
@@ -11,16 +12,20 @@ None for anything else so the caller can fall back on a general deserializer.
 from __future__ import annotations
 
 import struct
+from functools import cache
 
-import numpy as np
-
-__all__ = ["JointStateDecoder", "Decoded"]
+__all__ = ["Decoded", "JointStateDecoder"]
 
 _STAMP = struct.Struct("<iI")
 _UINT32 = struct.Struct("<I")
 
-Decoded = tuple[int, tuple[str, ...], np.ndarray]
+Decoded = tuple[int, tuple[str, ...], tuple[float, ...]]
 """(header stamp [ns], joint names, positions [rad or m])."""
+
+
+@cache
+def _doubles(count: int) -> struct.Struct:
+    return struct.Struct(f"<{count}d")
 
 
 class JointStateDecoder:
@@ -65,9 +70,8 @@ class JointStateDecoder:
         at += -at % 4
         (n,) = _UINT32.unpack_from(raw, at)
         at += 4
+        positions: tuple[float, ...] = ()
         if n:
             at += (4 - at) % 8  # doubles align to 8 in the payload, which starts at 4
-            if at + 8 * n > len(raw):
-                raise ValueError("the positions run past the message")
-        positions = np.frombuffer(raw, dtype="<f8", count=n, offset=at) if n else np.empty(0)
+            positions = _doubles(n).unpack_from(raw, at)  # struct.error if it runs past
         return sec * 1_000_000_000 + nanosec, names, positions
