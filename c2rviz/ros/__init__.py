@@ -6,12 +6,17 @@ MCAP storage out; rosbag2 folders, bare ``.mcap``/``.db3`` files and ROS 1
 ``.bag`` files in). Nothing here uses asyncio or the world: the recorder and
 the player drive these pieces.
 
-- ``messages``: builders of JointState, TFMessage, String and MarkerArray dicts;
+- ``messages``: builders of JointState, TFMessage and String dicts, stamps,
+  namespaces and frame prefixes; ``markers``: MarkerArray dicts (markers and
+  workcell objects);
+- ``cdr``: ``CdrEncoder``, dict -> CDR bytes, compiled once per type;
 - ``tf_tree``: ``TfTree``, a robot's joint states and transforms as
   robot_state_publisher gives them;
 - ``bag_writer``: ``BagWriter``, one rosbag2 MCAP bag being written;
+  ``bag_repair``: ending a bag whose writing stopped half-way;
 - ``robot_bag``: ``BagRobot``, one robot's topics in a bag;
-- ``bag_reader``: ``JointStateBag``, a bag's JointState samples, checked, streamed;
+- ``bag_reader``: ``JointStateBag``, a bag's JointState samples, checked, streamed
+  (``joint_state_cdr`` decodes them);
 - ``errors``: the door's errors (all ``C2rvizError``).
 
 Importing the package is cheap (a rosbridge door needs ``messages`` alone); the

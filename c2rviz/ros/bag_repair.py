@@ -1,12 +1,14 @@
-"""Ending a rosbag2 MCAP bag whose writing stopped half-way (a full disk, a failed close).
+"""Ending a rosbag2 MCAP bag whose writing stopped half-way (a full disk, a failed close, a kill).
 
-``end_mcap`` cuts an ``.mcap`` file after its last whole record and ends it
-with MCAP's DataEnd and Footer records and closing magic, without a summary
-section: what stays is every chunk written whole before the failure, and
-MCAP readers (``rosbags``, the ``mcap`` package, the MCAP C++ reader of ``ros2
-bag``) read such a file by scanning it. ``write_metadata`` then writes the
-folder's ``metadata.yaml`` from what the file really holds. Both write only a
-few hundred bytes; the file is only ever shortened before them.
+``end_bag(folder)`` ends a bag left unfinished. ``end_mcap`` cuts its
+``.mcap`` after the last whole record and ends it with MCAP's DataEnd and
+Footer records and closing magic, without a summary section: what stays is
+every chunk written whole before the failure. ``rosbags`` and the ``mcap``
+package read such a file by scanning it, Foxglove as an unindexed file;
+``ros2 bag play`` wants its index back first (``mcap recover`` writes it).
+Then ``write_metadata`` writes the folder's ``metadata.yaml`` from what the
+file really holds. Both write only a few hundred bytes, and the file is only
+ever shortened before them.
 
 The record layout is MCAP's public specification (https://mcap.dev/spec):
 8 bytes of magic, then records of an opcode byte, a little-endian uint64
@@ -24,7 +26,7 @@ from rosbags.interfaces import ConnectionExtRosbag2, Qos
 from rosbags.rosbag2 import Reader
 from rosbags.typesys.store import Typestore
 
-__all__ = ["MAGIC", "end_mcap", "ended", "qos_dict", "write_metadata"]
+__all__ = ["MAGIC", "end_bag", "end_mcap", "ended", "qos_dict", "write_metadata"]
 
 MAGIC = b"\x89MCAP0\r\n"
 _HEADER, _FOOTER, _DATA_END = 0x01, 0x02, 0x0F
@@ -175,3 +177,20 @@ def write_metadata(folder: Path, mcap: Path, typestore: Typestore) -> int:
     temporary.write_text(text, encoding="utf-8")
     temporary.replace(folder / "metadata.yaml")
     return count
+
+
+def end_bag(folder: Path, typestore: Typestore) -> int:
+    """End the one ``.mcap`` of a bag folder if it lacks its end, and (re)write its metadata.
+
+    Returns the number of messages it holds.
+
+    Raises:
+        OSError: a file cannot be read or written.
+        FileNotFoundError: the folder holds no ``.mcap``, or more than one.
+        rosbags.rosbag2.ReaderError: what is left cannot be read.
+    """
+    files = sorted(folder.glob("*.mcap"))
+    if len(files) != 1:
+        raise FileNotFoundError(f"{folder} holds {len(files)} .mcap files, not one")
+    end_mcap(files[0])
+    return write_metadata(folder, files[0], typestore)

@@ -15,16 +15,19 @@ static broadcaster does.
 A write error (a full disk: ENOSPC, a file-size limit: EFBIG, any OSError)
 stops the bag: the error is logged and reported once (``error``, and
 ``on_error`` if given), later writes are ignored, and the bag is ended where
-it stands. End state after an error: ``NAME.mcap`` holds every message up to
-its last whole chunk (rosbags writes chunks of about 1 MiB, so the newest
-messages up to that size are lost), ended with MCAP's DataEnd and Footer and no
-summary (readers scan it); ``metadata.yaml`` is written from what the file holds.
-Room for that end is kept: a reserve file ``.c2rviz-reserve`` of
-``RESERVE_BYTES`` sits in the folder while it records and is deleted before
-the bag is ended (and before a normal close writes its summary). If even that
-fails, ``NAME.mcap`` alone (without ``metadata.yaml``) is still a bag
-``rosbags`` and ``mcap`` read, or none is left only if the disk refused the
-few bytes of its end.
+it stands. The end state after an error:
+
+- ``NAME.mcap`` holds every message up to its last whole chunk (rosbags writes
+  chunks of about 1 MiB: the newest messages up to that size are lost), ended
+  with MCAP's DataEnd and Footer records and no summary. ``rosbags`` and the
+  ``mcap`` package read it by scanning; ``ros2 bag play`` wants it indexed
+  first (``mcap recover``).
+- ``metadata.yaml`` is written from what ``NAME.mcap`` really holds.
+- Room for both is kept: a reserve file ``.c2rviz-reserve`` of
+  ``RESERVE_BYTES`` sits in the folder while recording and is deleted before the
+  bag is ended (and before a normal close writes its summary). Should the disk
+  still refuse those few hundred bytes, the warning says the bag "could not be
+  fully ended" and ``bag_repair.end_bag`` can end it later.
 """
 
 from __future__ import annotations
@@ -49,9 +52,10 @@ from rosbags.rosbag2 import StoragePlugin, Writer, WriterError
 from rosbags.typesys import Stores, get_typestore
 
 from . import messages
-from .bag_repair import end_mcap, write_metadata
+from .bag_repair import end_bag
 from .cdr import CdrEncoder
 from .errors import BagError, MessageError
+from .markers import MARKER_ARRAY
 
 __all__ = ["QOS_DEFAULT", "QOS_LATCHED", "QOS_TF", "RESERVE_BYTES", "BagWriter", "qos_for"]
 
@@ -202,7 +206,7 @@ class BagWriter:
     def markers(self, t_s: float, message: Mapping[str, Any], namespace: str = "") -> None:
         """A ``MarkerArray`` on ``[/NAMESPACE]/visualization_marker_array``."""
         topic = messages.topic(namespace, "visualization_marker_array")
-        self.write(topic, messages.MARKER_ARRAY, t_s, message)
+        self.write(topic, MARKER_ARRAY, t_s, message)
 
     # The end.
 
@@ -232,9 +236,7 @@ class BagWriter:
         self._unreserve()
         ended = "ended"
         try:
-            if self.mcap.exists():
-                end_mcap(self.mcap)
-                write_metadata(self.path, self.mcap, self.typestore)
+            end_bag(self.path, self.typestore)
         except Exception as again:  # what is left is reported, whatever the reader said
             ended = f"could not be fully ended ({again})"
         log.warning("bag %s stopped by a %s; it is %s", self.path, self.error, ended)

@@ -14,6 +14,7 @@ from rosbags.highlevel import AnyReader
 from rosbags.interfaces import QosDurability
 from test_ros_tf_tree import close, link_poses
 
+from c2rviz.ros import markers as mk
 from c2rviz.ros import messages as m
 from c2rviz.ros.bag_writer import BagWriter
 from c2rviz.ros.errors import BagError, MessageError
@@ -41,11 +42,11 @@ def record_one(path: Path) -> tuple[list[tuple[float, list[float]]], BagRobot]:
             if t in (0.0, 1.0):
                 writer.text("/c2rviz/commands", t, f"tcp:1 joints {q}")
                 writer.text("/c2rviz/replies", t, "ok")
-        marker = m.marker(
-            0.2, "base_link", "markers", 0, m.SPHERE, (0.5, 0, 0.3), scale=(0.02,) * 3
+        marker = mk.marker(
+            0.2, "base_link", "markers", 0, mk.SPHERE, (0.5, 0, 0.3), scale=(0.02,) * 3
         )
-        writer.markers(0.2, m.marker_array([marker]))
-        writer.markers(1.2, m.marker_array([m.delete_marker(1.2, "base_link", "markers", 0)]))
+        writer.markers(0.2, mk.marker_array([marker]))
+        writer.markers(1.2, mk.marker_array([mk.delete_marker(1.2, "base_link", "markers", 0)]))
         assert not writer.closed and writer.error is None
     assert writer.closed and writer.error is None
     return states, arm
@@ -136,8 +137,8 @@ def test_one_robot_reads_back_with_rosbags(tmp_path: Path) -> None:
     assert [x.data for _, x in by_topic["/c2rviz/replies"]] == ["ok", "ok"]
     markers = [x.markers[0] for _, x in by_topic["/visualization_marker_array"]]
     assert [(x.action, x.type, x.ns, x.id) for x in markers] == [
-        (0, m.SPHERE, "markers", 0),
-        (2, m.CUBE, "markers", 0),
+        (0, mk.SPHERE, "markers", 0),
+        (2, mk.CUBE, "markers", 0),
     ]
     metadata = (tmp_path / "rec" / "metadata.yaml").read_text()
     assert "version: 9" in metadata and "storage_identifier: mcap" in metadata

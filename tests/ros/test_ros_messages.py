@@ -9,6 +9,7 @@ from typing import Any
 import pytest
 from ros_helpers import HUMBLE, as_plain
 
+from c2rviz.ros import markers as mk
 from c2rviz.ros import messages as m
 from c2rviz.ros.cdr import CdrEncoder
 from c2rviz.ros.errors import MessageError
@@ -117,17 +118,17 @@ def test_string() -> None:
 @pytest.mark.parametrize(
     ("shape", "size", "kind", "scale"),
     [
-        ("box", (0.1, 0.2, 0.3), m.CUBE, (0.1, 0.2, 0.3)),
-        ("sphere", (0.25,), m.SPHERE, (0.5, 0.5, 0.5)),
-        ("cylinder", (0.05, 0.4), m.CYLINDER, (0.1, 0.1, 0.4)),
-        ("mesh", (1.0, 2.0, 1.0), m.MESH_RESOURCE, (1.0, 2.0, 1.0)),
+        ("box", (0.1, 0.2, 0.3), mk.CUBE, (0.1, 0.2, 0.3)),
+        ("sphere", (0.25,), mk.SPHERE, (0.5, 0.5, 0.5)),
+        ("cylinder", (0.05, 0.4), mk.CYLINDER, (0.1, 0.1, 0.4)),
+        ("mesh", (1.0, 2.0, 1.0), mk.MESH_RESOURCE, (1.0, 2.0, 1.0)),
     ],
     ids=["box", "sphere", "cylinder", "mesh"],
 )
 def test_object_markers(
     shape: str, size: tuple[float, ...], kind: int, scale: tuple[float, ...]
 ) -> None:
-    marker = m.object_marker(
+    marker = mk.object_marker(
         3.0,
         "base_link",
         f"workcell/{shape}",
@@ -139,10 +140,10 @@ def test_object_markers(
         (1, 0, 0, 0.5),
         mesh_uri="file:///tmp/part.stl",
     )
-    assert marker["type"] == kind and marker["action"] == m.ADD
+    assert marker["type"] == kind and marker["action"] == mk.ADD
     assert (marker["scale"]["x"], marker["scale"]["y"], marker["scale"]["z"]) == scale
     assert marker["mesh_resource"] == ("file:///tmp/part.stl" if shape == "mesh" else "")
-    decoded = round_trip(m.MARKER_ARRAY, m.marker_array([marker]))["markers"][0]
+    decoded = round_trip(mk.MARKER_ARRAY, mk.marker_array([marker]))["markers"][0]
     assert decoded["ns"] == f"workcell/{shape}" and decoded["header"]["frame_id"] == "base_link"
     assert decoded["pose"]["position"] == {"x": 1.0, "y": 2.0, "z": 3.0}
     assert decoded["color"] == {"r": 1.0, "g": 0.0, "b": 0.0, "a": 0.5}
@@ -150,19 +151,19 @@ def test_object_markers(
 
 @pytest.mark.parametrize("shape", ["sphere", "cube", "arrow", "cylinder"])
 def test_c2rviz_marker_shapes(shape: str) -> None:
-    marker = m.marker(1.0, "world", "markers", 7, m.SHAPES[shape], (0, 0, 1), scale=(0.02,) * 3)
+    marker = mk.marker(1.0, "world", "markers", 7, mk.SHAPES[shape], (0, 0, 1), scale=(0.02,) * 3)
     assert (
-        round_trip(m.MARKER_ARRAY, m.marker_array([marker]))["markers"][0]["type"]
-        == m.SHAPES[shape]
+        round_trip(mk.MARKER_ARRAY, mk.marker_array([marker]))["markers"][0]["type"]
+        == mk.SHAPES[shape]
     )
 
 
 def test_deletions() -> None:
-    delete = m.delete_marker(5.0, "world", "markers", 7)
-    everything = m.delete_all(5.0)
-    assert (delete["action"], delete["ns"], delete["id"]) == (m.DELETE, "markers", 7)
-    assert (everything["action"], everything["ns"]) == (m.DELETEALL, "")
-    decoded = round_trip(m.MARKER_ARRAY, m.marker_array([delete, everything]))
+    delete = mk.delete_marker(5.0, "world", "markers", 7)
+    everything = mk.delete_all(5.0)
+    assert (delete["action"], delete["ns"], delete["id"]) == (mk.DELETE, "markers", 7)
+    assert (everything["action"], everything["ns"]) == (mk.DELETEALL, "")
+    decoded = round_trip(mk.MARKER_ARRAY, mk.marker_array([delete, everything]))
     assert [x["action"] for x in decoded["markers"]] == [2, 3]
 
 
@@ -170,20 +171,20 @@ def test_deletions() -> None:
     ("call", "problem"),
     [
         (
-            lambda: m.object_marker(
+            lambda: mk.object_marker(
                 0, "f", "n", 0, "cone", (1,), (0, 0, 0), (0, 0, 0, 1), (1, 1, 1, 1)
             ),
             "not one of",
         ),
         (
-            lambda: m.object_marker(
+            lambda: mk.object_marker(
                 0, "f", "n", 0, "box", (1, 2), (0, 0, 0), (0, 0, 0, 1), (1, 1, 1, 1)
             ),
             "takes 3",
         ),
-        (lambda: m.marker(0, "f", "n", 0, 42), "shape 42"),
-        (lambda: m.marker(0, "f", "n", 0, m.CUBE, action=1), "action 1"),
-        (lambda: m.marker(0, "f", "n", 2**31, m.CUBE), "outside int32"),
+        (lambda: mk.marker(0, "f", "n", 0, 42), "shape 42"),
+        (lambda: mk.marker(0, "f", "n", 0, mk.CUBE, action=1), "action 1"),
+        (lambda: mk.marker(0, "f", "n", 2**31, mk.CUBE), "outside int32"),
     ],
     ids=["shape", "size", "marker-type", "action", "id"],
 )
@@ -198,7 +199,7 @@ def test_every_builder_gives_json() -> None:
         m.joint_state(1.0, ["a"], [1.0]),
         m.tf_message([m.transform(1.0, "a", "b", (0, 0, 0), (0, 0, 0, 1))]),
         m.string("x"),
-        m.marker_array([m.marker(1.0, "f", "n", 1, m.SPHERE), m.delete_all(1.0)]),
+        mk.marker_array([mk.marker(1.0, "f", "n", 1, mk.SPHERE), mk.delete_all(1.0)]),
     ]
     for message in built:
         assert json.loads(json.dumps(message)) == message

@@ -21,7 +21,7 @@ from ros_helpers import HUMBLE, ROOT, bundled
 from rosbags.highlevel import AnyReader
 
 from c2rviz.ros import messages as m
-from c2rviz.ros.bag_repair import end_mcap, write_metadata
+from c2rviz.ros.bag_repair import end_bag, end_mcap
 from c2rviz.ros.bag_writer import BagWriter
 from c2rviz.ros.robot_bag import BagRobot
 
@@ -148,7 +148,7 @@ def test_a_bag_cut_anywhere_ends_readable(
     (cut / "rec.mcap").write_bytes(data[: int(len(data) * fraction)])
     assert end_mcap(cut / "rec.mcap")
     assert not end_mcap(cut / "rec.mcap")  # ended once: left alone
-    count = write_metadata(cut, cut / "rec.mcap", HUMBLE)
+    count = end_bag(cut, HUMBLE)  # a folder with no metadata.yaml yet
     stamps = read_stamps(cut)
     assert stamps == everything[: len(stamps)] and count == len(stamps)
     assert mcap_count(cut / "rec.mcap") == len(stamps)
@@ -161,3 +161,24 @@ def test_a_whole_bag_is_left_alone(whole_bag: tuple[Path, list[tuple[str, int]]]
     before = (source / "rec.mcap").read_bytes()
     assert not end_mcap(source / "rec.mcap")
     assert (source / "rec.mcap").read_bytes() == before
+
+
+def test_a_killed_recording_is_ended_afterwards(tmp_path: Path) -> None:
+    """A process killed mid-recording leaves an .mcap without its end; end_bag ends it."""
+    path = tmp_path / "rec"
+    code = (
+        "import os, sys\n"
+        f"sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
+        "from pathlib import Path\n"
+        "from test_ros_write_errors import record_until_stopped\n"
+        f"writer, _, _ = record_until_stopped(Path({str(path)!r}), 3000)\n"
+        "os._exit(0)  # no close: as a SIGKILL would leave it\n"
+    )
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    subprocess.run([sys.executable, "-c", code], env=env, check=True, timeout=100)
+    assert not (path / "metadata.yaml").exists()
+    with pytest.raises(Exception, match="end magic"):
+        read_stamps(path / "rec.mcap")
+    count = end_bag(path, HUMBLE)
+    stamps = read_stamps(path)
+    assert 0 < count == len(stamps) and stamps == sorted(stamps, key=lambda s: s[1])
