@@ -1,6 +1,6 @@
 """What a rosbag2 bag costs to record beside the CSV, and what reading one back costs the player.
 
-Run: ``python benchmarks/bag_bench.py [--quick] [--minutes M] [--keep DIR]``.
+Run: ``python benchmarks/bag_bench.py [--quick] [--minutes M] [--keep DIR] [--ros1]``.
 
 Writing (CPU time of this process, median of several runs, motoman_sia20d): the
 cost of one 100 Hz frame for 1 and for 8 robots of
@@ -24,7 +24,9 @@ by a fresh process the way the player will: ``JointStateBag.open``, ``check`` of
 the span, then the first sample (goals: 2 s for a 60 s span, 10 s for the whole
 bag, the check included), then every sample to the span's end. Peak RSS of each
 reading process is printed beside the bag's size: flat memory means the whole
-bag peaks where 60 s of it does. Figures only: nothing here passes or fails.
+bag peaks where 60 s of it does. ``--ros1`` reads a ROS 1 ``.bag`` of the same
+joint states too (rosbags keeps a ROS 1 bag's message index in memory, so its
+memory grows with the bag). Figures only: nothing here passes or fails.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import xml.etree.ElementTree as ET
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
@@ -225,12 +228,51 @@ def long_bag(path: Path, minutes: float) -> Path:
     return path
 
 
+def chain_names() -> tuple[str, ...]:
+    """The motoman's chain (all its moving joints), without loading Pinocchio."""
+    root = ET.fromstring(URDF.read_text())
+    return tuple(j.get("name", "") for j in root.iter("joint") if j.get("type") != "fixed")
+
+
+def peak_rss_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def long_ros1_bag(path: Path, minutes: float) -> Path:
+    """The same joint states as a ROS 1 bag (rosbags' rosbag1 writer), for comparison."""
+    from rosbags.rosbag1 import Writer as Writer1
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS1_NOETIC)
+    types, msgtype = store.types, "sensor_msgs/msg/JointState"
+    names = list(chain_names())
+    rng = np.random.default_rng(3)
+    q = np.zeros(len(names))
+    with Writer1(path) as writer:
+        conn = writer.add_connection("/joint_states", msgtype, typestore=store)
+        for i in range(round(minutes * 60 * RATE_HZ)):
+            q = q + rng.normal(0, 0.002, len(names))
+            ns = i * 10_000_000
+            time_ = types["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9)
+            message = types[msgtype](
+                header=types["std_msgs/msg/Header"](seq=i, stamp=time_, frame_id=""),
+                name=names,
+                position=q,
+                velocity=np.empty(0),
+                effort=np.empty(0),
+            )
+            writer.write(conn, ns, store.serialize_ros1(message, msgtype))
+    print(f"wrote {path.name}: {minutes:g} min at 100 Hz, {path.stat().st_size / 1e6:.0f} MB")
+    return path
+
+
 def read_once(path: Path, duration_s: float | None) -> dict[str, float]:
     """In this process: open, check the span, time to the first sample, then the rest."""
-    chain = load().joint_names
+    chain = chain_names()
     start = time.perf_counter()
     bag = JointStateBag.open(path)
     opened = time.perf_counter()
+    rss_open = peak_rss_mb()
     warnings = bag.check(chain, 0.0, duration_s)
     checked = time.perf_counter()
     samples = bag.samples(chain, 0.0, duration_s)
@@ -246,14 +288,15 @@ def read_once(path: Path, duration_s: float | None) -> dict[str, float]:
         "all_s": done - start,
         "samples": count,
         "warnings": len(warnings),
-        "peak_rss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+        "open_rss_mb": rss_open,
+        "peak_rss_mb": peak_rss_mb(),
     }
 
 
 def reading(path: Path) -> None:
     print(f"reading {path.name} as the player will (a fresh process each; wall time)")
     print(f"{'span':>8s} {'open s':>7s} {'check s':>8s} {'first s':>8s} {'goal':>5s} "
-          f"{'all s':>7s} {'samples':>8s} {'peak RSS':>9s}")  # fmt: skip
+          f"{'all s':>7s} {'samples':>8s} {'RSS open':>9s} {'peak RSS':>9s}")  # fmt: skip
     for label, duration, goal in (("60 s", "60", 2.0), ("whole", "none", 10.0)):
         done = subprocess.run(
             [sys.executable, __file__, "--read-child", str(path), duration],
@@ -264,10 +307,11 @@ def reading(path: Path) -> None:
         r = json.loads(done.stdout.strip().splitlines()[-1])
         print(
             f"{label:>8s} {r['open_s']:7.2f} {r['check_s']:8.2f} {r['first_s']:8.2f} "
-            f"{goal:4.0f}s {r['all_s']:7.2f} {r['samples']:8d} {r['peak_rss_mb']:7.0f} MB"
+            f"{goal:4.0f}s {r['all_s']:7.2f} {r['samples']:8d} {r['open_rss_mb']:6.0f} MB "
+            f"{r['peak_rss_mb']:6.0f} MB"
         )
     print("goals: first sample <= 2 s (60 s span) and <= 10 s (whole), check included; "
-          "peak RSS of 'whole' near that of '60 s' (flat)")  # fmt: skip
+          "memory flat: 'whole' peaks where '60 s' does, a few MB over the opened bag")  # fmt: skip
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -275,6 +319,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="fewer frames; a 6-minute bag")
     parser.add_argument("--minutes", type=float, help="length of the bag to read (default 60)")
     parser.add_argument("--keep", type=Path, help="write the long bag in this folder and keep it")
+    parser.add_argument("--ros1", action="store_true", help="also read a ROS 1 .bag as long")
     parser.add_argument("--read-child", nargs=2, metavar=("BAG", "SECONDS"), help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.read_child:
@@ -284,13 +329,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     writing(frames=500 if args.quick else 3000, reps=3 if args.quick else 7)
     print()
     minutes = args.minutes or (6.0 if args.quick else 60.0)
-    if args.keep is not None:
-        args.keep.mkdir(parents=True, exist_ok=True)
-        path = args.keep / f"joint_states_{minutes:g}min"
+    with tempfile.TemporaryDirectory() as temporary:
+        folder = Path(temporary)
+        if args.keep is not None:
+            args.keep.mkdir(parents=True, exist_ok=True)
+            folder = args.keep
+        path = folder / f"joint_states_{minutes:g}min"
         reading(path if path.exists() else long_bag(path, minutes))
-    else:
-        with tempfile.TemporaryDirectory() as folder:
-            reading(long_bag(Path(folder) / f"joint_states_{minutes:g}min", minutes))
+        if args.ros1:
+            print()
+            ros1 = folder / f"joint_states_{minutes:g}min.bag"
+            reading(ros1 if ros1.exists() else long_ros1_bag(ros1, minutes))
     return 0
 
 

@@ -16,7 +16,7 @@ the player drive these pieces.
   ``bag_repair``: ending a bag whose writing stopped half-way;
 - ``robot_bag``: ``BagRobot``, one robot's topics in a bag;
 - ``bag_reader``: ``JointStateBag``, a bag's JointState samples, checked, streamed
-  (``joint_state_cdr`` decodes them);
+  (``joint_state_bytes`` decodes them);
 - ``errors``: the door's errors (all ``C2rvizError``).
 
 Importing the package is cheap (a rosbridge door needs ``messages`` alone); the

@@ -42,7 +42,7 @@ from .errors import (
     StampsBackwards,
     UnknownTopic,
 )
-from .joint_state_cdr import JointStateDecoder
+from .joint_state_bytes import JointStateDecoder
 
 __all__ = ["JOINT_STATE_TYPES", "JointStateBag"]
 
@@ -85,9 +85,8 @@ class JointStateBag:
         """The bag's first log time [ns]: t = 0."""
         self.duration_s = max(0, reader.end_time - 1 - reader.start_time) / 1e9
         """The bag's length [s]: its last message's log time (end_time is 1 ns past it)."""
-        self._cdr = all(
-            getattr(c.ext, "serialization_format", None) == "cdr" for c in self.connections
-        )  # ROS 2 CDR: the quick decoder; ROS 1: rosbags' deserializer
+        formats = {getattr(c.ext, "serialization_format", "ros1") for c in self.connections}
+        self._wire = formats.pop() if len(formats) == 1 else None  # "cdr", "ros1" or mixed
 
     @classmethod
     def open(cls, path: str | Path, topic: str | None = None) -> JointStateBag:
@@ -192,7 +191,7 @@ class JointStateBag:
         warnings: list[str],
     ) -> Generator[tuple[float, tuple[float, ...]], None, None]:
         start, stop = self._span(start_s, duration_s)
-        decoder = JointStateDecoder()
+        decoder = JointStateDecoder(ros1=self._wire == "ros1")
         chain = tuple(chain_names)
         where: dict[tuple[str, ...], list[int] | None] = {}  # names -> chain's indices
         extra: dict[str, None] = {}
@@ -251,7 +250,7 @@ class JointStateBag:
         self, decoder: JointStateDecoder, raw: bytes, t_s: float
     ) -> tuple[int, tuple[str, ...], tuple[float, ...]]:
         try:
-            decoded = decoder.decode(raw) if self._cdr else None
+            decoded = decoder.decode(raw) if self._wire in ("cdr", "ros1") else None
             if decoded is not None:
                 return decoded
             message: Any = self.reader.deserialize(raw, self.msgtype)

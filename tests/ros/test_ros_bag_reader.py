@@ -281,3 +281,20 @@ def test_samples_are_lazy(mcap_bag: Path) -> None:
         assert first[0] == 0.0
         stream.close()
     assert humble_joint_state(CHAIN, first[1], 0).position.tolist() == list(first[1])
+
+
+def test_big_endian_cdr_plays_through_rosbags(tmp_path: Path) -> None:
+    """The quick decoder reads little-endian CDR; rosbags' deserializer takes the rest."""
+    from rosbags.rosbag2 import Writer
+
+    with Writer(tmp_path / "be", version=9, storage_plugin=StoragePlugin.MCAP) as writer:
+        conn = writer.add_connection(
+            "/joint_states", "sensor_msgs/msg/JointState", typestore=HUMBLE
+        )
+        for t, names, positions in SAMPLES[:20]:
+            state = humble_joint_state(names, positions, round(t * 1e9))
+            raw = HUMBLE.serialize_cdr(state, "sensor_msgs/msg/JointState", little_endian=False)
+            writer.write(conn, round(t * 1e9), raw)
+    with JointStateBag.open(tmp_path / "be") as bag:
+        played = list(bag.samples(CHAIN))
+    assert [q for _, q in played] == [chain_values(t) for t, _, _ in SAMPLES[:20]]
