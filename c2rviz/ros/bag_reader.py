@@ -55,12 +55,19 @@ _NOT_A_BAG = (
     "seems to be empty",
     "profile is not",
     "unrecognized storage",
+    "file is not a database",
 )
+
+
+def _one_line(exc: BaseException) -> str:
+    """The first line of an exception's message (a YAML error adds a picture of the line)."""
+    lines = str(exc).strip().splitlines()
+    return lines[0].strip() if lines else type(exc).__name__
 
 
 def _classify(path: Path, exc: BaseException) -> BagError:
     """Our error for what rosbags raised while opening ``path``."""
-    text = str(exc).strip() or type(exc).__name__
+    text = _one_line(exc)
     if isinstance(exc, FileNotFoundError) and path.is_dir():
         return NotABag(str(path), f"is a folder without metadata.yaml; give {_KINDS}")
     if any(words in text.lower() for words in _NOT_A_BAG):
@@ -109,7 +116,6 @@ class JointStateBag:
             raise NotABag(str(path), f"does not exist; give {_KINDS}")
         if not path.is_dir() and path.suffix not in _SUFFIXES:
             raise NotABag(str(path), f"is not a bag (by its name); give {_KINDS}")
-        reader = None
         try:
             reader = AnyReader([path])
             reader.open()
@@ -180,7 +186,7 @@ class JointStateBag:
             except StopIteration:
                 return
             except Exception as exc:  # a damaged chunk or record, deep in rosbags
-                raise BagCorrupted(str(self.path), f"is damaged: {exc}") from None
+                raise BagCorrupted(str(self.path), f"is damaged: {_one_line(exc)}") from None
             yield log_ns, raw
 
     def _scan(
@@ -256,7 +262,7 @@ class JointStateBag:
             message: Any = self.reader.deserialize(raw, self.msgtype)
         except Exception as exc:  # a message whose bytes do not fit JointState
             raise BagCorrupted(
-                str(self.path), f"holds a damaged JointState at {t_s:.6f} s: {exc}"
+                str(self.path), f"holds a damaged JointState at {t_s:.6f} s: {_one_line(exc)}"
             ) from None
         stamp = message.header.stamp
         names = tuple(message.name)

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 from ros_helpers import HUMBLE, humble_joint_state, sweep, write_rosbag1, write_rosbag2
-from rosbags.rosbag2 import StoragePlugin
+from rosbags.rosbag2 import StoragePlugin, Writer
 
 from c2rviz.ros.bag_reader import JointStateBag
 from c2rviz.ros.errors import (
@@ -132,6 +132,13 @@ def _damaged(tmp_path: Path, mcap_bag: Path, kind: str) -> Path:
     if kind == "folder":
         (tmp_path / "folder").mkdir()
         return tmp_path / "folder"
+    if kind == "text-as-db3":
+        (tmp_path / "notes.db3").write_text("joints 1 2 3\n" * 10)
+        return tmp_path / "notes.db3"
+    if kind == "bad-metadata":
+        shutil.copytree(mcap_bag, tmp_path / "arm")
+        (tmp_path / "arm" / "metadata.yaml").write_text("rosbag2_bagfile_information: [\n  {a: b\n")
+        return tmp_path / "arm"
     if kind == "text-as-bag":
         (tmp_path / "notes.bag").write_text("#ROSBAG V2.0\n" + "x" * 100)
         return tmp_path / "notes.bag"
@@ -157,6 +164,8 @@ def _damaged(tmp_path: Path, mcap_bag: Path, kind: str) -> Path:
         ("text-as-mcap", NotABag, "is not a bag (File magic is invalid)"),
         ("empty-mcap", NotABag, "seems to be empty"),
         ("folder", NotABag, "is a folder without metadata.yaml"),
+        ("text-as-db3", NotABag, "file is not a database"),
+        ("bad-metadata", BagCorrupted, "Could not load YAML"),
         ("text-as-bag", BagCorrupted, "is truncated or damaged"),
         ("truncated-mcap", BagCorrupted, "is truncated or damaged"),
         ("truncated-folder", BagCorrupted, "is truncated or damaged"),
@@ -285,8 +294,6 @@ def test_samples_are_lazy(mcap_bag: Path) -> None:
 
 def test_big_endian_cdr_plays_through_rosbags(tmp_path: Path) -> None:
     """The quick decoder reads little-endian CDR; rosbags' deserializer takes the rest."""
-    from rosbags.rosbag2 import Writer
-
     with Writer(tmp_path / "be", version=9, storage_plugin=StoragePlugin.MCAP) as writer:
         conn = writer.add_connection(
             "/joint_states", "sensor_msgs/msg/JointState", typestore=HUMBLE
@@ -298,3 +305,15 @@ def test_big_endian_cdr_plays_through_rosbags(tmp_path: Path) -> None:
     with JointStateBag.open(tmp_path / "be") as bag:
         played = list(bag.samples(CHAIN))
     assert [q for _, q in played] == [chain_values(t) for t, _, _ in SAMPLES[:20]]
+
+
+def test_damage_inside_the_bag_is_met_while_reading(tmp_path: Path, mcap_bag: Path) -> None:
+    """A chunk damaged in the middle of an indexed file: the open succeeds, the check does not."""
+    shutil.copytree(mcap_bag, tmp_path / "arm")
+    data = bytearray((tmp_path / "arm" / "arm.mcap").read_bytes())
+    middle = data.find(b"joint_2", len(data) // 2)
+    data[middle - 40 : middle + 40] = b"\xff" * 80  # a message's lengths and names overwritten
+    (tmp_path / "arm" / "arm.mcap").write_bytes(bytes(data))
+    with JointStateBag.open(tmp_path / "arm") as bag, pytest.raises(BagCorrupted) as caught:
+        bag.check(CHAIN)
+    assert "\n" not in str(caught.value) and "damaged" in str(caught.value)
