@@ -26,6 +26,7 @@ from .errors import (
     StartCollides,
 )
 from .ompl_planner import MAX_TIMEOUT_S, EdgeCheck, PlannedPath, plan_for, plan_path
+from .timing import TimedPath, TimingFailed, time_path
 from .validity import PlacedShape, ValidityChecker, robot_shapes
 
 __all__ = [
@@ -44,10 +45,13 @@ __all__ = [
     "PlannedPath",
     "PlanningError",
     "StartCollides",
+    "TimedPath",
+    "TimingFailed",
     "ValidityChecker",
     "edge_resolution",
     "lever_arms",
     "plan_for",
     "plan_path",
     "robot_shapes",
+    "time_path",
 ]

@@ -196,8 +196,10 @@ def plan_path(
         waypoints = np.array([a, b])
     else:
         with _LOCK:
-            waypoints = _rrt_connect(a, b, low, high, checks, timeout, chosen)
-        waypoints = _shorten(waypoints, checks)
+            found = _rrt_connect(a, b, low, high, checks, timeout, chosen)
+        if found is None:  # raised here, so that no OMPL object lives on in its traceback
+            raise NoPathFound(timeout, checks.count)
+        waypoints = _shorten(found, checks)
         for k in range(len(waypoints) - 1):
             if not checks.edge(waypoints[k], waypoints[k + 1]):
                 raise PathCheckFailed(k)
@@ -213,8 +215,9 @@ def _rrt_connect(
     checks: _Counted,
     timeout_s: float,
     seed: int,
-) -> np.ndarray:
-    """RRT-Connect's path from ``start`` to ``goal`` after OMPL's shortcutting (rows)."""
+) -> np.ndarray | None:
+    """RRT-Connect's path from ``start`` to ``goal`` after OMPL's shortcutting (rows), or
+    None if it found none in ``timeout_s``."""
     n = len(start)
     level = ou.getLogLevel()
     ou.setLogLevel(ou.LOG_NONE)
@@ -239,7 +242,7 @@ def _rrt_connect(
         setup.setPlanner(og.RRTConnect(info))
         setup.solve(timeout_s)
         if not setup.haveExactSolutionPath():
-            raise NoPathFound(timeout_s, checks.count)
+            return None
         path = setup.getSolutionPath()
         simplifier = og.PathSimplifier(info)
         simplifier.reduceVertices(path)
