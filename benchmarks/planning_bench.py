@@ -4,7 +4,8 @@ For each arm (the three bundled ones, and example-robot-data's panda when it is
 installed) a fixed set of scenes is drawn from a fixed seed: a start and a goal,
 collision-free, at most ``--reach`` rad apart on every joint, and a box (15 cm)
 where the tool passes halfway along the straight joint path, so that the
-straight path is blocked and the planner has to go around. Each scene is
+straight path is blocked and the planner has to go around (the box above the
+floor: its centre at least half its size above the base). Each scene is
 planned once with its own seed (``plan_for``: the direct edge, RRT-Connect,
 OMPL's shortcutting, the final check at 1 degree / 5 mm of tool travel).
 
@@ -101,6 +102,8 @@ def scenes(model: CollisionModel, count: int, reach_rad: float, seed: int) -> li
         step = rng.uniform(-reach_rad, reach_rad, robot.n)
         goal = np.clip(start + step, lower, upper)
         box = robot.ee_pose(((start + goal) / 2).tolist()).translation
+        if box[2] < BOX_M / 2:  # the box stands on the floor or above it
+            continue
         place_box(model, box)
         checker = ValidityChecker(model)
         points = checker.edge_points(start, goal)
@@ -122,7 +125,7 @@ def raw_rate(checker: ValidityChecker, robot: Robot, configs: int) -> float:
 
 def bench(name: str, robot: Robot, count: int, reach_rad: float, timeout_s: float) -> dict:
     model = CollisionModel(robot)
-    times, rates, ratios, corners, failed = [], [], [], [], 0
+    times, rates, ratios, corners, states, failed = [], [], [], [], [], 0
     for k, scene in enumerate(scenes(model, count, reach_rad, seed=11)):
         place_box(model, scene.box)
         checker = ValidityChecker(model)
@@ -134,6 +137,7 @@ def bench(name: str, robot: Robot, count: int, reach_rad: float, timeout_s: floa
             print(f"  scene {k}: {exc}")
             continue
         times.append(path.planning_s)
+        states.append(path.states_checked)
         rates.append(path.states_checked / path.planning_s)
         straight = float(np.linalg.norm(np.subtract(scene.goal, scene.start)))
         ratios.append(path.length_rad / straight)
@@ -147,6 +151,7 @@ def bench(name: str, robot: Robot, count: int, reach_rad: float, timeout_s: floa
     print(
         f"{name}: {robot.n} joints, lever arms {arms} m; {len(times)} scenes, "
         f"planning median {median:.1f} ms, p95 {p95:.1f} ms, max {max(times) * 1e3:.1f} ms; "
+        f"checks per plan median {statistics.median(states) if states else 0:,.0f}; "
         f"{rate:,.0f} checks/s while planning, {raw:,.0f}/s is_valid on random configurations; "
         f"length / straight median {statistics.median(ratios):.2f}, max {max(ratios):.2f}; "
         f"waypoints median {statistics.median(corners):.0f}, max {max(corners)}; "

@@ -108,6 +108,7 @@ class ValidityChecker:
         _copy_requests(model_data, self._data)
         self._pool = _Pool(robot.model, geometry, 1)
         _copy_requests(model_data, self._pool.getGeometryData(0))  # it holds a reference
+        self._manager = self._pool.getBroadPhaseManager(0)  # one state: no batch to build
         self._model = robot.model
         self._model_data = robot.model.createData()
         self._neutral = np.asarray(robot.neutral, dtype=float)
@@ -140,7 +141,9 @@ class ValidityChecker:
 
     def is_valid(self, q: Joints) -> bool:
         """True when ``q`` [rad or m] collides with nothing checked."""
-        return self.first_invalid(np.asarray(q, dtype=float)[None, :]) is None
+        self.checks += 1
+        config = self.robot.configuration(q)
+        return not pin.computeCollisions(self._model, self._model_data, self._manager, config, True)
 
     def edge_points(self, q0: Joints, q1: Joints) -> np.ndarray:
         """Every point checked on the edge ``q0 -> q1``, ends included, in order ((k+1) x n)."""
