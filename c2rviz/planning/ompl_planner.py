@@ -268,7 +268,7 @@ def _rrt_connect(
         rows = [path.getState(k)[0:n] for k in range(path.getStateCount())]
     finally:
         ou.setLogLevel(level)
-    waypoints = np.array(rows, dtype=float)
+    waypoints = np.clip(np.array(rows, dtype=float), lower, upper)  # a zero-width joint
     waypoints[0], waypoints[-1] = start, goal  # exact ends, not OMPL's copies
     return waypoints
 

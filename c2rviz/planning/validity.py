@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, cast
 
 import coal
 import numpy as np
@@ -142,7 +142,7 @@ class ValidityChecker:
     def is_valid(self, q: Joints) -> bool:
         """True when ``q`` [rad or m] collides with nothing checked."""
         self.checks += 1
-        config = self.robot.configuration(q)
+        config = self.robot.configuration(cast(Sequence[float], q))  # an array does as well
         return not pin.computeCollisions(self._model, self._model_data, self._manager, config, True)
 
     def edge_points(self, q0: Joints, q1: Joints) -> np.ndarray:

@@ -89,7 +89,7 @@ def blocked_scenes(model: CollisionModel, count: int, seed: int, reach: float = 
         scene = Scene(tuple(start), tuple(goal), (((BOX_M,) * 3, tuple(centre)),))
         furnish(model, scene)
         path = [start + f * (goal - start) for f in np.linspace(0, 1, 200)]
-        if model.is_free(start) and model.is_free(goal) and model.first_collision(path):
+        if model.is_free(list(start)) and model.is_free(list(goal)) and model.first_collision(path):
             found.append(scene)
     return found
 

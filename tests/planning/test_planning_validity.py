@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pinocchio as pin
 import pytest
-from planning_scenes import BUNDLED, erd_folder, load
+from planning_scenes import BUNDLED, ROOT, erd_folder, load
 
 from c2rviz.collision import CollisionModel
 from c2rviz.planning import (
@@ -16,8 +16,10 @@ from c2rviz.planning import (
     ValidityChecker,
     edge_resolution,
     lever_arms,
+    plan_for,
     robot_shapes,
 )
+from c2rviz.robot import Robot
 
 ARMS = [
     *BUNDLED,
@@ -37,12 +39,12 @@ def near_contacts(model: CollisionModel, count: int, seed: int) -> list[np.ndarr
     found: list[np.ndarray] = []
     while len(found) < 2 * count:
         a, b = np.array(robot.random(rng)), np.array(robot.random(rng))
-        free_a = model.is_free(a)
-        if free_a == model.is_free(b):
+        free_a = model.is_free(list(a))
+        if free_a == model.is_free(list(b)):
             continue
         for _ in range(32):
             middle = (a + b) / 2
-            if model.is_free(middle) == free_a:
+            if model.is_free(list(middle)) == free_a:
                 a = middle
             else:
                 b = middle
@@ -56,11 +58,11 @@ def test_checker_answers_as_the_collision_model_at_contact(name: str) -> None:
     model.set_object("box", "box", (0.3, 0.3, 0.3), pin.SE3(np.eye(3), np.array([0.45, 0.1, 0.4])))
     checker = ValidityChecker(model)
     qs = near_contacts(model, 40, seed=3)
-    expected = [model.is_free(q) for q in qs]
+    expected = [model.is_free(list(q)) for q in qs]
     assert True in expected and False in expected
     assert [checker.is_valid(q) for q in qs] == expected
     assert [checker.describe(q) for q in qs] == [
-        None if free else model.colliding(q)[0] for q, free in zip(qs, expected)
+        None if free else model.colliding(list(q))[0] for q, free in zip(qs, expected)
     ]
     first = checker.first_invalid(np.array(qs))
     assert first == expected.index(False)
@@ -109,7 +111,7 @@ def test_edge_points_keep_joint_and_tool_steps(name: str) -> None:
     rng = np.random.default_rng(8)
 
     def tool(q: np.ndarray) -> np.ndarray:
-        pin.framesForwardKinematics(model, data, robot.configuration(q))
+        pin.framesForwardKinematics(model, data, robot.configuration(list(q)))
         return data.oMf[robot.ee_frame].translation.copy()
 
     for _ in range(20):
@@ -165,3 +167,16 @@ def test_resolution_without_tool_bound_is_the_joint_grid() -> None:
     assert len(grid) == 11 and np.allclose(grid[-1], [0.1, -0.1])
     with pytest.raises(BadPlanningSetting, match="lever_arm"):
         EdgeResolution((0.01, 0.02), 0.005, (1.0,))
+
+
+def test_a_continuous_joint_plans_to_its_literal_value() -> None:
+    robot = Robot.from_urdf(ROOT / "tests/data/limits_robot/limits.urdf")
+    assert robot.joints[2].continuous
+    checker = ValidityChecker(CollisionModel(robot))
+    qs = np.array([[0.1, -0.2, 7.0], [0.0, 0.3, -2.5]])
+    assert np.allclose(checker.configurations(qs).T, [robot.configuration(q) for q in qs])
+    lower, upper = checker.bounds([0.0, 0.0, 7.0], [0.0, 0.0, -1.0])
+    assert lower[2] == pytest.approx(-1.0 - math.pi) and upper[2] == pytest.approx(7.0 + math.pi)
+    assert lower[:2] == robot.lower[:2] and upper[:2] == robot.upper[:2]
+    path = plan_for(checker, [0.0, 0.0, 0.0], [0.5, 0.3, 7.0])
+    assert path.waypoints.tolist() == [[0.0, 0.0, 0.0], [0.5, 0.3, 7.0]]  # no wrapping
