@@ -195,7 +195,8 @@ def plan_path(
         check_edge = _grid_check(is_valid, EdgeResolution(tuple(max_step or ())))
     a, b, low, high = (np.asarray(x, dtype=float) for x in (start, goal, lower, upper))
     n = len(a)
-    for key, values in (("goal", b), ("lower", low), ("upper", high)):
+    steps = np.asarray(max_step if max_step is not None else np.zeros(n))
+    for key, values in (("goal", b), ("lower", low), ("upper", high), ("max_step", steps)):
         if values.shape != (n,):
             raise BadPlanningSetting(key, tuple(values.ravel()), f"give {n} values, like start")
     for which, q in (("start", a), ("goal", b)):

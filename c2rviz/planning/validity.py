@@ -55,7 +55,7 @@ def robot_shapes(
 
 
 class ValidityChecker:
-    """Whether configurations and edges of one robot are free of collisions.
+    """Whether configurations and edges of one robot are free of collisions (one thread).
 
     Attributes:
         collision: The robot's collision model (self pairs and workcell objects).

@@ -239,3 +239,5 @@ def test_plan_path_takes_max_step_or_check_edge_not_both() -> None:
         plan_path([0.0], [1.0], [-1.0], [2.0], lambda q: True)
     with pytest.raises(BadPlanningSetting, match=r"^max_step = "):
         plan_path([0.0], [1.0], [-1.0], [2.0], lambda q: True, max_step=[math.inf])
+    with pytest.raises(BadPlanningSetting, match=r"^max_step = .* give 1 values"):
+        plan_path([0.0], [1.0], [-1.0], [2.0], lambda q: True, max_step=[0.1, 0.1])
