@@ -1,0 +1,57 @@
+"""Collision-free paths: OMPL plans them, the collision model checks them, ruckig times them.
+
+``ValidityChecker`` (``validity.py``) checks one robot against itself, its
+workcell and the other robots of a cell, at the resolution of
+``edge_resolution.py``; ``plan_for``/``plan_path`` (``ompl_planner.py``) plan
+with RRT-Connect and shorten the path; ``time_path`` (``timing.py``) turns the
+waypoints into a motion that stays on them. No asyncio and no world here: the
+caller owns the clock.
+"""
+
+from .edge_resolution import (
+    MAX_STEP_M,
+    MAX_STEP_RAD,
+    MAX_TOOL_STEP_M,
+    EdgeResolution,
+    edge_resolution,
+    lever_arms,
+)
+from .errors import (
+    BadPlanningSetting,
+    GoalCollides,
+    NoPathFound,
+    OutOfLimits,
+    PathCheckFailed,
+    PlanningError,
+    StartCollides,
+)
+from .ompl_planner import MAX_TIMEOUT_S, EdgeCheck, PlannedPath, plan_for, plan_path
+from .timing import TimedPath, TimingFailed, time_path
+from .validity import PlacedShape, ValidityChecker, robot_shapes
+
+__all__ = [
+    "MAX_STEP_M",
+    "MAX_STEP_RAD",
+    "MAX_TIMEOUT_S",
+    "MAX_TOOL_STEP_M",
+    "BadPlanningSetting",
+    "EdgeCheck",
+    "EdgeResolution",
+    "GoalCollides",
+    "NoPathFound",
+    "OutOfLimits",
+    "PathCheckFailed",
+    "PlacedShape",
+    "PlannedPath",
+    "PlanningError",
+    "StartCollides",
+    "TimedPath",
+    "TimingFailed",
+    "ValidityChecker",
+    "edge_resolution",
+    "lever_arms",
+    "plan_for",
+    "plan_path",
+    "robot_shapes",
+    "time_path",
+]
