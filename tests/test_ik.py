@@ -175,8 +175,18 @@ def test_tool_offset(name: str) -> None:
 # --- unreachable targets ---------------------------------------------------------------
 
 MESSAGE = re.compile(
-    r"pose unreachable: the closest reachable tool pose is (\d+\.\d) mm and (\d+\.\d) deg away"
+    r"pose unreachable: the closest reachable tool pose is (\d+\.\d+) mm and (\d+\.\d+) deg away"
+    r", over the 0\.1 mm / 0\.1 deg tolerance"
 )
+BEYOND_REACH = re.compile(
+    r"pose unreachable: the target is (\d+\.\d{3}) m from the arm's first joint, which reaches "
+    r"(\d+\.\d{3}) m at most: every tool pose is at least (\d+\.\d+) mm away, over the 0\.1 mm "
+    r"tolerance"
+)
+
+
+def decimals(figure: str) -> int:
+    return len(figure.split(".")[1])
 
 
 def sampled_best_cost(robot: Robot, target: pin.SE3, weight: float) -> tuple[float, float]:
@@ -203,10 +213,17 @@ def test_unreachable_reports_the_closest_pose(name: str, where: str) -> None:
         ik.solve(target, [min(max(0.0, lo), hi) for lo, hi in zip(robot.lower, robot.upper)])
     error = caught.value
     assert isinstance(error, C2rvizError)
-    match = MESSAGE.fullmatch(str(error))
-    assert match is not None, str(error)
-    assert float(match[1]) == round(error.distance_m * 1e3, 1)
-    assert float(match[2]) == round(math.degrees(error.angle_rad), 1)
+    if where == "2 m away":  # refused by the reach bound: a lower bound, no pose searched
+        beyond = BEYOND_REACH.fullmatch(str(error))
+        assert beyond is not None, str(error)
+        assert float(beyond[3]) == round(error.distance_m * 1e3, decimals(beyond[3]))
+        assert error.reach_m is not None and error.angle_rad == 0.0
+        assert float(beyond[1]) - float(beyond[2]) == pytest.approx(error.distance_m, abs=2e-3)
+    else:
+        match = MESSAGE.fullmatch(str(error))
+        assert match is not None, str(error)
+        assert float(match[1]) == round(error.distance_m * 1e3, decimals(match[1]))
+        assert float(match[2]) == round(math.degrees(error.angle_rad), decimals(match[2]))
     weight = ik.settings.orientation_cost
     best, reach = sampled_best_cost(robot, target, weight)
     # no worse than 4000 random configurations, and no closer than the reach allows
@@ -239,7 +256,8 @@ def test_wrist_orientation_out_of_range() -> None:
     with pytest.raises(Unreachable) as caught:
         ik.solve(target, [0.25, 0.0, 0.0, 0.0])
     assert str(caught.value) == (
-        "pose unreachable: the closest reachable tool pose is 0.0 mm and 45.0 deg away"
+        "pose unreachable: the closest reachable tool pose is 0.0 mm and 45.0 deg away, "
+        "over the 0.1 mm / 0.1 deg tolerance"
     )
 
 

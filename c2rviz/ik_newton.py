@@ -1,0 +1,189 @@
+"""Damped Newton descents of the tool frame: the IK's fast path, in numpy over Pinocchio.
+
+One step: Pinocchio's frame Jacobian and placement (one call, forward
+kinematics included), the error as position difference [m] and rotation vector
+[rad] in world axes (weighted by ``orientation_cost``), and the damped
+least-squares step ``J^T (J J^T + lambda^2 I)^-1 e`` (or its n x n twin when the
+chain has fewer joints than the error has rows). ``lambda^2`` grows with the
+error (Levenberg-Marquardt): long cautious steps far away, full Newton steps
+near the target, where the error falls quadratically. The minimum-norm step
+keeps a redundant arm near where it starts.
+
+Joint limits: a joint whose step would cross its limit stops on it, and the
+others are solved again without it (one active-set pass), so an arm pressed on
+a stop still slides along it. Pure: no clock, no I/O, no randomness.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+import pinocchio as pin
+
+from .ik_chain import IkChain
+from .ik_target import Goal
+
+__all__ = ["Descent", "NewtonDescent"]
+
+# A descent stalls when its cost is not ``stall_ratio`` of 3 steps before (after 5 steps).
+_STALL_AFTER, _STALL_LAG = 5, 3
+_EXACT = 1e-10  # a converged descent takes one more step when its cost is above this [m]
+_WORLD = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+
+class Descent(NamedTuple):
+    """The end of one descent.
+
+    Attributes:
+        ok: True when the tool is within tolerance of the goal.
+        q: The model's configuration reached.
+        distance_m: Tool position error [m].
+        angle_rad: Tool orientation error [rad] (0 when the orientation is free).
+        iterations: Steps taken.
+    """
+
+    ok: bool
+    q: np.ndarray
+    distance_m: float
+    angle_rad: float
+    iterations: int
+
+
+class NewtonDescent:
+    """Damped Newton descents on one chain's model. Not thread-safe (one pin.Data).
+
+    Args:
+        chain: The chain (its model and tool frame; ``set_tool`` is seen at once).
+        orientation_cost: Weight of 1 rad against 1 m of error [m/rad].
+        position_tolerance_m: Position error that counts as there [m].
+        angle_tolerance_rad: Orientation error that counts as there [rad].
+        max_step: Largest change of any joint in one step [rad or m].
+        damping: Levenberg-Marquardt factor: ``lambda^2 = 1e-9 + damping * cost^2`` [1/m^2].
+    """
+
+    def __init__(
+        self,
+        chain: IkChain,
+        orientation_cost: float,
+        position_tolerance_m: float,
+        angle_tolerance_rad: float,
+        max_step: float,
+        damping: float,
+    ) -> None:
+        self.chain = chain
+        self.model = model = chain.model
+        self.data = model.createData()
+        self.frame = chain.tool_frame
+        self.weight = orientation_cost
+        self.position_tolerance_m = position_tolerance_m
+        self.angle_tolerance_rad = angle_tolerance_rad
+        self.max_step = max_step
+        self.damping = damping
+        self.steps = 0  # every step taken since construction (for tests and benchmarks)
+        # Velocity-space view of the limits: a (cos, sin) joint is unbounded.
+        self._simple = model.nq == model.nv
+        q_of_v = np.zeros(model.nv, dtype=int)
+        bounded = np.zeros(model.nv, dtype=bool)
+        for joint in model.joints[1:]:
+            for k in range(joint.nv):
+                q_of_v[joint.idx_v + k] = joint.idx_q + k
+                bounded[joint.idx_v + k] = joint.nq == joint.nv
+        self._q_of_v = q_of_v
+        self._v_lower = np.where(bounded, chain.lower[q_of_v], -np.inf)
+        self._v_upper = np.where(bounded, chain.upper[q_of_v], np.inf)
+
+    def descend(
+        self,
+        q0: np.ndarray,
+        goal: Goal,
+        iterations: int,
+        *,
+        limited: bool = True,
+        stall_ratio: float = 0.9,
+    ) -> Descent:
+        """Up to ``iterations`` steps from ``q0`` towards ``goal``; fewer when done or stalled.
+
+        Args:
+            q0: The model's configuration to start from (within the limits when ``limited``).
+            goal: The target in the model's world frame.
+            iterations: Most steps taken.
+            limited: Keep the joints within their limits (else the model's limits are ignored).
+            stall_ratio: Give up when the cost is not this fraction of 3 steps before.
+        """
+        model, data, frame = self.model, self.data, self.frame
+        target_p, target_r = goal.position, goal.rotation
+        weight = self.weight
+        tol_p, tol_a = self.position_tolerance_m, self.angle_tolerance_rad
+        q = q0
+        costs: list[float] = []
+        done: Descent | None = None  # a converged point, kept while one more step polishes it
+        distance = angle = math.inf
+        step = 0
+        for step in range(iterations + 2):  # noqa: B007 (step is read after the loop)
+            jacobian = pin.computeFrameJacobian(model, data, q, frame, _WORLD)
+            placement = data.oMf[frame]
+            error_p = target_p - placement.translation
+            distance = math.sqrt(error_p @ error_p)
+            if target_r is None:
+                angle, error, jacobian = 0.0, error_p, jacobian[:3]
+            else:
+                error_r = pin.log3(target_r @ placement.rotation.T)
+                angle = math.sqrt(error_r @ error_r)
+                error = np.concatenate((error_p, weight * error_r))
+                jacobian[3:] *= weight
+            cost = math.hypot(distance, weight * angle)
+            if done is not None:  # the polishing step: keep it only if it helped
+                better = distance <= tol_p and angle <= tol_a and cost < costs[-1]
+                return Descent(True, q, distance, angle, step) if better else done
+            if distance <= tol_p and angle <= tol_a:
+                here = Descent(True, q, distance, angle, step)
+                if cost <= _EXACT:
+                    return here
+                done = here  # quadratic convergence: one more step reads back exactly
+            elif step >= iterations or (
+                step >= _STALL_AFTER and cost > stall_ratio * costs[-1 - _STALL_LAG]
+            ):
+                break
+            costs.append(cost)
+            q = self._step(q, jacobian, error, 1e-9 + self.damping * cost * cost, limited)
+            self.steps += 1
+        return Descent(False, q, distance, angle, step)
+
+    def _step(
+        self, q: np.ndarray, jacobian: np.ndarray, error: np.ndarray, damping: float, limited: bool
+    ) -> np.ndarray:
+        """The damped least-squares step from ``q``, stopped at the limits when ``limited``."""
+        dq = _least_squares(jacobian, error, damping)
+        largest = float(np.abs(dq).max())
+        if largest > self.max_step:  # a trust region: long steps are only directions
+            dq *= self.max_step / largest
+        if limited:
+            now = q if self._simple else q[self._q_of_v]
+            room_low, room_high = self._v_lower - now, self._v_upper - now
+            out = (dq < room_low) | (dq > room_high)
+            if out.any():
+                # the joints that would cross stop on their limits; the rest try again
+                dq = np.clip(dq, room_low, room_high)
+                free = ~out
+                if free.any():
+                    rest = error - jacobian[:, out] @ dq[out]
+                    again = _least_squares(jacobian[:, free], rest, damping)
+                    dq[free] = np.clip(again, room_low[free], room_high[free])
+        q_next = q + dq if self._simple else pin.integrate(self.model, q, dq)
+        if limited:  # rounding only: the step already kept within
+            np.clip(q_next, self.chain.lower, self.chain.upper, out=q_next)
+        return q_next
+
+
+def _least_squares(jacobian: np.ndarray, error: np.ndarray, damping: float) -> np.ndarray:
+    """The damped least-squares solution of ``jacobian @ dq = error``."""
+    rows, cols = jacobian.shape
+    if cols >= rows:
+        normal = jacobian @ jacobian.T
+        normal.flat[:: rows + 1] += damping
+        return jacobian.T @ np.linalg.solve(normal, error)
+    normal = jacobian.T @ jacobian
+    normal.flat[:: cols + 1] += damping
+    return np.linalg.solve(normal, jacobian.T @ error)
