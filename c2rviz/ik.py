@@ -10,17 +10,15 @@ How a solve goes:
    the chain is long is refused at once, before any step.
 2. A damped Newton descent (``NewtonDescent``, numpy over Pinocchio) from the
    seed itself: most answers near the seed end here in a few steps.
-3. Restarts, alternately near the seed (a widening box) and anywhere: each
-   first descends without limits (joint limits make local minima: a joint
-   pressed against its stop), then wraps revolute joints by whole turns into
-   their range and descends within the limits. When one succeeds, the solver
-   looks for ``successes_compared`` answers and returns the one nearest the seed.
+3. Restarts from stored configurations whose tool is closest to the target
+   (``SeedPool``), closest first. When one succeeds, the solver looks for
+   ``successes_compared`` answers and returns the one nearest the seed.
 4. When none reaches the target, the closest attempt is taken to the bottom
-   (pink's QP keeps the limits exactly there) and ``Unreachable`` says how far
-   that pose is, over which tolerance.
+   (pink's QP keeps the limits exactly there, ``ClosestPose``) and
+   ``Unreachable`` says how far that pose is, over which tolerance.
 
-Pure: no clock, no I/O; the restart seeds come from an rng seeded anew on every
-call, so one question always gets one answer.
+Pure: no clock, no I/O, no randomness after construction (the seed pool is
+drawn once with a fixed seed), so one question always gets one answer.
 """
 
 from __future__ import annotations
@@ -36,6 +34,7 @@ from .ik_chain import IkChain
 from .ik_closest import ClosestPose
 from .ik_newton import Descent, NewtonDescent
 from .ik_reach import ReachBound
+from .ik_seeds import SeedPool
 from .ik_target import Goal, PointTarget, Target, goal_in_world
 from .ik_unreachable import Unreachable
 from .robot import Robot
@@ -51,7 +50,7 @@ class IkSettings:
         position_tolerance_m: Tool position error a descent aims for [m].
         angle_tolerance_rad: Tool orientation error a descent aims for [rad].
         max_iterations: Newton steps per descent.
-        max_attempts: Attempts per solve: the seed, then restarts.
+        max_attempts: Attempts per solve: the seed, then restarts (at most ``seed_pool``).
         max_total_iterations: Hard cap on Newton steps per solve (some 30 us each)...
         polish_iterations: ...plus these, for the closest pose when unreachable.
         successes_compared: After a restart succeeds, keep restarting until this
@@ -63,12 +62,14 @@ class IkSettings:
         orientation_cost: Weight of 1 rad of orientation error against 1 m of
             position error [m/rad]; "closest" when unreachable minimises
             hypot(position error, orientation_cost * angle error).
-        seed: Seed of the restart rng.
+        seed: Seed of the rng that draws the seed pool.
         damping: Levenberg-Marquardt factor of the Newton steps [1/m^2]:
             ``lambda^2 = damping * cost^2``.
         promise_position_m: The promise (0.1 mm): a closest pose within it is an
             answer, not a refusal; ``Unreachable`` states it [m].
         promise_angle_rad: The promise (0.1 deg), likewise [rad].
+        seed_pool: Random in-limit configurations stored to start restarts from
+            (``SeedPool``): each restart begins from the next closest one.
     """
 
     position_tolerance_m: float = 1e-5
@@ -86,6 +87,7 @@ class IkSettings:
     damping: float = 0.1
     promise_position_m: float = 1e-4
     promise_angle_rad: float = math.radians(0.1)
+    seed_pool: int = 500
 
 
 @dataclass(frozen=True)
@@ -123,6 +125,7 @@ class IkSolver:
             s.damping,
         )
         self.reach = ReachBound(self.chain)
+        self.seeds = SeedPool(self.chain, s.seed_pool, s.seed, s.orientation_cost)
         self._closest = ClosestPose(self.chain, s.orientation_cost, s.posture_cost)
 
     # --- public -----------------------------------------------------------------------
@@ -138,9 +141,10 @@ class IkSolver:
         """Chain values within the limits that put the tool at ``target``.
 
         The first attempt descends from the seed itself; when it stalls, the
-        restarts (near the seed, then anywhere) go on until a solution is found
-        and, if it is not the seed's own, until ``successes_compared`` are, or
-        the budget ends. The answer is the one nearest the seed.
+        restarts (from the stored configurations whose tool is closest) go on
+        until a solution is found and, if it is not the seed's own, until
+        ``successes_compared`` are, or the budget ends. The answer is the one
+        nearest the seed.
 
         Args:
             target: Tool pose in the base frame, or a ``PointTarget`` (orientation free).
@@ -161,38 +165,28 @@ class IkSolver:
         goal = goal_in_world(target, self.chain.base_placement)
         seed = self.chain.to_model(q_seed)
         self.check_reach(goal)
-        rng = np.random.default_rng(s.seed)
-        budget = s.max_total_iterations
+        first = self._attempt(self.newton.descend(seed, goal, s.max_iterations), q_seed)
+        if first.ok:
+            return first.q  # the seed's own basin: nearest by continuity
+        budget = s.max_total_iterations - first.iterations - 1
         found: list[Attempt] = []
-        closest: Attempt | None = None
-        start = seed
-
-        def steps() -> int:
-            return max(0, min(s.max_iterations, budget))
-
-        for index in range(s.max_attempts):
-            if index > 0:
-                free = self.newton.descend(start, goal, steps(), limited=False)
-                budget -= free.iterations + 1
-                start = self.chain.to_model(self.chain.to_chain(free.q, q_seed))  # wrapped
-            attempt = self._attempt(self.newton.descend(start, goal, steps()), q_seed)
+        closest = first
+        for start in self.seeds.ranked(goal, s.max_attempts - 1):
+            steps = max(0, min(s.max_iterations, budget))
+            attempt = self._attempt(self.newton.descend(start, goal, steps), q_seed)
             budget -= attempt.iterations + 1
             if attempt.ok:
-                if index == 0:
-                    return attempt.q  # the seed's own basin: nearest by continuity
                 found.append(attempt)
                 if len(found) >= s.successes_compared:
                     break
                 budget = min(budget, s.compare_iterations)
-            elif closest is None or self._cost(attempt) < self._cost(closest):
+            elif self._cost(attempt) < self._cost(closest):
                 closest = attempt
             if budget <= 0:
                 break
-            start = self._restart(rng, q_seed, index)
         if found:
             distance = [np.linalg.norm(np.subtract(a.q, q_seed)) for a in found]
             return found[int(np.argmin(distance))].q
-        assert closest is not None
         return self._closest_or_refuse(closest, goal, q_seed)
 
     def follow(
@@ -240,14 +234,6 @@ class IkSolver:
     def _attempt(self, descent: Descent, near: Sequence[float]) -> Attempt:
         q = self.chain.to_chain(descent.q, near)
         return Attempt(descent.ok, q, descent.distance_m, descent.angle_rad, descent.iterations)
-
-    def _restart(self, rng: np.random.Generator, q_seed: Sequence[float], index: int) -> np.ndarray:
-        """Every other restart is near the seed (a widening box), the rest anywhere."""
-        q = np.array(self.robot.random(rng))
-        if index % 2 == 0:
-            width = min(1.0, 0.15 * (index // 2 + 1))
-            q = np.asarray(q_seed) + width * (q - np.asarray(q_seed))
-        return self.chain.to_model(q.tolist())
 
     def _closest_or_refuse(
         self, closest: Attempt, goal: Goal, q_seed: Sequence[float]

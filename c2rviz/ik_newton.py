@@ -21,6 +21,7 @@ from typing import NamedTuple
 
 import numpy as np
 import pinocchio as pin
+from scipy.linalg.lapack import dposv
 
 from .ik_chain import IkChain
 from .ik_target import Goal
@@ -31,6 +32,7 @@ __all__ = ["Descent", "NewtonDescent"]
 _STALL_AFTER, _STALL_LAG = 5, 3
 _EXACT = 1e-10  # a converged descent takes one more step when its cost is above this [m]
 _WORLD = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+_IDENTITY = [np.eye(n) for n in range(7)]  # the damping's identity, by size (at most 6 rows)
 
 
 class Descent(NamedTuple):
@@ -102,6 +104,7 @@ class NewtonDescent:
         *,
         limited: bool = True,
         stall_ratio: float = 0.9,
+        exact: bool = True,
     ) -> Descent:
         """Up to ``iterations`` steps from ``q0`` towards ``goal``; fewer when done or stalled.
 
@@ -111,35 +114,42 @@ class NewtonDescent:
             iterations: Most steps taken.
             limited: Keep the joints within their limits (else the model's limits are ignored).
             stall_ratio: Give up when the cost is not this fraction of 3 steps before.
+            exact: Once within tolerance, take one more step (kept if it helps): the
+                error falls quadratically, so the answer is then exact to rounding
+                (a pose sent reads back as sent).
         """
         model, data, frame = self.model, self.data, self.frame
         target_p, target_r = goal.position, goal.rotation
         weight = self.weight
         tol_p, tol_a = self.position_tolerance_m, self.angle_tolerance_rad
+        jacobian_of, log3, sqrt, hypot = pin.computeFrameJacobian, pin.log3, math.sqrt, math.hypot
+        error = np.empty(3 if target_r is None else 6)
         q = q0
         costs: list[float] = []
         done: Descent | None = None  # a converged point, kept while one more step polishes it
         distance = angle = math.inf
         step = 0
         for step in range(iterations + 2):  # noqa: B007 (step is read after the loop)
-            jacobian = pin.computeFrameJacobian(model, data, q, frame, _WORLD)
+            jacobian = jacobian_of(model, data, q, frame, _WORLD)
             placement = data.oMf[frame]
-            error_p = target_p - placement.translation
-            distance = math.sqrt(error_p @ error_p)
+            error[:3] = target_p - placement.translation
             if target_r is None:
-                angle, error, jacobian = 0.0, error_p, jacobian[:3]
+                jacobian = jacobian[:3]
+                x, y, z = error.tolist()
+                distance, angle = sqrt(x * x + y * y + z * z), 0.0
             else:
-                error_r = pin.log3(target_r @ placement.rotation.T)
-                angle = math.sqrt(error_r @ error_r)
-                error = np.concatenate((error_p, weight * error_r))
+                error[3:] = log3(target_r @ placement.rotation.T)
+                x, y, z, rx, ry, rz = error.tolist()
+                distance, angle = sqrt(x * x + y * y + z * z), sqrt(rx * rx + ry * ry + rz * rz)
+                error[3:] *= weight
                 jacobian[3:] *= weight
-            cost = math.hypot(distance, weight * angle)
+            cost = hypot(distance, weight * angle)
             if done is not None:  # the polishing step: keep it only if it helped
                 better = distance <= tol_p and angle <= tol_a and cost < costs[-1]
                 return Descent(True, q, distance, angle, step) if better else done
             if distance <= tol_p and angle <= tol_a:
                 here = Descent(True, q, distance, angle, step)
-                if cost <= _EXACT:
+                if not exact or cost <= _EXACT:
                     return here
                 done = here  # quadratic convergence: one more step reads back exactly
             elif step >= iterations or (
@@ -159,22 +169,56 @@ class NewtonDescent:
         largest = float(np.abs(dq).max())
         if largest > self.max_step:  # a trust region: long steps are only directions
             dq *= self.max_step / largest
+        if not self._simple:
+            return self._step_on_manifold(q, dq, jacobian, error, damping, limited)
+        q_next = q + dq
+        if not limited:
+            return q_next
+        lower, upper = self.chain.lower, self.chain.upper
+        within = np.minimum(np.maximum(q_next, lower), upper)
+        if (within == q_next).all():
+            return q_next
+        dq = self._stop_at_limits(dq, lower - q, upper - q, jacobian, error, damping)
+        return np.minimum(np.maximum(q + dq, lower), upper)  # rounding only
+
+    def _step_on_manifold(
+        self,
+        q: np.ndarray,
+        dq: np.ndarray,
+        jacobian: np.ndarray,
+        error: np.ndarray,
+        damping: float,
+        limited: bool,
+    ) -> np.ndarray:
+        """``_step`` for a model with (cos, sin) joints: limits in velocity space."""
         if limited:
-            now = q if self._simple else q[self._q_of_v]
+            now = q[self._q_of_v]
             room_low, room_high = self._v_lower - now, self._v_upper - now
-            out = (dq < room_low) | (dq > room_high)
-            if out.any():
-                # the joints that would cross stop on their limits; the rest try again
-                dq = np.clip(dq, room_low, room_high)
-                free = ~out
-                if free.any():
-                    rest = error - jacobian[:, out] @ dq[out]
-                    again = _least_squares(jacobian[:, free], rest, damping)
-                    dq[free] = np.clip(again, room_low[free], room_high[free])
-        q_next = q + dq if self._simple else pin.integrate(self.model, q, dq)
+            if ((dq < room_low) | (dq > room_high)).any():
+                dq = self._stop_at_limits(dq, room_low, room_high, jacobian, error, damping)
+        q_next = pin.integrate(self.model, q, dq)
         if limited:  # rounding only: the step already kept within
             np.clip(q_next, self.chain.lower, self.chain.upper, out=q_next)
         return q_next
+
+    @staticmethod
+    def _stop_at_limits(
+        dq: np.ndarray,
+        room_low: np.ndarray,
+        room_high: np.ndarray,
+        jacobian: np.ndarray,
+        error: np.ndarray,
+        damping: float,
+    ) -> np.ndarray:
+        """The joints whose step would cross a limit stop on it; the others try again."""
+        out = (dq < room_low) | (dq > room_high)
+        dq = np.clip(dq, room_low, room_high)
+        free = ~out
+        if free.any():
+            rest = error - jacobian[:, out] @ dq[out]
+            again = _least_squares(jacobian[:, free], rest, damping)
+            dq[free] = np.clip(again, room_low[free], room_high[free])
+        return dq
 
 
 def _least_squares(jacobian: np.ndarray, error: np.ndarray, damping: float) -> np.ndarray:
@@ -182,8 +226,18 @@ def _least_squares(jacobian: np.ndarray, error: np.ndarray, damping: float) -> n
     rows, cols = jacobian.shape
     if cols >= rows:
         normal = jacobian @ jacobian.T
-        normal.flat[:: rows + 1] += damping
-        return jacobian.T @ np.linalg.solve(normal, error)
+        normal += damping * _IDENTITY[rows]
+        return jacobian.T @ _solve_spd(normal, error)
     normal = jacobian.T @ jacobian
-    normal.flat[:: cols + 1] += damping
-    return np.linalg.solve(normal, jacobian.T @ error)
+    normal += damping * _IDENTITY[cols]
+    return _solve_spd(normal, jacobian.T @ error)
+
+
+def _solve_spd(normal: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """``normal^-1 rhs`` for a symmetric positive definite ``normal`` (LAPACK's Cholesky).
+
+    LAPACK's ``dposv`` straight from scipy (which pink's qpsolvers loads anyway):
+    a third of ``np.linalg.solve``'s cost on these 3x3 to 6x6 systems.
+    """
+    _, solution, info = dposv(normal, rhs)
+    return solution if info == 0 else np.linalg.lstsq(normal, rhs)[0]
