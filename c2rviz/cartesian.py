@@ -198,6 +198,8 @@ def plan_line(
     smallest = nominal * min(1.0, min_step_m / step_m)  # as small a turn, in proportion
     q = tuple(float(v) for v in q0)
     here = chain.to_model(q)
+    model, lower, upper = chain.model, chain.lower, chain.upper
+    simple = model.nq == model.nv  # no (cos, sin) joint: configurations add and subtract
     before: tuple[float, np.ndarray] | None = None  # the waypoint before, for the predictor
     waypoints = [LineWaypoint(0.0, q)]
     s, ds = 0.0, nominal
@@ -207,16 +209,17 @@ def plan_line(
         target = Goal(p0 + s_next * travel, rotation)
         guess = here
         if before is not None:  # the path so far, extrapolated: errors of order ds^2
-            velocity = pin.difference(chain.model, before[1], here) / (s - before[0])
-            guess = np.clip(
-                pin.integrate(chain.model, here, velocity * (s_next - s)), chain.lower, chain.upper
-            )
+            ratio = (s_next - s) / (s - before[0])
+            if simple:
+                guess = here + ratio * (here - before[1])
+            else:
+                guess = pin.integrate(model, here, ratio * pin.difference(model, before[1], here))
+            guess = np.minimum(np.maximum(guess, lower), upper)
         reached = newton.descend(guess, target, ik.settings.max_iterations, exact=s_next == 1.0)
-        attempt_q = chain.to_chain(reached.q, q)
-        jump = float(np.abs(np.subtract(attempt_q, q)).max())
-        if reached.ok and jump <= max_joint_step:
+        change = reached.q - here if simple else pin.difference(model, here, reached.q)
+        if reached.ok and float(np.abs(change).max()) <= max_joint_step:
             before = (s, here)
-            s, q, here = s_next, attempt_q, reached.q
+            s, q, here = s_next, chain.to_chain(reached.q, q), reached.q
             waypoints.append(LineWaypoint(s, q))
             ds = min(nominal, 2 * ds)
             continue
@@ -226,7 +229,7 @@ def plan_line(
         ik.solve(goal, q0, tool)  # an unreachable goal is reported as such, not as a block
         if reached.ok:  # there, but only by a jump: the arm turns over a singularity
             raise LineBlocked(s, q)
-        joint = _joint_at_limit(ik, attempt_q)
+        joint = _joint_at_limit(ik, chain.to_chain(reached.q, q))
         # An arm of under 6 joints reaches a thin set of poses; a line leaves it.
         few = ik.robot.n if joint is None and ik.robot.n < 6 and not point else None
         raise LineBlocked(s, q, joint, few)

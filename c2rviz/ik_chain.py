@@ -62,7 +62,7 @@ class IkChain:
     Attributes:
         robot: The robot whose chain this is.
         model: The chain's model, with the tool frame ``TOOL_FRAME``.
-        tool_frame: Index of the tool frame in both models.
+        tool_frame: Index of the tool frame in the model.
         base_placement: Base link placement in the model's world frame.
         lower: The model's lower position limits (cos/sin bounds for continuous joints).
         upper: The model's upper position limits.
@@ -94,6 +94,9 @@ class IkChain:
         self._turns = [
             wraps and j.upper - j.lower > math.tau for wraps, j in zip(self._wraps, robot.joints)
         ]
+        self._plain = not any(self._continuous)  # every chain value is one model entry
+        self._idx = np.array(self._idx_q, dtype=int)
+        self._turn_idx = np.flatnonzero(self._turns)
 
     def set_tool(self, tool: pin.SE3 | None) -> None:
         """Put the tool frame at ``tool`` from the end-effector link (identity when None)."""
@@ -136,7 +139,20 @@ class IkChain:
         A continuous joint takes any turn; a revolute joint whose range spans
         more than a turn (a UR arm's +-360 deg) takes the whole-turn equivalent
         nearest ``near`` that is within its limits: the same pose, less motion.
+        A value within half a turn of ``near`` is returned exactly as it is.
         """
+        if not self._plain:
+            return self._to_chain_turning(q, near)
+        values = q[self._idx]
+        if len(self._turn_idx):
+            turns = self._turn_idx
+            gap = values[turns] - np.asarray(near, dtype=float)[turns]
+            if (np.abs(gap) > math.pi).any():
+                return self._to_chain_turning(q, near)
+        return tuple(values.tolist())
+
+    def _to_chain_turning(self, q: np.ndarray, near: Sequence[float]) -> tuple[float, ...]:
+        """``to_chain`` one joint at a time, for continuous joints and whole turns."""
         out = []
         joints = self.robot.joints
         for i, idx in enumerate(self._idx_q):
@@ -145,7 +161,7 @@ class IkChain:
                 out.append(near[i] + math.remainder(angle - near[i], math.tau))
                 continue
             value = float(q[idx])
-            if self._turns[i]:
+            if self._turns[i] and abs(value - near[i]) > math.pi:
                 lower, upper = joints[i].lower, joints[i].upper
                 nearest = near[i] + math.remainder(value - near[i], math.tau)
                 other = math.copysign(math.tau, near[i] - nearest)  # the next nearest turn
