@@ -14,7 +14,9 @@ For each arm, one table:
   (the reach bound answers before any step). Goal: <= 5 ms, all refused.
 - ``movel``: 0.5 m lines (random direction, up to 30 deg of turn) from random
   starts until 10 pass; the planning time of those that pass. Goal: median
-  <= 10 ms. ``movel pt`` plans the same lines with the orientation free.
+  <= 10 ms (n/a on an arm of under 6 joints when no full-pose 0.5 m line
+  passes: such an arm holds few poses along a line). ``movel pt`` plans the
+  same lines with the orientation free.
 
 Times are wall-clock and CPU (thread) time [ms]; the ``met`` column reads the
 CPU figure, the steadier one on a shared machine (wall time there includes
@@ -31,6 +33,7 @@ import math
 import sys
 import time
 from collections.abc import Callable, Sequence
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -96,13 +99,13 @@ def solve_rows(
     solved, walls, cpus = 0, [], []
     for _ in range(count):
         q_target = np.array(robot.random(rng))
-        pose = robot.ee_pose(q_target)
+        pose = robot.ee_pose(q_target.tolist())
         target: Target = PointTarget.at(pose.translation) if point else pose
         if near:
             seed = np.clip(q_target + rng.uniform(-0.2, 0.2, robot.n), robot.lower, robot.upper)
         else:
             seed = np.array(robot.random(rng))
-        ok, wall, cpu = timed(lambda t=target, s=seed: ik.solve(t, s.tolist()))
+        ok, wall, cpu = timed(partial(ik.solve, target, seed.tolist()))
         solved += ok
         walls.append(wall)
         cpus.append(cpu)
@@ -118,7 +121,7 @@ def far_rows(ik: IkSolver, count: int) -> tuple[int, list[float], list[float]]:
     for _ in range(count):
         direction = rng.normal(size=3)
         far = pin.SE3(np.eye(3), 2.0 * direction / np.linalg.norm(direction))
-        ok, wall, cpu = timed(lambda f=far: ik.solve(f, rest))
+        ok, wall, cpu = timed(partial(ik.solve, far, rest))
         refused += not ok
         walls.append(wall)
         cpus.append(cpu)
@@ -204,8 +207,13 @@ def arm_table(name: str, count: int, lines_wanted: int) -> bool:
     for case, point in (("movel", False), ("movel pt", True)):
         passed, tried, times, waypoints = line_rows(ik, lines_wanted, 40 * lines_wanted, point)
         if not times:
-            print(f"{name:18s} {case:8s} {passed:4d}/{tried:<4d}  no 0.5 m line passed")
-            all_met &= point  # a free-orientation line is extra: no goal
+            # Under 6 joints an arm holds few poses along a line: no 0.5 m one may pass.
+            verdict = "n/a" if point or robot.n < 6 else "NO"
+            print(
+                f"{name:18s} {case:8s} {passed:4d}/{tried:<4d}  no 0.5 m line passed"
+                f"{'':49s}  {'' if point else LINE_GOAL:15s} {'' if point else verdict}"
+            )
+            all_met &= verdict == "n/a"
             continue
         median = float(np.median(times))
         met = median <= 10.0
@@ -229,7 +237,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(machine())
     names = args.robots if args.robots is not None else default_robots()
     met = [name for name in names if arm_table(name, count, lines_wanted)]
-    print(f"\nevery goal met on {len(met)} of {len(names)} arms", end="")
+    print(f"\nevery goal met (or n/a) on {len(met)} of {len(names)} arms", end="")
     missed = [name for name in names if name not in met]
     print(f" (missed on: {', '.join(missed)})" if missed else "")
     return 0

@@ -130,6 +130,11 @@ class IkSolver:
 
     # --- public -----------------------------------------------------------------------
 
+    @property
+    def steps(self) -> int:
+        """Descent steps taken since construction, Newton and pink (for tests and benchmarks)."""
+        return self.newton.steps + self._closest.steps
+
     def tool_pose(self, q: Sequence[float], tool: pin.SE3 | None = None) -> pin.SE3:
         """Tool placement in the base frame for chain values ``q`` [rad or m]."""
         self.chain.set_tool(tool)

@@ -30,7 +30,8 @@ __all__ = ["Descent", "NewtonDescent"]
 
 # A descent stalls when its cost is not ``stall_ratio`` of 3 steps before (after 5 steps).
 _STALL_AFTER, _STALL_LAG = 5, 3
-_EXACT = 1e-10  # a converged descent takes one more step when its cost is above this [m]
+_EXACT = 1e-10  # a converged descent takes more steps while its cost is above this [m] ...
+_POLISH_STEPS = 3  # ... up to this many
 _WORLD = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 _IDENTITY = [np.eye(n) for n in range(7)]  # the damping's identity, by size (at most 6 rows)
 
@@ -114,9 +115,9 @@ class NewtonDescent:
             iterations: Most steps taken.
             limited: Keep the joints within their limits (else the model's limits are ignored).
             stall_ratio: Give up when the cost is not this fraction of 3 steps before.
-            exact: Once within tolerance, take one more step (kept if it helps): the
-                error falls quadratically, so the answer is then exact to rounding
-                (a pose sent reads back as sent).
+            exact: Once within tolerance, take up to 3 more steps while each halves
+                the error: it falls quadratically, so the answer is then exact to
+                rounding (a pose sent reads back as sent).
         """
         model, data, frame = self.model, self.data, self.frame
         target_p, target_r = goal.position, goal.rotation
@@ -126,10 +127,11 @@ class NewtonDescent:
         error = np.empty(3 if target_r is None else 6)
         q = q0
         costs: list[float] = []
-        done: Descent | None = None  # a converged point, kept while one more step polishes it
+        best: Descent | None = None  # converged: kept while a few more steps polish it
+        polish = 0
         distance = angle = math.inf
         step = 0
-        for step in range(iterations + 2):  # noqa: B007 (step is read after the loop)
+        for step in range(iterations + 2 + _POLISH_STEPS):  # noqa: B007 (read after the loop)
             jacobian = jacobian_of(model, data, q, frame, _WORLD)
             placement = data.oMf[frame]
             error[:3] = target_p - placement.translation
@@ -144,14 +146,19 @@ class NewtonDescent:
                 error[3:] *= weight
                 jacobian[3:] *= weight
             cost = hypot(distance, weight * angle)
-            if done is not None:  # the polishing step: keep it only if it helped
-                better = distance <= tol_p and angle <= tol_a and cost < costs[-1]
-                return Descent(True, q, distance, angle, step) if better else done
-            if distance <= tol_p and angle <= tol_a:
-                here = Descent(True, q, distance, angle, step)
+            within = distance <= tol_p and angle <= tol_a
+            if best is not None:  # polishing: keep a step only while it halves the cost
+                if not within or cost > 0.5 * costs[-1]:
+                    return best
+                best = Descent(True, q, distance, angle, step)
+                if cost <= _EXACT or polish >= _POLISH_STEPS:
+                    return best
+                polish += 1
+            elif within:
+                best = Descent(True, q, distance, angle, step)
                 if not exact or cost <= _EXACT:
-                    return here
-                done = here  # quadratic convergence: one more step reads back exactly
+                    return best
+                polish = 1  # quadratic convergence: a step or two more read back exactly
             elif step >= iterations or (
                 step >= _STALL_AFTER and cost > stall_ratio * costs[-1 - _STALL_LAG]
             ):

@@ -127,7 +127,7 @@ def test_a_near_target_keeps_the_arm_near_its_seed(name: str) -> None:
     for _ in range(20):
         seed = np.array(robot.random(rng))
         nudged = np.clip(seed + rng.uniform(-0.02, 0.02, robot.n), robot.lower, robot.upper)
-        q = ik.solve(robot.ee_pose(nudged), seed.tolist())
+        q = ik.solve(robot.ee_pose(nudged.tolist()), seed.tolist())
         assert np.abs(np.subtract(q, seed)).max() < 0.2
 
 
