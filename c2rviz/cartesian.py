@@ -1,12 +1,15 @@
 """Straight-line tool motion: the joint path that keeps the tool on a segment.
 
 The tool point moves on the straight segment from its pose at ``q0`` to the
-goal while its orientation turns by slerp; both progress with one parameter
-``s`` from 0 to 1. Each waypoint is solved from the one before (warm start),
-so the path is continuous; where joints move fast for little tool motion the
-step is halved, and where even a tiny step cannot follow the line (a joint at
-its limit, a singularity) the whole line is refused before anything moves.
-Pure: time enters only through the speeds given to ``StraightLine.timestamps``.
+goal while its orientation turns by slerp (or, for a ``PointTarget`` goal, is
+left free); both progress with one parameter ``s`` from 0 to 1. Each waypoint
+is solved from the one before (warm start, extrapolated along the path, so one
+Newton step usually does), so the path is continuous; where joints move fast
+for little tool motion the step is halved, and where even a tiny step cannot
+follow the line (a joint at its limit, a singularity) the whole line is refused
+before anything moves. A goal beyond the arm's reach is refused before any
+step. Pure: time enters only through the speeds given to
+``StraightLine.timestamps``.
 """
 
 from __future__ import annotations

@@ -54,7 +54,7 @@ class Unreachable(C2rvizError):
             where = from_first_joint_m if from_first_joint_m is not None else math.nan
             message = (
                 f"{what} unreachable: the target is {where:.3f} m from the arm's first joint, "
-                f"which reaches {reach_m:.3f} m at most: every tool pose is at least "
+                f"which reaches {reach_m:.3f} m at most: every tool {what} is at least "
                 f"{away_mm} mm away, over the {tol_mm:g} mm tolerance"
             )
         elif orientation_free:

@@ -119,7 +119,7 @@ def test_beyond_reach_is_refused_before_any_step(name: str, point: bool) -> None
     what = "point" if point else "pose"
     assert re.fullmatch(
         rf"{what} unreachable: the target is \d+\.\d{{3}} m from the arm's first joint, which "
-        r"reaches \d+\.\d{3} m at most: every tool pose is at least \d+\.\d mm away, over the "
+        rf"reaches \d+\.\d{{3}} m at most: every tool {what} is at least \d+\.\d mm away, over the "
         r"0\.1 mm tolerance",
         str(refused),
     ), str(refused)
