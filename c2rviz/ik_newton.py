@@ -30,7 +30,7 @@ __all__ = ["Descent", "NewtonDescent"]
 
 # A descent stalls when its cost is not ``stall_ratio`` of 3 steps before (after 5 steps).
 _STALL_AFTER, _STALL_LAG = 5, 3
-_EXACT = 1e-10  # a converged descent takes more steps while its cost is above this [m] ...
+_EXACT = 1e-13  # a converged descent takes more steps while its cost is above this [m] ...
 _POLISH_STEPS = 3  # ... up to this many
 _WORLD = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 _IDENTITY = [np.eye(n) for n in range(7)]  # the damping's identity, by size (at most 6 rows)

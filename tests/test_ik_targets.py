@@ -16,6 +16,7 @@ from test_ik import BENT_ELBOW, BUNDLED, EXAMPLE_ARMS, errors, solver, within_li
 
 from c2rviz.cartesian import plan_line
 from c2rviz.ik import IkSolver, PointTarget, Unreachable
+from c2rviz.ik_rpy import canonical_rpy
 from c2rviz.ik_target import goal_in_world
 from c2rviz.robot import Robot
 
@@ -264,3 +265,32 @@ def test_a_five_joint_arm_follows_a_line_to_a_point_not_to_a_pose() -> None:
     line = plan_line(ik, q0, PointTarget.at(end))
     assert line.waypoints[-1].s == 1.0
     assert point_error(robot, line.waypoints[-1].q, PointTarget.at(end)) <= 1e-9
+
+
+# --- a pose sent reads back as sent ----------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "sent",
+    [
+        (0.6, 0.2, 1.0, 0.0, 90.0, 0.0),  # issue 30: once read back as 30.64,89.99997,30.64
+        (0.6, -0.2, 1.0, 0.0, 90.0, 0.0),
+        (0.5, 0.1, 0.7, 180.0, 0.0, 0.0),  # tool down
+        (0.4, 0.3, 0.9, 0.0, 150.0, 0.0),  # not 180,30,180
+        (0.5, 0.0, 0.6, 0.0, 180.0, 0.0),  # not 180,0,180
+        (0.45, -0.25, 0.8, 12.5, -33.25, 101.75),
+    ],
+    ids=str,
+)
+def test_a_pose_sent_reads_back_as_sent(sent: tuple[float, ...]) -> None:
+    """moveto x,y,z,r,p,y then pose: the solution is exact to rounding and canonical_rpy
+    reads its orientation back in the form it was sent (10 significant digits agree)."""
+    ik = solver("motoman_sia20d")
+    robot = ik.robot
+    tool = pin.SE3(np.eye(3), np.array([0.0, 0.0, 0.1]))
+    x, y, z, *rpy_deg = sent
+    target = pin.SE3(pin.rpy.rpyToMatrix(*np.radians(rpy_deg)), np.array([x, y, z]))
+    q = ik.solve(target, robot.home, tool)
+    pose = robot.ee_pose(q) * tool
+    read = [*pose.translation, *np.degrees(canonical_rpy(pose.rotation))]
+    np.testing.assert_allclose(read, sent, rtol=0, atol=1e-9)
