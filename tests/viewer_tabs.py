@@ -11,6 +11,8 @@ can wait for what a page would have been told. ``Harness`` runs a real
 from __future__ import annotations
 
 import asyncio
+import math
+import socket
 import threading
 import time
 from collections.abc import Callable
@@ -192,3 +194,85 @@ class Harness:
             tab.close()
         self.scene.stop()
         self.loop.close()
+
+
+def gui_update(uuid: str, updates: dict[str, Any]) -> bytes:
+    return encode({"type": "GuiUpdateMessage", "uuid": uuid, "updates": updates})
+
+
+def never_reading_tab(port: int) -> socket.socket:
+    """A websocket tab that opens, then reads nothing: its TCP window stays shut."""
+    sock = socket.socket()
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    sock.settimeout(10)
+    sock.connect(("127.0.0.1", port))
+    sock.sendall(
+        (
+            f"GET / HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nUpgrade: websocket\r\n"
+            "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+            f"Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: {VERSION}\r\n\r\n"
+        ).encode()
+    )
+    head = b""
+    while b"\r\n\r\n" not in head:
+        head += sock.recv(1)
+    assert head.startswith(b"HTTP/1.1 101"), head
+    return sock
+
+
+def bad_messages(slider: str, checkbox: str) -> dict[str, bytes | str]:
+    """Frames a page must not get through, aimed at the slider and the checkbox."""
+    nested = {"type": "GuiUpdateMessage", "uuid": slider, "updates": {"value": 2.0}}
+    return {
+        "nan": gui_update(slider, {"value": math.nan}),
+        "infinity": gui_update(slider, {"value": -math.inf}),
+        "update_cb": gui_update(slider, {"update_cb": []}),
+        "removed": gui_update(slider, {"removed": True}),
+        "uuid": gui_update(slider, {"uuid": "nope"}),
+        "gui_api": gui_update(slider, {"gui_api": 0}),
+        "value-and-removed": gui_update(slider, {"value": 2.0, "removed": True}),
+        "no-value": gui_update(slider, {}),
+        "a-string": gui_update(slider, {"value": "3"}),
+        "true-for-a-slider": gui_update(slider, {"value": True}),
+        "a-number-for-a-checkbox": gui_update(checkbox, {"value": 1}),
+        "unknown-id": gui_update("no-such-input", {"value": 1.0}),
+        "a-field-of-its-own": encode({**nested, "excluded_self_client": 1}),
+        "upload-start": encode(
+            {
+                "type": "FileTransferStartUpload",
+                "source_component_uuid": slider,
+                "transfer_uuid": "t1",
+                "filename": "x.bin",
+                "mime_type": "application/octet-stream",
+                "part_count": 0,
+                "size_bytes": 0,
+            }
+        ),
+        "upload-part": encode(
+            {
+                "type": "FileTransferPart",
+                "source_component_uuid": slider,
+                "transfer_uuid": "t1",
+                "part_index": 0,
+                "content": b"",
+            }
+        ),
+        "share-request": encode({"type": "ShareUrlRequest"}),
+        "share-disconnect": encode({"type": "ShareUrlDisconnect"}),
+        "a-server-message": encode(
+            {"type": "SetPositionMessage", "name": "/frame", "position": [9.0, 9.0, 9.0]}
+        ),
+        "camera-nan": encode(
+            {
+                "type": "ViewerCameraMessage",
+                "wxyz": [1.0, 0.0, 0.0, 0.0],
+                "position": [math.nan, 0.0, 0.0],
+                **{"fov": 1.0, "near": 0.01, "far": 100.0, "image_height": 10},
+                **{"image_width": 10, "look_at": [0.0, 0.0, 0.0], "up_direction": [0, 0, 1]},
+            }
+        ),
+        "text": "hello",
+        "not-msgpack": b"\xc1\xc1\xc1",
+        "many-tiny-items": b"\xdd" + (60_000).to_bytes(4, "big") + b"\x90" * 60_000,
+        "many-tiny-fields": gui_update(slider, {f"k{i}": [] for i in range(5000)}),
+    }

@@ -23,7 +23,6 @@ from ..robot.model import Robot
 __all__ = ["TOOL_FRAME", "IkChain", "chain_model"]
 
 TOOL_FRAME = "c2rviz_ik_tool"
-_UNBOUNDED = 1e10  # a position limit pink ignores
 
 
 def chain_model(robot: Robot) -> pin.Model:
@@ -58,13 +57,12 @@ def chain_model(robot: Robot) -> pin.Model:
 
 
 class IkChain:
-    """The chain's model with a tool frame, and a copy of it without joint limits.
+    """The chain's model with a tool frame, and conversions to and from chain values.
 
     Attributes:
         robot: The robot whose chain this is.
         model: The chain's model, with the tool frame ``TOOL_FRAME``.
-        free_model: The same model without position limits (for free descents).
-        tool_frame: Index of the tool frame in both models.
+        tool_frame: Index of the tool frame in the model.
         base_placement: Base link placement in the model's world frame.
         lower: The model's lower position limits (cos/sin bounds for continuous joints).
         upper: The model's upper position limits.
@@ -85,9 +83,6 @@ class IkChain:
             )
         )
         self.model = model
-        self.free_model = model.copy()
-        self.free_model.lowerPositionLimit[:] = -_UNBOUNDED
-        self.free_model.upperPositionLimit[:] = _UNBOUNDED
         self.data = model.createData()
         pin.framesForwardKinematics(model, self.data, pin.neutral(model))
         self.base_placement = self.data.oMf[model.getFrameId(robot.base, pin.BODY)].copy()
@@ -96,12 +91,17 @@ class IkChain:
         self._idx_q = [model.joints[model.getJointId(j.name)].idx_q for j in robot.joints]
         self._continuous = [j.continuous and j.nq == 2 for j in robot.joints]
         self._wraps = [not (j.prismatic or j.continuous) for j in robot.joints]
+        self._turns = [
+            wraps and j.upper - j.lower > math.tau for wraps, j in zip(self._wraps, robot.joints)
+        ]
+        self._plain = not any(self._continuous)  # every chain value is one model entry
+        self._idx = np.array(self._idx_q, dtype=int)
+        self._turn_idx = np.flatnonzero(self._turns)
 
     def set_tool(self, tool: pin.SE3 | None) -> None:
         """Put the tool frame at ``tool`` from the end-effector link (identity when None)."""
         placement = self._ee_placement * (tool if tool is not None else pin.SE3.Identity())
         self.model.frames[self.tool_frame].placement = placement
-        self.free_model.frames[self.tool_frame].placement = placement
 
     def tool_pose(self, q: Sequence[float]) -> pin.SE3:
         """Tool placement in the base frame for chain values ``q`` [rad or m]."""
@@ -134,12 +134,40 @@ class IkChain:
         return out
 
     def to_chain(self, q: np.ndarray, near: Sequence[float]) -> tuple[float, ...]:
-        """Chain values [rad or m]; a continuous joint takes the turn nearest ``near``."""
+        """Chain values [rad or m], each revolute joint on the turn nearest ``near``.
+
+        A continuous joint takes any turn; a revolute joint whose range spans
+        more than a turn (a UR arm's +-360 deg) takes the whole-turn equivalent
+        nearest ``near`` that is within its limits: the same pose, less motion.
+        A value within half a turn of ``near`` is returned exactly as it is.
+        """
+        if not self._plain:
+            return self._to_chain_turning(q, near)
+        values = q[self._idx]
+        if len(self._turn_idx):
+            turns = self._turn_idx
+            gap = values[turns] - np.asarray(near, dtype=float)[turns]
+            if (np.abs(gap) > math.pi).any():
+                return self._to_chain_turning(q, near)
+        return tuple(values.tolist())
+
+    def _to_chain_turning(self, q: np.ndarray, near: Sequence[float]) -> tuple[float, ...]:
+        """``to_chain`` one joint at a time, for continuous joints and whole turns."""
         out = []
+        joints = self.robot.joints
         for i, idx in enumerate(self._idx_q):
             if self._continuous[i]:
                 angle = math.atan2(q[idx + 1], q[idx])
                 out.append(near[i] + math.remainder(angle - near[i], math.tau))
-            else:
-                out.append(float(q[idx]))
+                continue
+            value = float(q[idx])
+            if self._turns[i] and abs(value - near[i]) > math.pi:
+                lower, upper = joints[i].lower, joints[i].upper
+                nearest = near[i] + math.remainder(value - near[i], math.tau)
+                other = math.copysign(math.tau, near[i] - nearest)  # the next nearest turn
+                for candidate in (nearest, nearest + other, nearest - other):
+                    if lower <= candidate <= upper:
+                        value = candidate
+                        break
+            out.append(value)
         return tuple(out)

@@ -1,12 +1,15 @@
 """Straight-line tool motion: the joint path that keeps the tool on a segment.
 
 The tool point moves on the straight segment from its pose at ``q0`` to the
-goal while its orientation turns by slerp; both progress with one parameter
-``s`` from 0 to 1. Each waypoint is solved from the one before (warm start),
-so the path is continuous; where joints move fast for little tool motion the
-step is halved, and where even a tiny step cannot follow the line (a joint at
-its limit, a singularity) the whole line is refused before anything moves.
-Pure: time enters only through the speeds given to ``StraightLine.timestamps``.
+goal while its orientation turns by slerp (or, for a ``PointTarget`` goal, is
+left free); both progress with one parameter ``s`` from 0 to 1. Each waypoint
+is solved from the one before (warm start, extrapolated along the path, so one
+Newton step usually does), so the path is continuous; where joints move fast
+for little tool motion the step is halved, and where even a tiny step cannot
+follow the line (a joint at its limit, a singularity) the whole line is refused
+before anything moves. A goal beyond the arm's reach is refused before any
+step. Pure: time enters only through the speeds given to
+``StraightLine.timestamps``.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ import pinocchio as pin
 
 from ..errors import C2rvizError
 from .solver import IkSolver
+from .target import Goal, PointTarget, Target, goal_in_world
 
 __all__ = ["LineBlocked", "LineWaypoint", "StraightLine", "interpolate", "plan_line"]
 
@@ -141,7 +145,7 @@ class StraightLine:
 def plan_line(
     ik: IkSolver,
     q0: Sequence[float],
-    goal: pin.SE3,
+    goal: Target,
     tool: pin.SE3 | None = None,
     *,
     step_m: float = 0.005,
@@ -154,12 +158,20 @@ def plan_line(
     Waypoints are at most ``step_m`` and ``step_rad`` of tool motion apart;
     a step that would move a joint more than ``max_joint_step`` is halved,
     down to ``min_step_m`` (and a turn as small in proportion), where the
-    line is blocked.
+    line is blocked. Each waypoint's descent starts from the path extrapolated
+    from the two before it, so most take one Newton step.
+
+    A ``PointTarget`` goal leaves the orientation free all along: the tool
+    point keeps to the segment while the joints move least (so the
+    orientation drifts only as the arm needs; an arm of under 6 joints can
+    follow such lines). The returned line's ``goal`` is then the pose reached,
+    and ``pose_at`` turns by slerp between the start's and that orientation,
+    an approximation of the path's (its positions are exact).
 
     Args:
         ik: The robot's solver.
         q0: Chain values at the start [rad or m], within the limits.
-        goal: Tool pose at the end, in the base frame.
+        goal: Tool pose at the end, in the base frame, or a ``PointTarget``.
         tool: Tool offset from the end-effector link (identity when None).
         step_m: Largest tool travel between waypoints [m].
         step_rad: Largest tool turn between waypoints [rad].
@@ -174,34 +186,58 @@ def plan_line(
             or (under 6 joints) the line leaves the poses the arm can reach.
         Unreachable: the goal itself cannot be reached.
     """
-    ik.solve(goal, q0, tool)  # an unreachable goal is reported as such, not as a block
-    start = ik.tool_pose(q0, tool)
-    length = float(np.linalg.norm(goal.translation - start.translation))
-    angle = float(np.linalg.norm(pin.log3(start.rotation.T @ goal.rotation)))
+    chain, newton = ik.chain, ik.newton
+    start = ik.tool_pose(q0, tool)  # also puts the tool on the chain
+    point = isinstance(goal, PointTarget)
+    end = goal_in_world(goal, chain.base_placement)
+    ik.check_reach(end)  # far beyond reach: refused at once
+    world_start = chain.base_placement * start
+    p0, rotation0 = world_start.translation, world_start.rotation
+    travel = end.position - p0
+    turn = np.zeros(3) if end.rotation is None else pin.log3(rotation0.T @ end.rotation)
+    length, angle = float(np.linalg.norm(travel)), float(np.linalg.norm(turn))
     count = max(1, math.ceil(max(length / step_m, angle / step_rad)))
     nominal = 1.0 / count
     smallest = nominal * min(1.0, min_step_m / step_m)  # as small a turn, in proportion
     q = tuple(float(v) for v in q0)
+    here = chain.to_model(q)
+    model, lower, upper = chain.model, chain.lower, chain.upper
+    simple = model.nq == model.nv  # no (cos, sin) joint: configurations add and subtract
+    before: tuple[float, np.ndarray] | None = None  # the waypoint before, for the predictor
     waypoints = [LineWaypoint(0.0, q)]
     s, ds = 0.0, nominal
     while s < 1.0:
         s_next = s + ds if s + ds < 1.0 - 1e-9 else 1.0
-        attempt = ik.follow(interpolate(start, goal, s_next), q, tool)
-        jump = float(np.abs(np.subtract(attempt.q, q)).max())
-        if attempt.ok and jump <= max_joint_step:
-            s, q = s_next, attempt.q
+        rotation = None if point else rotation0 @ pin.exp3(s_next * turn)
+        target = Goal(p0 + s_next * travel, rotation)
+        guess = here
+        if before is not None:  # the path so far, extrapolated: errors of order ds^2
+            ratio = (s_next - s) / (s - before[0])
+            if simple:
+                guess = here + ratio * (here - before[1])
+            else:
+                guess = pin.integrate(model, here, ratio * pin.difference(model, before[1], here))
+            guess = np.minimum(np.maximum(guess, lower), upper)
+        reached = newton.descend(guess, target, ik.settings.max_iterations, exact=s_next == 1.0)
+        change = reached.q - here if simple else pin.difference(model, here, reached.q)
+        if reached.ok and float(np.abs(change).max()) <= max_joint_step:
+            before = (s, here)
+            s, q, here = s_next, chain.to_chain(reached.q, q), reached.q
             waypoints.append(LineWaypoint(s, q))
             ds = min(nominal, 2 * ds)
             continue
         if ds > smallest:
             ds /= 2
             continue
-        if attempt.ok:  # there, but only by a jump: the arm turns over a singularity
+        ik.solve(goal, q0, tool)  # an unreachable goal is reported as such, not as a block
+        if reached.ok:  # there, but only by a jump: the arm turns over a singularity
             raise LineBlocked(s, q)
-        joint = _joint_at_limit(ik, attempt.q)
+        joint = _joint_at_limit(ik, chain.to_chain(reached.q, q))
         # An arm of under 6 joints reaches a thin set of poses; a line leaves it.
-        few = ik.robot.n if joint is None and ik.robot.n < 6 else None
+        few = ik.robot.n if joint is None and ik.robot.n < 6 and not point else None
         raise LineBlocked(s, q, joint, few)
+    if point:  # the orientation was free: the line ends where the joints took it
+        return StraightLine(start, ik.tool_pose(q, tool), tuple(waypoints))
     return StraightLine(start, goal, tuple(waypoints))
 
 

@@ -1,11 +1,24 @@
-"""Inverse kinematics of the chain: chain values that put the tool at a pose.
+"""Inverse kinematics of the chain: chain values that put the tool at a pose or a point.
 
 Poses are the tool point in the robot's base frame (the frame ``Robot.ee_pose``
-uses); the tool is an ``SE3`` offset from the end-effector link. pink solves
-each step as a small QP (daqp) with the joint limits as constraints; the
-solver iterates those steps from the seed, then restarts from other seeds when
-an attempt stalls. Pure: no clock, no I/O; the restart seeds come from an rng
-seeded anew on every call, so one question always gets one answer.
+uses); the tool is an ``SE3`` offset from the end-effector link. A target is a
+full pose (``pin.SE3``) or a ``PointTarget`` (position only, orientation free).
+
+How a solve goes:
+
+1. The reach bound (``ReachBound``): a target farther from the first joint than
+   the chain is long is refused at once, before any step.
+2. A damped Newton descent (``NewtonDescent``, numpy over Pinocchio) from the
+   seed itself: most answers near the seed end here in a few steps.
+3. Restarts from stored configurations whose tool is closest to the target
+   (``SeedPool``), closest first. When one succeeds, the solver looks for
+   ``successes_compared`` answers and returns the one nearest the seed.
+4. When none reaches the target, the closest attempt is taken to the bottom
+   (pink's QP keeps the limits exactly there, ``ClosestPose``) and
+   ``Unreachable`` says how far that pose is, over which tolerance.
+
+Pure: no clock, no I/O, no randomness after construction (the seed pool is
+drawn once with a fixed seed), so one question always gets one answer.
 """
 
 from __future__ import annotations
@@ -15,38 +28,18 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import pink
 import pinocchio as pin
-from pink.limits import ConfigurationLimit
-from pink.tasks import FrameTask, PostureTask
 
-from ..errors import C2rvizError
 from ..robot.model import Robot
-from .chain import TOOL_FRAME, IkChain
-from .tool_task import ToolTask
+from .chain import IkChain
+from .closest import ClosestPose
+from .newton import Descent, NewtonDescent
+from .reach import ReachBound
+from .seeds import SeedPool
+from .target import Goal, PointTarget, Target, goal_in_world
+from .unreachable import Unreachable
 
-__all__ = ["Attempt", "IkSettings", "IkSolver", "Unreachable"]
-
-# An attempt stalls when its cost is not 10 % lower than 3 steps before (after 5 steps).
-_STALL_AFTER, _STALL_LAG, _STALL_RATIO = 5, 3, 0.9
-_POLISH_RATIO = 0.999  # the closest pose of an unreachable target: descend to the bottom
-
-
-class Unreachable(C2rvizError):
-    """No chain values within the limits put the tool at the target pose.
-
-    Attributes:
-        distance_m: Position error of the closest tool pose found [m].
-        angle_rad: Orientation error of that pose [rad].
-    """
-
-    def __init__(self, distance_m: float, angle_rad: float) -> None:
-        self.distance_m = distance_m
-        self.angle_rad = angle_rad
-        super().__init__(
-            f"pose unreachable: the closest reachable tool pose is {distance_m * 1e3:.1f} mm "
-            f"and {math.degrees(angle_rad):.1f} deg away"
-        )
+__all__ = ["Attempt", "IkSettings", "IkSolver", "PointTarget", "Target", "Unreachable"]
 
 
 @dataclass(frozen=True)
@@ -54,48 +47,59 @@ class IkSettings:
     """How hard the solver tries, and what it calls done.
 
     Attributes:
-        position_tolerance_m: Tool position error accepted [m] (promise: 0.1 mm).
-        angle_tolerance_rad: Tool orientation error accepted [rad] (promise: 0.1 deg).
-        max_iterations: pink steps per attempt.
-        max_attempts: Attempts per solve: the seed, then restarts.
-        max_total_iterations: Hard cap on pink steps per solve (about 0.1 ms each)...
+        position_tolerance_m: Tool position error a descent aims for [m].
+        angle_tolerance_rad: Tool orientation error a descent aims for [rad].
+        max_iterations: Newton steps per descent.
+        max_attempts: Attempts per solve: the seed, then restarts (at most ``seed_pool``).
+        max_total_iterations: Hard cap on Newton steps per solve (some 30 us each)...
         polish_iterations: ...plus these, for the closest pose when unreachable.
         successes_compared: After a restart succeeds, keep restarting until this
             many solutions are found and return the one nearest the seed...
-        compare_iterations: ...spending at most this many more pink steps on it.
+        compare_iterations: ...spending at most this many more steps on it.
         max_step: Largest change of any joint in one step [rad or m].
-        posture_cost: Pull towards the seed [cost/rad]; small, it only chooses
-            among solutions of a redundant arm and is dropped for the last steps.
+        posture_cost: Pull towards the seed while the closest pose of an
+            unreachable target is polished [cost/rad].
         orientation_cost: Weight of 1 rad of orientation error against 1 m of
             position error [m/rad]; "closest" when unreachable minimises
             hypot(position error, orientation_cost * angle error).
-        seed: Seed of the restart rng.
+        seed: Seed of the rng that draws the seed pool.
+        damping: Levenberg-Marquardt factor of the Newton steps [1/m^2]:
+            ``lambda^2 = damping * cost^2``.
+        promise_position_m: The promise (0.1 mm): a closest pose within it is an
+            answer, not a refusal; ``Unreachable`` states it [m].
+        promise_angle_rad: The promise (0.1 deg), likewise [rad].
+        seed_pool: Random in-limit configurations stored to start restarts from
+            (``SeedPool``): each restart begins from the next closest one.
     """
 
     position_tolerance_m: float = 1e-5
     angle_tolerance_rad: float = math.radians(0.01)
     max_iterations: int = 20
-    max_attempts: int = 16
+    max_attempts: int = 24
     max_total_iterations: int = 250
     polish_iterations: int = 100
     successes_compared: int = 2
-    compare_iterations: int = 60
+    compare_iterations: int = 40
     max_step: float = 1.0
     posture_cost: float = 1e-4
     orientation_cost: float = 0.1
     seed: int = 0
+    damping: float = 0.1
+    promise_position_m: float = 1e-4
+    promise_angle_rad: float = math.radians(0.1)
+    seed_pool: int = 500
 
 
 @dataclass(frozen=True)
 class Attempt:
-    """The end of one pink descent.
+    """The end of one descent.
 
     Attributes:
         ok: True when the tool is within tolerance of the target.
         q: Chain values reached [rad or m].
         distance_m: Tool position error [m].
-        angle_rad: Tool orientation error [rad].
-        iterations: pink steps taken.
+        angle_rad: Tool orientation error [rad] (0 for a point target).
+        iterations: Steps taken.
     """
 
     ok: bool
@@ -105,15 +109,6 @@ class Attempt:
     iterations: int
 
 
-class _Stage:
-    """A model pink descends on, with its data and the limits it keeps."""
-
-    def __init__(self, model: pin.Model, limits: list[ConfigurationLimit]) -> None:
-        self.model = model
-        self.data = model.createData()
-        self.limits = limits
-
-
 class IkSolver:
     """Tool poses to chain values for one robot. Not thread-safe (one pin.Data)."""
 
@@ -121,23 +116,24 @@ class IkSolver:
         self.robot = robot
         self.settings = s = settings if settings is not None else IkSettings()
         self.chain = IkChain(robot)
-        # gain 0.9: a step may close 90 % of the gap to a limit, never cross it
-        self._limited = _Stage(self.chain.model, [ConfigurationLimit(self.chain.model, 0.9)])
-        # Restarts first descend without limits: joint limits make local minima
-        # (a joint pressed against its stop), and a free solution is often in
-        # range once revolute joints are wrapped by whole turns. On the bundled
-        # arms this lifts one attempt's success from 40-70 % to 70-90 %.
-        self._free = _Stage(self.chain.free_model, [])
-        # The search descends with pink's FrameTask: from far away its screw error
-        # converges more often (41 % against 33 % of single Fanuc attempts); the
-        # closest pose of an unreachable target is found with ToolTask, whose
-        # Levenberg-Marquardt damping (scaled by the residual) keeps steps going
-        # down where full Gauss-Newton steps would overshoot.
-        self._frame_task = FrameTask(TOOL_FRAME, 1.0, s.orientation_cost)
-        self._tool_task = ToolTask(TOOL_FRAME, s.orientation_cost, lm_damping=1.0)
-        self._posture_task = PostureTask(s.posture_cost)
+        self.newton = NewtonDescent(
+            self.chain,
+            s.orientation_cost,
+            s.position_tolerance_m,
+            s.angle_tolerance_rad,
+            s.max_step,
+            s.damping,
+        )
+        self.reach = ReachBound(self.chain)
+        self.seeds = SeedPool(self.chain, s.seed_pool, s.seed, s.orientation_cost)
+        self._closest = ClosestPose(self.chain, s.orientation_cost, s.posture_cost)
 
     # --- public -----------------------------------------------------------------------
+
+    @property
+    def steps(self) -> int:
+        """Descent steps taken since construction, Newton and pink (for tests and benchmarks)."""
+        return self.newton.steps + self._closest.steps
 
     def tool_pose(self, q: Sequence[float], tool: pin.SE3 | None = None) -> pin.SE3:
         """Tool placement in the base frame for chain values ``q`` [rad or m]."""
@@ -145,17 +141,18 @@ class IkSolver:
         return self.chain.tool_pose(q)
 
     def solve(
-        self, target: pin.SE3, q_seed: Sequence[float], tool: pin.SE3 | None = None
+        self, target: Target, q_seed: Sequence[float], tool: pin.SE3 | None = None
     ) -> tuple[float, ...]:
         """Chain values within the limits that put the tool at ``target``.
 
         The first attempt descends from the seed itself; when it stalls, the
-        restarts (near the seed, then anywhere) go on until a solution is found
-        and, if it is not the seed's own, until ``successes_compared`` are, or
-        the budget ends. The answer is the one nearest the seed.
+        restarts (from the stored configurations whose tool is closest) go on
+        until a solution is found and, if it is not the seed's own, until
+        ``successes_compared`` are, or the budget ends. The answer is the one
+        nearest the seed.
 
         Args:
-            target: Tool pose in the base frame.
+            target: Tool pose in the base frame, or a ``PointTarget`` (orientation free).
             q_seed: Current chain values [rad or m].
             tool: Tool offset from the end-effector link (identity when None).
 
@@ -164,148 +161,100 @@ class IkSolver:
             tolerances of ``target``.
 
         Raises:
-            Unreachable: no attempt got there; carries the closest pose's errors.
+            Unreachable: beyond the arm's reach, or no attempt got there; carries
+                the closest pose's errors and the tolerance they miss.
+            JointCountError: ``q_seed`` does not have one value per chain joint.
         """
         s = self.settings
         self.chain.set_tool(tool)
-        world_target = self.chain.base_placement * target
+        goal = goal_in_world(target, self.chain.base_placement)
         seed = self.chain.to_model(q_seed)
-        self._posture_task.set_target(seed)
-        rng = np.random.default_rng(s.seed)
-        budget = s.max_total_iterations
+        self.check_reach(goal)
+        first = self._attempt(self.newton.descend(seed, goal, s.max_iterations), q_seed)
+        if first.ok:
+            return first.q  # the seed's own basin: nearest by continuity
+        budget = s.max_total_iterations - first.iterations - 1
         found: list[Attempt] = []
-        closest: Attempt | None = None
-        start = seed
-
-        def steps() -> int:
-            return max(0, min(s.max_iterations, budget))
-
-        for index in range(s.max_attempts):
-            if index > 0:
-                free = self._descend(self._free, start, world_target, steps(), q_seed)
-                budget -= free.iterations + 1
-                start = self.chain.to_model(free.q)  # whole turns wrapped, then clipped
-            attempt = self._descend(self._limited, start, world_target, steps(), q_seed)
+        closest = first
+        for start in self.seeds.ranked(goal, s.max_attempts - 1):
+            steps = max(0, min(s.max_iterations, budget))
+            attempt = self._attempt(self.newton.descend(start, goal, steps), q_seed)
             budget -= attempt.iterations + 1
             if attempt.ok:
-                if index == 0:
-                    return attempt.q  # the seed's own basin: nearest by continuity
                 found.append(attempt)
                 if len(found) >= s.successes_compared:
                     break
                 budget = min(budget, s.compare_iterations)
-            elif closest is None or self._cost(attempt) < self._cost(closest):
+            elif self._cost(attempt) < self._cost(closest):
                 closest = attempt
             if budget <= 0:
                 break
-            start = self._restart(rng, q_seed, index)
         if found:
             distance = [np.linalg.norm(np.subtract(a.q, q_seed)) for a in found]
             return found[int(np.argmin(distance))].q
-        assert closest is not None
-        # Attempts are cut short when slow; take the closest one to the bottom.
-        bottom = self._descend(
-            self._limited,
-            self.chain.to_model(closest.q),
-            world_target,
-            s.polish_iterations,
-            q_seed,
-            _POLISH_RATIO,
-            self._tool_task,
-        )
-        if bottom.ok:  # it was only slow (near a singularity)
-            return bottom.q
-        raise Unreachable(bottom.distance_m, bottom.angle_rad)
+        return self._closest_or_refuse(closest, goal, q_seed)
 
     def follow(
-        self, target: pin.SE3, q_start: Sequence[float], tool: pin.SE3 | None = None
+        self, target: Target, q_start: Sequence[float], tool: pin.SE3 | None = None
     ) -> Attempt:
         """One descent from ``q_start`` towards ``target``, no restarts (for paths).
 
-        The posture pull is towards ``q_start``, so a redundant arm moves little.
+        The steps are of least joint motion, so a redundant arm moves little.
         """
         self.chain.set_tool(tool)
+        goal = goal_in_world(target, self.chain.base_placement)
         start = self.chain.to_model(q_start)
-        self._posture_task.set_target(start)
-        return self._descend(
-            self._limited,
-            start,
-            self.chain.base_placement * target,
-            self.settings.max_iterations,
-            q_start,
-        )
+        descent = self.newton.descend(start, goal, self.settings.max_iterations)
+        return self._attempt(descent, q_start)
 
-    # --- the descent ------------------------------------------------------------------
+    def check_reach(self, goal: Goal) -> None:
+        """Refuse a goal (world frame) beyond the reach bound, before any step.
+
+        Raises:
+            Unreachable: with the bound's distance, a lower bound on every pose's error.
+        """
+        s = self.settings
+        outside = self.reach.beyond(goal.position)
+        if outside > s.promise_position_m:
+            radius = self.reach.radius_m()
+            raise Unreachable(
+                outside,
+                0.0,
+                s.promise_position_m,
+                s.promise_angle_rad,
+                orientation_free=goal.rotation is None,
+                reach_m=radius,
+                from_first_joint_m=outside + radius,
+            )
+
+    def cost(self, distance_m: float, angle_rad: float) -> float:
+        """How far a pose is from the target, the norm the descents minimise [m]."""
+        return math.hypot(distance_m, self.settings.orientation_cost * angle_rad)
+
+    # --- inside -----------------------------------------------------------------------
 
     def _cost(self, attempt: Attempt) -> float:
         return self.cost(attempt.distance_m, attempt.angle_rad)
 
-    def cost(self, distance_m: float, angle_rad: float) -> float:
-        """How far a pose is from the target, the norm pink minimises [m]."""
-        return math.hypot(distance_m, self.settings.orientation_cost * angle_rad)
+    def _attempt(self, descent: Descent, near: Sequence[float]) -> Attempt:
+        q = self.chain.to_chain(descent.q, near)
+        return Attempt(descent.ok, q, descent.distance_m, descent.angle_rad, descent.iterations)
 
-    def _restart(self, rng: np.random.Generator, q_seed: Sequence[float], index: int) -> np.ndarray:
-        """Every other restart is near the seed (a widening box), the rest anywhere."""
-        q = np.array(self.robot.random(rng))
-        if index % 2 == 0:
-            width = min(1.0, 0.15 * (index // 2 + 1))
-            q = np.asarray(q_seed) + width * (q - np.asarray(q_seed))
-        return self.chain.to_model(q.tolist())
-
-    def _descend(
-        self,
-        stage: _Stage,
-        q0: np.ndarray,
-        world_target: pin.SE3,
-        iterations: int,
-        near: Sequence[float],
-        stall_ratio: float = _STALL_RATIO,
-        pose_task: FrameTask | ToolTask | None = None,
-    ) -> Attempt:
-        """Up to ``iterations`` pink steps from ``q0``, fewer when it converges or stalls."""
+    def _closest_or_refuse(
+        self, closest: Attempt, goal: Goal, q_seed: Sequence[float]
+    ) -> tuple[float, ...]:
+        """Take the closest attempt to the bottom; return it if within the promise."""
         s = self.settings
-        configuration = pink.Configuration(stage.model, stage.data, q0, copy_data=False)
-        if pose_task is None:
-            pose_task = self._frame_task
-            pose_task.set_target(world_target)
-        else:
-            pose_task.target = world_target
-        tasks_far = [pose_task, self._posture_task]
-        tasks_near = [pose_task]
-        costs: list[float] = []
-        distance = angle = math.inf
-        step = 0
-        for step in range(iterations + 1):  # noqa: B007 (step is read after the loop)
-            placement = configuration.data.oMf[self.chain.tool_frame]
-            distance = float(np.linalg.norm(world_target.translation - placement.translation))
-            angle = float(np.linalg.norm(pin.log3(placement.rotation.T @ world_target.rotation)))
-            if distance <= s.position_tolerance_m and angle <= s.angle_tolerance_rad:
-                return Attempt(
-                    True, self.chain.to_chain(configuration.q, near), distance, angle, step
-                )
-            costs.append(self.cost(distance, angle))
-            # stalled: under 10 % better than three steps ago (a local minimum or a limit)
-            if step == iterations or (
-                step >= _STALL_AFTER and costs[-1] > stall_ratio * costs[-1 - _STALL_LAG]
-            ):
-                break
-            # The posture pull would leave a tiny steady error near singularities;
-            # within 1 mm and 1 deg the null-space choice is made, so drop it.
-            near_target = distance < 1e-3 and angle < math.radians(1.0)
-            velocity = pink.solve_ik(
-                configuration,
-                tasks_near if near_target else tasks_far,
-                1.0,  # dt: one step is one displacement, the velocity is the step
-                solver="daqp",
-                damping=1e-12,
-                limits=stage.limits,  # position limits only: no velocity limit per step
-            )
-            largest = float(np.abs(velocity).max())
-            if largest > s.max_step:  # a trust region: scale the Gauss-Newton step down
-                velocity *= s.max_step / largest
-            # DAQP meets the limits to its tolerance (~1e-6); clip so every q is within
-            q_next = pin.integrate(stage.model, configuration.q, velocity)
-            if stage.limits:
-                q_next = np.clip(q_next, self.chain.lower, self.chain.upper)
-            configuration.update(q_next)
-        return Attempt(False, self.chain.to_chain(configuration.q, near), distance, angle, step)
+        bottom = self._closest.descend(
+            self.chain.to_model(closest.q), goal, s.polish_iterations, self.newton
+        )
+        attempt = self._attempt(bottom, q_seed)
+        if attempt.distance_m <= s.promise_position_m and attempt.angle_rad <= s.promise_angle_rad:
+            return attempt.q  # it was only slow (near a singularity)
+        raise Unreachable(
+            attempt.distance_m,
+            attempt.angle_rad,
+            s.promise_position_m,
+            s.promise_angle_rad,
+            orientation_free=goal.rotation is None,
+        )

@@ -1,0 +1,229 @@
+"""The page in a real headless Chromium, with the whole program behind it.
+
+One test walks through what a user sees: the robot drawn, TCP commands moving
+it, a slider on the page commanding the world (read back with ``where``), a
+late second tab showing the same state, markers appearing and ``clear``
+taking the page back to how it started. Screenshots go to test-artifacts/.
+
+Every wait is on a signal with a generous deadline, never on a short timer: the
+page's own state (viser's end-to-end hooks: the scene tree, node poses, the
+message queue and three.js's frame counter) says when a change has arrived and
+been drawn, and only then are pixels compared. Software WebGL on a busy 2-core
+CI machine is slow, not wrong; a timeout says what it last saw.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import socket
+import time
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import numpy as np
+from support import ROOT
+
+ARTIFACTS = ROOT / "test-artifacts"
+VIEWPORT = {"width": 1000, "height": 700}
+# Where the robot is drawn: right of viser's 'software WebGL' notice, left of the panel.
+SCENE = (slice(160, 700), slice(320, 660))
+JOINTS = ("joint_s", "joint_l", "joint_e", "joint_u", "joint_r", "joint_b", "joint_t")
+DEADLINE_S = 180.0  # for any one wait; a healthy run takes a second or two per step
+
+# viser's end-to-end hooks (App.tsx puts them on window for Playwright): the one place
+# this file reads the page's internals. Robot links are /robots/ROBOT/links/LINK, their geometry
+# /robots/ROBOT/links/LINK/visual_K, markers batched in /markers/ROBOT/SHAPE (c2rviz/view/).
+PAGE_STATE = """() => {
+  const m = window.__viserMutable, t = window.__viserSceneTree, tp = window.__viserTestpoints;
+  if (!m || !t || !tp) return null;
+  const nodes = Object.keys(t.getState());
+  const visuals = nodes.filter((n) => /^\\/robots\\/[^/]+\\/links\\/[^/]+\\/visual_\\d+$/.test(n));
+  const poses = {};
+  for (const [n, p] of Object.entries(m.nodePoseData)) {
+    if (/^\\/robots\\/[^/]+\\/links\\/[^/]+$/.test(n)) poses[n] = [...p.wxyz, ...p.position];
+  }
+  let markers = 0;  // one batched node per robot and shape: count its instances
+  for (const n of nodes.filter((n) => /^\\/markers\\//.test(n))) {
+    const at = t.getState()[n]?.message?.props?.batched_positions;
+    markers += at ? at.byteLength / 12 : 0;
+  }
+  return {
+    visuals: visuals.length,
+    mounted: visuals.filter((n) => m.nodeRefFromName[n]).length,
+    markers,
+    queued: m.messageQueue.length,
+    frame: tp.rendererInfo.render.frame,
+    poses,
+  };
+}"""
+
+
+class Tcp:
+    """A controller on the command port."""
+
+    def __init__(self, port: int) -> None:
+        self.sock = socket.create_connection(("127.0.0.1", port), timeout=10)
+        self.file = self.sock.makefile("rb")
+
+    def ask(self, line: str) -> str:
+        self.sock.sendall(line.encode() + b"\n")
+        return self.file.readline().decode().strip()
+
+    def close(self) -> None:
+        self.file.close()
+        self.sock.close()
+
+
+def scene_pixels(page: Any) -> np.ndarray:
+    from PIL import Image
+
+    image = Image.open(io.BytesIO(page.screenshot())).convert("RGB")
+    return np.asarray(image, dtype=np.int16)[SCENE]
+
+
+def settle(page: Any, name: str, timeout_s: float = 60.0) -> np.ndarray:
+    """The drawn scene once two screenshots in a row agree; saved as ``name``.png."""
+    previous = scene_pixels(page)
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        page.wait_for_timeout(150)
+        current = scene_pixels(page)
+        if np.array_equal(current, previous):
+            break
+        previous = current
+    page.screenshot(path=str(ARTIFACTS / f"{name}.png"))
+    return previous
+
+
+def blue_pixels(scene: np.ndarray) -> int:
+    """Pixels of the motoman's light blue (0.45, 0.68, 0.90), lit or shaded."""
+    r, b = scene[..., 0], scene[..., 2]
+    return int(((b - r > 60) & (b > 150)).sum())
+
+
+def wait_until(check: Callable[[], tuple[bool, Any]], what: str) -> Any:
+    """Poll ``check`` (it returns done, what it saw) until done; return what it saw.
+
+    Fails after ``DEADLINE_S`` naming ``what``, with what was seen along the way
+    (every 10 s and last), so a slow machine and a real fault can be told apart.
+    """
+    start = time.monotonic()
+    seen: list[str] = []
+    while True:
+        done, state = check()
+        if done:
+            return state
+        waited = time.monotonic() - start
+        if not seen or waited >= 10 * len(seen):
+            seen.append(f"{waited:.0f} s: {state}")
+        assert waited < DEADLINE_S, f"{what} (after {waited:.0f} s; saw {seen}, last {state})"
+        time.sleep(0.1)
+
+
+def page_state(page: Any) -> dict[str, Any] | None:
+    """What the page holds: robot visuals (and how many are mounted), markers, poses."""
+    return page.evaluate(PAGE_STATE)
+
+
+def same_poses(a: dict[str, list[float]], b: dict[str, list[float]], tol: float = 1e-6) -> bool:
+    return a.keys() == b.keys() and all(np.allclose(a[k], b[k], atol=tol) for k in a)
+
+
+def wait_for_scene(
+    page: Any, what: str, expect: Callable[[dict[str, Any]], bool] = lambda state: True
+) -> dict[str, Any]:
+    """Wait until the page holds ``expect``'s scene, steadily, and has drawn a frame of it.
+
+    Steady: every scene message applied (empty queue), every robot visual
+    mounted, and the same nodes and poses in two polls in a row.
+    """
+    previous: list[dict[str, Any] | None] = [None]
+
+    def ready() -> tuple[bool, Any]:
+        state = page_state(page)
+        if state is None:
+            return False, "viser's test hooks not on the page (yet)"
+        steady = {k: v for k, v in state.items() if k != "frame"}
+        done = (
+            state["visuals"] > 0
+            and state["mounted"] == state["visuals"]
+            and state["queued"] == 0
+            and expect(state)
+            and steady == previous[0]
+        )
+        previous[0] = steady
+        return done, state
+
+    state = wait_until(ready, f"the page did not show {what}")
+    frame = state["frame"]
+    wait_until(
+        lambda: ((now := page_state(page)) is not None and now["frame"] > frame, now),
+        f"the page did not draw {what}",
+    )
+    return state
+
+
+def wait_for_robot(page: Any) -> dict[str, Any]:
+    """Wait until the robot's links are drawn, not only the panel and grid; its scene."""
+    state = wait_for_scene(page, "the robot")
+    wait_until(
+        lambda: ((n := blue_pixels(scene_pixels(page))) >= 1000, n),
+        "the robot was not drawn (blue pixels)",
+    )
+    return state
+
+
+def changed(a: np.ndarray, b: np.ndarray) -> int:
+    """How many pixels differ noticeably between two scene crops."""
+    return int((np.abs(a - b).max(axis=2) > 24).sum())
+
+
+def field(page: Any, label: str, css: str = "input:not([type=hidden]), textarea") -> Any:
+    """The input in the panel row labelled ``label``."""
+    row = page.locator("label", has_text=label).first.locator(
+        "xpath=ancestor::div[contains(@class, 'mantine-Flex-root')][1]"
+    )
+    return row.locator(css).first
+
+
+def slider_input(page: Any, joint: str) -> Any:
+    """The number box beside a joint's slider."""
+    return field(page, joint, "input[inputmode=decimal]")
+
+
+def panel_state(page: Any) -> dict[str, str]:
+    """Every slider's value and the end-effector readout, as the page shows them."""
+    state = {joint: slider_input(page, joint).input_value() for joint in JOINTS}
+    state["ee"] = field(page, "End effector").input_value()
+    return state
+
+
+def open_page(browser: Any, url: str) -> Any:
+    page = browser.new_page(viewport=VIEWPORT)
+    # fixedDpr: viser otherwise lowers the resolution when software WebGL is slow,
+    # at a moment of its choosing, and identical scenes stop giving identical pixels.
+    page.goto(url + "/?fixedDpr=1")
+    page.get_by_text(JOINTS[-1]).first.wait_for(timeout=DEADLINE_S * 1000)  # the panel
+    return page
+
+
+@contextlib.contextmanager
+def program_page(
+    browser: Any, c2rviz_process: Callable[..., Any], *args: str
+) -> Iterator[tuple[Any, Any, Tcp]]:
+    """The program (``ARGS``, its viewer on a free port), a page with the robot drawn, and a
+    controller on its command port (closed after)."""
+    ARTIFACTS.mkdir(exist_ok=True)
+    proc = c2rviz_process("--viser-port", "0", *args)
+    page = open_page(browser, proc.viewer_url)
+    wait_for_robot(page)
+    tcp = Tcp(proc.port)
+    try:
+        yield proc, page, tcp
+    finally:
+        tcp.close()
+
+
+def wait_for(predicate: Callable[[], bool], what: str = "timed out") -> None:
+    wait_until(lambda: (predicate(), None), what)

@@ -1,0 +1,145 @@
+"""What the tests share besides fixtures: the bundled robots, a live server on its own loop,
+a plain-socket client, the program as a subprocess (``conftest.py`` makes fixtures of them).
+
+Tests import these by name (``from support import load_robot``): ``tests/`` is on the
+path because the root ``conftest.py`` lives there.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+import subprocess
+import threading
+from collections.abc import Callable
+from concurrent.futures import Future
+from dataclasses import dataclass, field
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+from c2rviz.app.program import write_page
+from c2rviz.robot.model import Robot
+from c2rviz.session import ServerLimits, Services
+from c2rviz.transports.tcp_text import CommandServer
+from c2rviz.world.effects import RecordingScene
+from c2rviz.world.world import World
+
+ROOT = Path(__file__).resolve().parent.parent
+LIMITS_URDF = ROOT / "tests" / "data" / "limits_robot" / "limits.urdf"
+"""A robot whose limits are at awkward numbers (puma560's +-1.570796325 rad)."""
+CHROMIUM = Path("/usr/bin/chromium")  # Debian's; Playwright cannot download browsers here
+ARGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--no-first-run",
+]
+ROBOTS = {
+    "motoman_sia20d": ("robots/motoman_sia20d/robot.urdf", "base_link", "link_t"),
+    "fanuc_lrmate200id": ("robots/fanuc_lrmate200id/robot.urdf", "base_link", "link_6"),
+    "kuka_lwr": ("robots/kuka_lwr/robot.urdf", "lwr_base_link", "lwr_7_link"),
+}
+
+
+@cache
+def load_robot(name: str = "motoman_sia20d") -> Robot:
+    """One of the bundled robots, with the ini's base and eelink (cached)."""
+    path, base, eelink = ROBOTS[name]
+    return Robot.from_urdf(ROOT / path, base, eelink)
+
+
+@dataclass
+class ServerThread:
+    """A live server on its own loop and thread."""
+
+    robot: Robot
+    limits: ServerLimits
+    scene: RecordingScene = field(default_factory=RecordingScene)
+    quit: threading.Event = field(default_factory=threading.Event)
+    host: str = "127.0.0.1"
+    port: int = 0
+
+    def start(self) -> ServerThread:
+        self.loop = asyncio.new_event_loop()
+        self.world = World(self.robot, self.scene)
+        self.services = Services(self.world, limits=self.limits, exporters=(write_page,))
+        self.server = CommandServer(self.services, on_quit=self.quit.set)
+        self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
+        self.thread.start()
+        self.host, self.port = self.call_async(self.server.start("127.0.0.1", 0))
+        return self
+
+    def call(self, fn: Callable[..., Any], *args: Any) -> Any:
+        """Run ``fn(*args)`` on the server's loop and return its result."""
+        done: Future[Any] = Future()
+
+        def run() -> None:
+            try:
+                done.set_result(fn(*args))
+            except BaseException as exc:  # handed to the caller
+                done.set_exception(exc)
+
+        self.loop.call_soon_threadsafe(run)
+        return done.result(timeout=60)
+
+    def call_async(self, coro: Any) -> Any:
+        return asyncio.run_coroutine_threadsafe(coro, self.loop).result(timeout=60)
+
+    @property
+    def q(self) -> tuple[float, ...]:
+        """The shared joint values [rad], read on the server's loop."""
+        return self.call(lambda: self.world.q)
+
+    def stop(self) -> None:
+        if self.loop.is_running():
+            self.call_async(self.server.stop())
+            self.loop.call_soon_threadsafe(self.loop.stop)
+        self.thread.join(timeout=60)
+        self.loop.close()
+
+
+class Client:
+    """A controller's view of the server: a blocking TCP socket, one line at a time."""
+
+    def __init__(self, host: str, port: int, timeout: float = 60.0) -> None:
+        self.sock = socket.create_connection((host, port), timeout=timeout)
+        self.file = self.sock.makefile("rb")
+
+    def send(self, data: str | bytes) -> None:
+        self.sock.sendall(data.encode() if isinstance(data, str) else data)
+
+    def read_line(self) -> str:
+        """The next reply line, without its newline ('' when the server closed)."""
+        return self.file.readline().decode().rstrip("\n")
+
+    def ask(self, line: str) -> str:
+        """Send one command and return its reply."""
+        self.send(line + "\n")
+        return self.read_line()
+
+    def closed_by_server(self) -> bool:
+        """True when the server has closed the connection (reads EOF)."""
+        try:
+            return self.file.read() == b""  # reads to EOF: only returns once closed
+        except (ConnectionResetError, TimeoutError):
+            return False
+
+    def close(self) -> None:
+        self.file.close()
+        self.sock.close()
+
+
+@dataclass
+class Process:
+    """``python -m c2rviz`` running as a subprocess."""
+
+    popen: subprocess.Popen[str]
+    port: int
+    output: list[str]
+    viewer_url: str | None = None
+
+    def wait(self, timeout: float = 60.0) -> int:
+        return self.popen.wait(timeout=timeout)
