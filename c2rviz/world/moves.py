@@ -15,10 +15,8 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from ..errors import MotionInterrupted
-from ..motion.line_play import LinePlay
+from ..motion.path_play import PathPlay
 from ..motion.planner import Motion, MotionLimits
 from ..protocol import replies
 from .clock import Clock, Timer
@@ -39,7 +37,8 @@ class Travel:
             by the hundred thousand, only clear this; the next move re-syncs).
         arrivals: Replies waiting for the arm to reach the running move's target.
         rests: Replies waiting for the arm to come to rest (``wait``, ``stop``).
-        line: A straight-line path being played instead of ``motion``, if any.
+        path: A path being played instead of ``motion`` (a straight tool line, a planned
+            path, a timed trajectory), if any.
         stopping: The running move was stopped (``stop``): it ends at rest short of
             its target. Cleared by the next move.
     """
@@ -48,7 +47,7 @@ class Travel:
     motion: Motion
     active: bool = False
     synced: bool = True
-    line: LinePlay | None = None
+    path: PathPlay | None = None
     stopping: bool = False
     arrivals: list[asyncio.Future[str]] = field(default_factory=list)
     rests: list[asyncio.Future[str]] = field(default_factory=list)
@@ -92,7 +91,7 @@ class Travels:
         self._interrupt(travel, f"preempted by {source}")
         travel.active = False
         travel.synced = False
-        travel.line = None
+        travel.path = None
         _settle(travel.rests, replies.OK)
 
     def go(
@@ -107,9 +106,9 @@ class Travels:
         travel = self.by_robot[state.name]
         self._interrupt(travel, f"preempted by {source}")
         t = self.clock.now()
-        if travel.line is not None:  # leaving a line: from where it is, at rest (see README)
-            travel.motion.jump(travel.line.sample(t), t)
-            travel.line = None
+        if travel.path is not None:  # leaving a path: from where it is, at rest (see README)
+            travel.motion.jump(travel.path.sample(t), t)
+            travel.path = None
         elif not travel.synced:
             travel.motion.jump(state.q, t)
         travel.synced = True
@@ -127,26 +126,19 @@ class Travels:
             _settle(travel.arrivals, replies.OK)
         return arrival
 
-    def play_line(
-        self,
-        state: RobotState,
-        qs: np.ndarray,
-        times: Sequence[float],
-        ramp: tuple[float, float],
-        source: str,
-        wait: bool,
+    def play(
+        self, state: RobotState, path: PathPlay, source: str, wait: bool
     ) -> asyncio.Future[str] | None:
-        """Play the joint path ``qs`` (from where the arm is, at rest) along ``times`` [s],
-        eased in and out with the path-time acceleration and jerk ``ramp`` (``line_play``).
+        """Play ``path`` (which starts where the arm is, at rest, on the world's clock).
 
         Returns:
             As ``go``: with ``wait`` a reply on arrival, else None.
         """
         travel = self.by_robot[state.name]
         self._interrupt(travel, f"preempted by {source}")
-        travel.line = LinePlay(self.clock.now(), times, qs, *ramp)
+        travel.path = path
         travel.synced = False
-        state.target = tuple(qs[-1].tolist())
+        state.target = path.sample(path.arrival)
         travel.active = True
         self._run(travel)
         if not wait:
@@ -162,9 +154,9 @@ class Travels:
             return None
         self._interrupt(travel, f"motion stopped by {source}")
         travel.stopping = True
-        if travel.line is not None:  # a line brakes on the line
-            travel.line.brake(self.clock.now())
-            state.target = travel.line.sample(travel.line.arrival)
+        if travel.path is not None:  # a path brakes on the path
+            travel.path.brake(self.clock.now())
+            state.target = travel.path.sample(travel.path.arrival)
             return self.rest(state)
         travel.motion.stop(self.clock.now())
         state.target = travel.motion.target
@@ -184,7 +176,7 @@ class Travels:
         travel = self.by_robot[state.name]
         if not travel.active:
             return 0.0
-        end = travel.line.arrival if travel.line is not None else travel.motion.arrival()
+        end = travel.path.arrival if travel.path is not None else travel.motion.arrival()
         return max(end - self.clock.now(), 0.0)
 
     def now(self, state: RobotState) -> tuple[float, ...]:
@@ -192,8 +184,8 @@ class Travels:
         travel = self.by_robot[state.name]
         if not travel.active:
             return state.q
-        if travel.line is not None:
-            return travel.line.sample(self.clock.now())
+        if travel.path is not None:
+            return travel.path.sample(self.clock.now())
         return travel.motion.sample(self.clock.now())[0]
 
     def stop_all(self) -> None:
@@ -205,7 +197,7 @@ class Travels:
     # The frame timer.
 
     def _run(self, travel: Travel) -> None:
-        travel.active = travel.line is not None or travel.motion.moving(self.clock.now())
+        travel.active = travel.path is not None or travel.motion.moving(self.clock.now())
         if travel.active and self._timer is None:
             self._timer = self.clock.call_later(0.0, self._tick)
 
@@ -217,12 +209,12 @@ class Travels:
         for travel in self.by_robot.values():
             if not travel.active:
                 continue
-            line = travel.line
-            if line is not None:
-                q = line.sample(t)
-                end = line.arrival
-                if t >= end:  # at rest at the line's end: the planner stands there too
-                    travel.active, travel.line = False, None
+            path = travel.path
+            if path is not None:
+                q = path.sample(t)
+                end = path.arrival
+                if t >= end:  # at rest at the path's end: the planner stands there too
+                    travel.active, travel.path = False, None
                     travel.motion.jump(q, t)
                     travel.synced = True
             else:

@@ -15,7 +15,7 @@ import pinocchio as pin
 
 from ...errors import ArmMoved, UnknownMarker
 from ...ik.line import plan_line
-from ...motion.line_play import ramp_limits
+from ...motion.line_play import LinePlay, ramp_limits
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
 from ...protocol.verbs.cartesian import Ik, LinearSpeed, MoveL, MoveTo, PoseValues, Tool
@@ -76,9 +76,8 @@ async def movel(session: Session, command: MoveL) -> str:
     fraction, limits = session.speed / 100.0, session.travel.motion.limits
     times = line.timestamps(session.lspeed, [v * fraction for v in limits.velocity])
     ramp = ramp_limits(limits, fraction)
-    arrival = world.travels.play_line(
-        state, qs, times, ramp, session.source, session.motion == "on"
-    )
+    play = LinePlay(world.clock.now(), times, qs, *ramp)
+    arrival = world.travels.play(state, play, session.source, session.motion == "on")
     return replies.OK if arrival is None else await arrival
 
 
