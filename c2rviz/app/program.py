@@ -24,6 +24,7 @@ from ..world.effects import NullScene, Scene
 from ..world.state import RobotState
 from ..world.world import World
 from .config import Settings
+from .doors import close_doors, open_doors
 from .members import Member, furnish
 
 __all__ = ["serve", "write_page"]
@@ -132,6 +133,13 @@ async def serve(
         world.state(member.name).port = port
         servers.append(server)
     try:
+        doors = await open_doors(settings, services, members, stop.set)
+    except C2rvizError as exc:
+        print(f"c2rviz: {exc}", file=sys.stderr)
+        for server in servers:
+            await server.stop()
+        return 2
+    try:
         scene = _open_scene(settings, services, cell)
     except (OSError, C2rvizError) as exc:
         problem = exc.strerror or exc if isinstance(exc, OSError) else exc
@@ -140,6 +148,7 @@ async def serve(
             f"{problem}",
             file=sys.stderr,
         )
+        await close_doors(doors)
         for server in servers:
             await server.stop()
         return 2
@@ -153,6 +162,8 @@ async def serve(
         print(f"c2rviz: cell {cell}: {', '.join(m.name for m in members)}", flush=True)
     for member in members:
         _banner(member, settings.host, world.state(member.name).port, cell is not None)
+    for entry in doors:
+        print(f"c2rviz: {entry.banner}", flush=True)
     if scene.url:
         print(f"c2rviz: viewer at {scene.url}", flush=True)
     if not _is_loopback(settings.host):
@@ -176,6 +187,7 @@ async def serve(
     finally:
         for sig in _STOP_SIGNALS:
             loop.remove_signal_handler(sig)
+        await close_doors(doors)
         for server in servers:
             await server.stop()
         services.close()
