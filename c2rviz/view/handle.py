@@ -22,19 +22,19 @@ import contextlib
 import functools
 import logging
 import math
-import threading
 from collections.abc import Awaitable, Callable
 from typing import Any
 
-import numpy as np
 import pinocchio as pin
 import viser
 
 from ..errors import C2rvizError
 from ..protocol import replies
+from ..robot.frames import in_base, se3_pose, wxyz_se3
 from ..session.session import Session
-from ..world.world import RobotState
+from ..world.state import RobotState
 from . import adapter
+from .handoff import Handoff
 from .ratelog import RateLimitedLog
 from .robot_view import wxyz
 
@@ -59,9 +59,9 @@ def moveto_line(state: RobotState, in_world: pin.SE3, angle_scale: float = DEGRE
     Returns:
         ``moveto x,y,z,roll,pitch,yaw``: the pose in the robot's base frame [m].
     """
-    in_base = (state.origin * state.robot.base_placement).actInv(in_world)
-    rpy = pin.rpy.matrixToRpy(in_base.rotation) / angle_scale
-    return f"moveto {replies.numbers([*in_base.translation, *rpy])}"
+    x, y, z, roll, pitch, yaw = se3_pose(in_base(state.base, in_world))
+    angles = [roll / angle_scale, pitch / angle_scale, yaw / angle_scale]
+    return f"moveto {replies.numbers([x, y, z, *angles])}"
 
 
 class ToolHandles:
@@ -85,12 +85,11 @@ class ToolHandles:
         self._server = server
         self._request = request
         self._loop: asyncio.AbstractEventLoop | None = None
-        self._lock = threading.Lock()
-        self._pending: dict[str, Pose] = {}
+        self._handoff: Handoff[str, tuple[int, Pose]] = Handoff(self._run)
         self._running: set[str] = set()
         self._stale: set[str] = set()  # put back at the tool pose at the next send
         self._due: set[str] = set()  # drawn at the next send
-        self._held: dict[str, int] = {}  # the client holding each held handle
+        self._held: dict[str, int] = {}  # the client holding each held handle (under the lock)
         self._log = RateLimitedLog(log)
         self.refused = 0
         self.nodes: dict[str, Any] = {}
@@ -112,18 +111,21 @@ class ToolHandles:
     def start(self, loop: asyncio.AbstractEventLoop) -> None:
         """Run drags on ``loop`` from now on (earlier drags are dropped)."""
         self._loop = loop
+        self._handoff.start(loop)
 
     def stop(self) -> None:
         """Drop drags from now on."""
         self._loop = None
+        self._handoff.stop()
 
     def busy(self, name: str) -> bool:
         """Whether robot ``name``'s handle is held by a tab, or a drag of it waits or runs."""
-        client = self._held.get(name)
-        if client is not None and client not in self._server.get_clients():
-            self._held.pop(name, None)  # the tab closed mid-drag
-            client = None
-        return client is not None or name in self._pending or name in self._running
+        with self._handoff.lock:
+            client = self._held.get(name)
+            if client is not None and client not in self._server.get_clients():
+                self._held.pop(name, None)  # the tab closed mid-drag
+                client = None
+        return client is not None or self._handoff.waiting(name) or name in self._running
 
     def draw(self, state: RobotState) -> None:
         """Put the robot's handle at its tool point, unless a drag of it is under way."""
@@ -144,22 +146,15 @@ class ToolHandles:
     # viser's thread: record, and wake the loop once
 
     def _arrived(self, name: str, client: int, quaternion: Any, position: Any) -> None:
-        loop = self._loop
-        if loop is None:
-            return
-        with self._lock:
-            first = name not in self._pending
-            self._pending[name] = (quaternion, position)
-        if first:
-            with contextlib.suppress(RuntimeError):  # the loop is closed: we stop
-                loop.call_soon_threadsafe(self._run, name)
+        self._handoff.put(name, (client, (quaternion, position)))
 
     def _grabbed(self, name: str, client: int, held: bool) -> None:
-        if held:
-            self._held[name] = client
-            return
-        if self._held.get(name) == client:
-            self._held.pop(name, None)
+        with self._handoff.lock:
+            if held:
+                self._held[name] = client
+                return
+            if self._held.get(name) == client:
+                self._held.pop(name, None)
         loop = self._loop
         if loop is not None:
             with contextlib.suppress(RuntimeError):
@@ -171,16 +166,15 @@ class ToolHandles:
         self._due.add(name)
         self._request()
 
-    def _run(self, name: str) -> None:
-        if name in self._running:
-            return  # the drag in flight runs the newest when it is done
-        with self._lock:
-            pose = self._pending.pop(name, None)
-        session = self._sessions.get(name)
-        if pose is None or session is None or self._loop is None:
+    def _run(self, name: str, drag: tuple[int, Pose]) -> None:
+        if name in self._running:  # the drag in flight runs the newest when it is done
+            self._handoff.defer(name, drag)
             return
-        (w, x, y, z), position = pose
-        in_world = pin.SE3(pin.Quaternion(w, x, y, z).normalized().matrix(), np.array(position))
+        _, (wxyz_now, position) = drag
+        session = self._sessions.get(name)
+        if session is None or self._loop is None:
+            return
+        in_world = wxyz_se3(position, wxyz_now)
         line = moveto_line(session.state, in_world, session.angle_scale)
         try:
             reply = session.run(line)
@@ -212,9 +206,10 @@ class ToolHandles:
 
     def _done(self, name: str) -> None:
         """Run the newest drag that came meanwhile, or put the handle back (a send)."""
-        if name in self._pending:
+        newer = self._handoff.take(name)
+        if newer is not None:
             self._stale.discard(name)  # a newer drag: the page shows that one
-            self._run(name)
+            self._run(name, newer)
         else:
             self._due.add(name)
             self._request()

@@ -11,20 +11,17 @@ on a marker chooses it in its robot's folder; "Go to marker" then runs
 markers).
 
 viser's door (``adapter.accept_input``) hands each value to a callback on
-viser's thread and nowhere else. Here the callback only records the newest
-value of its control and, if none was waiting, asks the asyncio loop to run
-it: however fast a page sends, a control costs the loop at most one command
-per loop turn (the latest value wins; a click while one waits adds nothing).
-Marker clicks come the same way, one per robot per loop turn.
+viser's thread and nowhere else; the callback hands it to the loop through a
+``handoff.Handoff``: however fast a page sends, a control costs the loop at
+most one command per loop turn (the latest value wins; a click while one waits
+adds nothing). Marker clicks come the same way, one per robot per loop turn.
 """
 
 from __future__ import annotations
 
 import asyncio
-import contextlib
 import functools
 import logging
-import threading
 from collections.abc import Awaitable, Callable
 from typing import Any
 
@@ -33,6 +30,7 @@ import viser
 from ..errors import C2rvizError, MotionInterrupted
 from ..session.session import Session
 from . import adapter
+from .handoff import Handoff
 from .markers import MarkerLayer
 from .panel import RobotPanel
 from .ratelog import RateLimitedLog
@@ -57,20 +55,18 @@ class PageInput:
         self._server = server
         self._markers = markers
         self._panels: dict[str, RobotPanel] = {}
-        self._loop: asyncio.AbstractEventLoop | None = None
-        self._lock = threading.Lock()
-        self._pending: dict[Any, tuple[Apply, int, Any]] = {}
+        self._handoff: Handoff[Any, tuple[Apply, int, Any]] = Handoff(self._run)
         self._log = RateLimitedLog(log)
         self.refused = 0
         self.picks = 0
 
     def start(self, loop: asyncio.AbstractEventLoop) -> None:
         """Run page input on ``loop`` from now on (earlier input is dropped)."""
-        self._loop = loop
+        self._handoff.start(loop)
 
     def stop(self) -> None:
         """Drop page input from now on."""
-        self._loop = None
+        self._handoff.stop()
 
     # what is bound
 
@@ -96,7 +92,7 @@ class PageInput:
 
     def busy(self, handle: Any) -> bool:
         """Whether a page value for ``handle`` waits to be run (leave the control alone)."""
-        return id(handle) in self._pending
+        return self._handoff.waiting(id(handle))
 
     # viser's thread: record, and wake the loop once
 
@@ -119,23 +115,14 @@ class PageInput:
         return resend
 
     def _arrived(self, key: Any, apply: Apply, client: int, value: Any) -> None:
-        loop = self._loop
-        if loop is None:
-            return
-        with self._lock:
-            first = key not in self._pending
-            self._pending[key] = (apply, client, value)
-        if first:
-            with contextlib.suppress(RuntimeError):  # the loop is closed: we stop
-                loop.call_soon_threadsafe(self._run, key)
+        self._handoff.put(key, (apply, client, value))
 
     # the asyncio thread
 
-    def _run(self, key: Any) -> None:
-        with self._lock:
-            apply, client, value = self._pending.pop(key)
-        if self._loop is not None:
-            apply(client, value)
+    @staticmethod
+    def _run(key: Any, waiting: tuple[Apply, int, Any]) -> None:
+        apply, client, value = waiting
+        apply(client, value)
 
     def _move(self, panel: RobotPanel, session: Session, index: int, client: int, v: Any) -> None:
         ok = self._line(session, f"move {index} {float(v)!r}")

@@ -450,7 +450,7 @@ def test_a_page_flooding_a_slider_costs_one_command_per_loop_turn(
     for i in range(2000):
         tab.set(slider, float(i % 90))
     tab.set(slider, 45.0)
-    pending = h.scene.page_input._pending
+    pending = h.scene.page_input._handoff._pending
     tab.wait(lambda: pending.get(id(slider), (0, 0, 0))[2] == 45.0, "the door to read them all")
     assert len(pending) == 1
     h.until(lambda: h.world.q[0] == pytest.approx(np.radians(45.0)), "the last value")
