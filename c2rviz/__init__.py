@@ -35,7 +35,7 @@ from .version import __version__
 
 _HOME = {
     "C2rvizError": "errors",
-    "CommandServer": "transports.tcp_text",
+    "CommandServer": "transports.tcp_server",
     "Marker": "world.effects",
     "RecordingScene": "world.effects",
     "Robot": "robot.model",

@@ -21,7 +21,7 @@ from typing import Any
 from c2rviz.app.program import write_page
 from c2rviz.robot.model import Robot
 from c2rviz.session import ServerLimits, Services
-from c2rviz.transports.tcp_text import CommandServer
+from c2rviz.transports.tcp_server import CommandServer
 from c2rviz.world.effects import RecordingScene
 from c2rviz.world.world import World
 

@@ -7,10 +7,11 @@ from __future__ import annotations
 import asyncio
 import errno
 import ipaddress
+import logging
 import secrets
 import signal
 import sys
-from collections.abc import Sequence
+from collections.abc import Awaitable, Sequence
 from pathlib import Path
 
 from ..collision.geometry import read_srdf
@@ -18,7 +19,7 @@ from ..errors import C2rvizError, ConfigError
 from ..observers.recorder import Recorded
 from ..protocol.verbs.record import Record
 from ..session.services import Services
-from ..transports.tcp_text import CommandServer
+from ..transports.tcp_server import CommandServer
 from ..world.clock import Clock
 from ..world.effects import NullScene, Scene
 from ..world.state import RobotState
@@ -28,6 +29,8 @@ from .doors import close_doors, open_doors
 from .members import Member, furnish
 
 __all__ = ["serve", "write_page"]
+
+log = logging.getLogger("c2rviz")
 
 
 def _is_loopback(host: str) -> bool:
@@ -187,14 +190,24 @@ async def serve(
     finally:
         for sig in _STOP_SIGNALS:
             loop.remove_signal_handler(sig)
-        await close_doors(doors)
+        # Each step runs whatever the one before it met: the recording is finished even if
+        # a door's stop failed.
+        await _step("closing the doors", close_doors(doors))
         for server in servers:
-            await server.stop()
+            await _step("stopping a command server", server.stop())
         services.close()
-        await _stop_recording(services)
+        await _step("finishing the recording", _stop_recording(services))
         scene.stop()
     print("c2rviz: stopped", flush=True)
     return 0
+
+
+async def _step(what: str, step: Awaitable[None]) -> None:
+    """Await one step of the shutdown; a failure is logged, and the shutdown goes on."""
+    try:
+        await step
+    except Exception:
+        log.exception("while %s", what)
 
 
 def _banner(member: Member, host: str, port: int | None, in_cell: bool) -> None:

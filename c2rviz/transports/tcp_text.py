@@ -18,8 +18,9 @@ import asyncio
 import itertools
 import logging
 import time
-from collections.abc import Awaitable, Callable, Sequence
+from collections.abc import Awaitable, Sequence
 from itertools import chain
+from typing import Protocol
 
 from ..errors import C2rvizError, LineTooLong
 from ..observers.watch import STREAM_ALLOWANCE_BYTES
@@ -29,10 +30,27 @@ from ..protocol.grammar import ForeignProtocol, parse_line
 from ..protocol.registry import VERBS
 from ..session.services import Services
 from ..session.session import Session
+from ..session.settings import ServerLimits
 
-__all__ = ["CommandServer", "Connection"]
+__all__ = ["Connection", "Host", "TURN_S"]
 
 log = logging.getLogger("c2rviz.server")
+
+
+class Host(Protocol):
+    """What a connection needs of the server that accepted it (``tcp_server.CommandServer``)."""
+
+    services: Services
+    limits: ServerLimits
+    robot: str | None
+    viewer_url: str | None
+    stopping: bool
+    connections: set[Connection]
+    open: set[Connection]
+
+    def count_clients(self) -> None: ...
+
+    def request_quit(self) -> None: ...
 
 
 class Connection(asyncio.Protocol):
@@ -43,7 +61,7 @@ class Connection(asyncio.Protocol):
     when it comes, while other connections go on.
     """
 
-    def __init__(self, server: CommandServer) -> None:
+    def __init__(self, server: Host) -> None:
         self.server = server
         self.limits = server.limits
         self.session = Session(server.services, robot=server.robot)
@@ -112,7 +130,7 @@ class Connection(asyncio.Protocol):
         if self.closing:
             return False  # done lingering: asyncio closes the transport
         if not self.waiting:
-            self._close()
+            self._finish()
         return True  # keep the write side open until the replies are out
 
     # The watch stream (c2rviz.watch) writes only while the write buffer is low.
@@ -272,9 +290,21 @@ class Connection(asyncio.Protocol):
         if self.closing or self.waiting:
             return
         if self.eof:
-            self._close()
+            self._finish()
         elif self.transport is not None:
             self.transport.resume_reading()
+
+    def _finish(self) -> None:
+        """The client has sent all it will: a last line without its newline is a line too
+        (as ``nc -q1`` users expect); answer it, then close."""
+        if self.partial_timer is not None:
+            self.partial_timer.cancel()
+            self.partial_timer = None
+        last = self.framer.rest()
+        if last:
+            self._run(last)
+        if not (self.closing or self.waiting):
+            self._close()
 
     def _pause_reading(self) -> None:
         assert self.transport is not None
@@ -318,7 +348,11 @@ class Connection(asyncio.Protocol):
         if self.eof:
             transport.close()  # nothing more will come: nothing to linger for
             return
-        transport.write_eof()
+        try:
+            transport.write_eof()
+        except OSError:  # the client is already gone (ENOTCONN): nothing to deliver
+            transport.abort()
+            return
         transport.resume_reading()
         self.linger_timer = asyncio.get_running_loop().call_later(_LINGER_S, transport.abort)
 
@@ -359,75 +393,3 @@ _PLAIN_JOINTS = tuple(f"{name} " for name in (VERBS["joints"].name, *VERBS["join
 TURN_S = 0.002  # work per client per loop turn [s]: then the others go first
 _TURN_CHECK = 32  # lines between looks at the clock
 _LINGER_S = 2.0  # after the last reply, how long a closing client's input is read and dropped
-
-
-class CommandServer:
-    """Listens for TCP clients and runs each one's lines against one ``World``."""
-
-    def __init__(
-        self,
-        services: Services,
-        on_quit: Callable[[], None] | None = None,
-        robot: str | None = None,
-        viewer_url: str | None = None,
-    ) -> None:
-        """Set up the server; ``start`` makes it listen.
-
-        Args:
-            services: The world every client acts on, and what sessions share (its
-                ``limits`` say what one client may cost).
-            on_quit: Called once when a client sends ``quit``.
-            robot: The robot its clients drive until they say ``robot NAME`` (None:
-                the world's default).
-            viewer_url: The page's address, told to a browser that opens the
-                command port (None: no viewer). The attribute may be set later,
-                once the viewer is up.
-        """
-        self.services = services
-        self.world = services.world
-        self.viewer_url = viewer_url
-        self.limits = services.limits
-        self.on_quit = on_quit
-        self.robot = robot
-        self.connections: set[Connection] = set()  # the clients being served
-        self.open: set[Connection] = set()  # those and the refused ones, until their socket closes
-        self.stopping = False
-        self.quit_requested = False
-        self._server: asyncio.Server | None = None
-        self._door = f"tcp {id(self)}"
-
-    def count_clients(self) -> None:
-        """Tell the program how many clients this door serves now."""
-        self.services.count_clients(self._door, len(self.connections))
-
-    async def start(self, host: str = "127.0.0.1", port: int = 0) -> tuple[str, int]:
-        """Start listening; return the address actually bound (port 0 picks one)."""
-        loop = asyncio.get_running_loop()
-        self._server = await loop.create_server(lambda: Connection(self), host, port)
-        bound = self._server.sockets[0].getsockname()
-        return bound[0], bound[1]
-
-    def request_quit(self) -> None:
-        if not self.quit_requested:
-            self.quit_requested = True
-            log.info("quit requested by a client")
-            if self.on_quit is not None:
-                self.on_quit()
-
-    async def stop(self, grace_s: float = 1.0) -> None:
-        """Stop accepting, answer and close every client, free the port."""
-        self.stopping = True
-        if self._server is not None:
-            self._server.close()
-        for connection in list(self.connections):
-            connection.shutdown()
-        if self.open:  # each gets its last replies and then closes, or is cut off
-            await asyncio.wait([c.closed for c in self.open], timeout=grace_s)
-        left = list(self.open)
-        for connection in left:
-            if connection.transport is not None:
-                connection.transport.abort()
-        if left:  # let connection_lost run, so every socket is closed when we return
-            await asyncio.wait([c.closed for c in left], timeout=1.0)
-        if self._server is not None:
-            await self._server.wait_closed()

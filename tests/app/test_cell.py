@@ -23,7 +23,7 @@ from c2rviz.app.cell import load_cell
 from c2rviz.app.cli import main
 from c2rviz.errors import ConfigError
 from c2rviz.session import Services
-from c2rviz.transports.tcp_text import CommandServer
+from c2rviz.transports.tcp_server import CommandServer
 from c2rviz.world.effects import RecordingScene
 from c2rviz.world.world import World
 

@@ -215,3 +215,77 @@ def test_every_way_to_stop_answers_and_exits_with_a_tab_that_never_reads(c2rviz_
     assert port_is_free(proc.port) and port_is_free(viewer_port)
     rest = proc.popen.stdout.read()
     assert "c2rviz: stopped" in rest and "Traceback" not in rest
+
+
+@pytest.mark.parametrize("how", ["SIGTERM", "SIGINT", "quit"])
+def test_a_stop_after_a_waiting_client_left_exits_0_with_the_recording_whole(
+    c2rviz_process, tmp_path, how
+):
+    """Issue 23.1: client 1 records and moves; client 2 sleeps and closes its socket; a
+    signal or `quit` then stops the program: status 0, no traceback, the recording whole."""
+    import subprocess
+    import sys
+
+    from support import ROOT
+
+    proc = c2rviz_process("--no-viewer", "--record-dir", str(tmp_path))
+    recorder = socket.create_connection(("127.0.0.1", proc.port), timeout=60)
+    stream = recorder.makefile("rb")
+
+    def ask(line: str) -> str:
+        recorder.sendall(line.encode() + b"\n")
+        return stream.readline().decode().rstrip("\n")
+
+    assert ask("record take").startswith("ok recording take")
+    for q in ("0.1,0,0,0,0,0,0", "0.2,0.1,0,0,0,0,0", "0.3,0.2,0.1,0,0,0,0"):
+        assert ask(f"joints {q}") == "ok"
+    assert ask("mark") == "ok"
+    sleeper = socket.create_connection(("127.0.0.1", proc.port), timeout=60)
+    sleeper.sendall(b"sleep 100\n")
+    time.sleep(0.2)  # let the server read it (no reply comes for 100 s)
+    sleeper.close()
+    if how == "quit":
+        assert ask("quit") == "ok"
+    else:
+        proc.popen.send_signal(getattr(signal, how))
+    status = proc.wait(60)
+    log = "".join(proc.output) + proc.popen.stdout.read()
+    assert status == 0 and "Traceback" not in log and "internal error" not in log, log
+    stream.close()
+    recorder.close()
+    assert (tmp_path / "take.txt").is_file() and not list(tmp_path.glob(".take*")), log
+    checked = subprocess.run(
+        [sys.executable, "-m", "c2rviz.clients.player", "--check", str(tmp_path / "take.txt")],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert checked.returncode == 0, checked.stdout + checked.stderr
+    rows = (tmp_path / "take.csv").read_text().splitlines()
+    assert rows[-1].split(",")[1:4] == ["0.3", "0.2", "0.1"], rows[-3:]
+
+
+def test_bye_then_an_immediate_close_costs_no_traceback(start_server, connect, caplog):
+    """Issue 23.1: `bye` or `quit` followed at once by a closed socket is not an internal error."""
+    server = start_server()
+    for _ in range(20):
+        sock = socket.create_connection((server.host, server.port), timeout=60)
+        sock.sendall(b"bye\n")
+        sock.close()
+    client = connect(server)
+    assert client.ask("where") == HOME
+    assert "internal error" not in caplog.text and "Traceback" not in caplog.text
+    assert not [r for r in caplog.records if r.levelname == "ERROR"]
+
+
+def test_clients_over_the_limit_that_drop_at_once_cost_no_traceback(start_server, connect, caplog):
+    """Issue 23.1: refusing clients over the limit while they connect and drop logs one
+    warning each, never an exception."""
+    server = start_server(max_clients=1)
+    first = connect(server)
+    for _ in range(200):
+        sock = socket.create_connection((server.host, server.port), timeout=60)
+        sock.close()
+    assert first.ask("where") == HOME
+    assert not [r for r in caplog.records if r.exc_info or r.levelname == "ERROR"], caplog.text

@@ -30,7 +30,8 @@ from c2rviz.protocol import replies
 from c2rviz.protocol.framing import BATCH_BYTES
 from c2rviz.protocol.grammar import _MAX_INDEX_DIGITS
 from c2rviz.transports import tcp_text as server_module
-from c2rviz.transports.tcp_text import _LINGER_S, TURN_S, CommandServer
+from c2rviz.transports.tcp_server import CommandServer
+from c2rviz.transports.tcp_text import _LINGER_S, TURN_S
 from c2rviz.view.policy import DoorPolicy
 
 # A state away from home (so a stray home or joints shows) with long `where` replies.
@@ -260,18 +261,25 @@ def test_nothing_after_an_over_long_line_runs(live, connect, chunks):
 
 
 @pytest.mark.parametrize("how", ["close", "shutdown-write"])
-def test_a_partial_line_at_disconnect_is_discarded(live, connect, how):
-    server, _bystander, check = live()
+def test_a_last_line_without_its_newline_runs_at_eof(live, connect, how):
+    """The client's FIN ends its last line (issue 23.11, as ``nc -q1`` expects): it runs and
+    is answered, then the server closes; a client that closed outright runs it as well
+    (a FIN is a FIN), and the reply it cannot take costs the server nothing."""
+    server, bystander, _check = live()
     client = connect(server)
-    client.send("joints 0,0,0,0,0,0,0.5")  # would be valid with its newline
+    client.send("joints 0,0,0,0,0,0,0.5")  # no newline: the FIN ends it
     wait_for(lambda: max(server.call(lambda: buffered(server))))
     if how == "close":
         client.close()
     else:
         client.sock.shutdown(socket.SHUT_WR)
+        assert client.read_line() == "ok"
         assert client.closed_by_server()
     wait_for(lambda: client_count(server) == 1)
-    check()
+    assert bystander.ask("where") == "ok 0,0,0,0,0,0,0.5"
+    newcomer = connect(server)
+    assert newcomer.ask("where") == "ok 0,0,0,0,0,0,0.5"
+    newcomer.close()
 
 
 def test_a_reset_mid_line_ends_quietly(live, connect):

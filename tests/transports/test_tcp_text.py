@@ -315,3 +315,18 @@ def test_runs_of_joints_lines_answer_as_line_by_line(server, connect, name):
     assert noted >= len(RUNS[name])
     if name == "plain":  # one batch of 100 lines: far fewer states shown than lines
         assert server.call(lambda: len(server.scene.joints)) - frames_before < len(RUNS[name])
+
+
+@pytest.mark.parametrize("last", ["where", "joints 0.1,0,0,0,0,0,0\r", "sleep 0.2"])
+def test_a_last_line_without_a_newline_is_answered_at_eof(server, last):
+    """Issue 23.11: `printf 'where' | nc -q1 host 31000` gets its reply, then the close."""
+    sock = socket.create_connection((server.host, server.port), timeout=60)
+    with sock:
+        sock.sendall(b"degrees\n" + last.encode())
+        sock.shutdown(socket.SHUT_WR)
+        data = b""
+        while chunk := sock.recv(4096):
+            data += chunk
+    lines = data.decode().splitlines()
+    assert lines[0] == "ok" and len(lines) == 2, lines
+    assert lines[1] == ("ok 0,0,0,0,0,0,0" if last == "where" else "ok")

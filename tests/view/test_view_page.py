@@ -26,7 +26,7 @@ from websockets.exceptions import InvalidStatus
 from c2rviz.errors import MotionInterrupted
 from c2rviz.robot.model import Robot
 from c2rviz.session import Services, Session, SessionDefaults
-from c2rviz.transports.tcp_text import CommandServer
+from c2rviz.transports.tcp_server import CommandServer
 from c2rviz.view import adapter
 from c2rviz.view.panel import MAX_LABEL_CHARS, short_label
 from c2rviz.view.policy import DoorPolicy
