@@ -14,6 +14,8 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
+from .rpy import canonical_rpy
+
 __all__ = [
     "in_base",
     "in_world",
@@ -32,9 +34,9 @@ def pose_se3(pose: Sequence[float]) -> pin.SE3:
 
 
 def se3_pose(placement: pin.SE3) -> tuple[float, ...]:
-    """A placement as ``x, y, z, roll, pitch, yaw`` [m, rad]."""
-    rpy = pin.rpy.matrixToRpy(placement.rotation)
-    return (*map(float, placement.translation), *map(float, rpy))
+    """A placement as ``x, y, z, roll, pitch, yaw`` [m, rad], the angles in their canonical
+    form (``rpy.canonical_rpy``), so a pose sent reads back as sent."""
+    return (*map(float, placement.translation), *canonical_rpy(placement.rotation))
 
 
 def se3_wxyz(placement: pin.SE3) -> tuple[float, float, float, float]:

@@ -24,6 +24,7 @@ import numpy as np
 import pinocchio as pin
 import viser
 
+from ..robot.frames import se3_pose
 from ..tolerance import limit_text
 from ..world.effects import Marker
 from ..world.world import RobotState
@@ -168,9 +169,7 @@ class RobotPanel:
         """The end effector's placement in the base frame, in mm-rounded metres and degrees."""
         # round() then + 0.0: no "-0.0" in the readout
         x, y, z = (round(float(v), 3) + 0.0 for v in ee.translation)
-        roll, pitch, yaw = (
-            round(float(v), 1) + 0.0 for v in np.degrees(pin.rpy.matrixToRpy(ee.rotation))
-        )
+        roll, pitch, yaw = (round(float(v), 1) + 0.0 for v in np.degrees(se3_pose(ee)[3:]))
         self.pose.value = (
             f"x {x:+.3f}  y {y:+.3f}  z {z:+.3f} m\nR {roll:+.1f}  P {pitch:+.1f}  Y {yaw:+.1f} deg"
         )

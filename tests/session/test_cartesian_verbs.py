@@ -242,13 +242,44 @@ def test_moveto_marker_and_bad_cartesian_lines(server: ServerThread, connect):
         == "error: no marker 2: this robot has markers 1..1 (1 is the oldest)"
     )
     for line, error in [
-        ("ik 1,2,3", "ik: needs 6 values, got 3"),
+        ("ik 1,2,3,4", "ik: needs 3 values (x,y,z) or 6 (x,y,z,roll,pitch,yaw), got 4"),
+        ("ik 1,2,3", "point unreachable: the target is 3.422 m from the arm's first joint"),
         ("movel 1,2,3,0,0,nan", "bad number 'nan'"),
-        ("lspeed 0", "lspeed: 0 m/s is outside 0..5"),
-        ("lspeed 9", "9 m/s is outside 0..5"),
+        ("lspeed 0", "lspeed: 0 m/s is outside 0.001..5"),
+        ("lspeed 9", "9 m/s is outside 0.001..5"),
+        ("lspeed 1e-320", "lspeed: 9.99989e-321 m/s is outside 0.001..5"),
+        ("ik 1e300,0,0,0,0,0", "ik: x = 1e+300 m is outside -1000..1000 m"),
+        ("tool 1e300,0,0,0,0,0", "tool: x = 1e+300 m is outside -10..10 m"),
+        ("mark 1e308,0,0,0,0,0", "mark: x = 1e+308 m is outside -1000..1000 m"),
+        ("moveto 0,0,1,0,2e6,0", "moveto: pitch = 2e+06 is outside -1e+06..1e+06"),
         ("moveto marker x", "marker needs a number from 1"),
         ("tool 1,2", "tool: needs 6 values, got 2"),
     ]:
         reply = client.ask(line)
         assert reply.startswith("error: ") and error in reply, reply
     assert client.ask("lspeed") == "ok 0.25"
+
+
+def test_a_point_alone_is_a_target_with_any_orientation(server: ServerThread, connect):
+    """Issue 30.4: `x,y,z` alone wherever a target is taken; the tool point goes there."""
+    client = connect(server)
+    client.ask("degrees")
+    for line in ("moveto 0.5,0.3,0.9", "movel 0.5,0.1,0.9"):
+        assert client.ask(line) == "ok", line
+        x, y, z = (float(v) for v in client.ask("pose").removeprefix("ok ").split(",")[:3])
+        want = [float(v) for v in line.split()[1].split(",")]
+        assert max(abs(a - b) for a, b in zip((x, y, z), want)) <= 1e-4, (line, x, y, z)
+    q = client.ask("ik 0.4,-0.2,1.0")
+    assert q.startswith("ok ") and len(q.split(",")) == 7, q
+
+
+def test_a_pose_reads_back_as_sent_near_pitch_90(server: ServerThread, connect):
+    """Issue 30.5: the canonical form at pitch +-90 (roll 0, yaw carrying the rotation)."""
+    client = connect(server)
+    client.ask("degrees")
+    assert client.ask("moveto 0.6,0.2,1.0,0,90,0") == "ok"
+    x, y, z, roll, pitch, yaw = (
+        float(v) for v in client.ask("pose").removeprefix("ok ").split(",")
+    )
+    assert (round(x, 4), round(y, 4), round(z, 4)) == (0.6, 0.2, 1.0)
+    assert (roll, pitch, yaw) == (0.0, 90.0, 0.0)

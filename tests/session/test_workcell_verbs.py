@@ -126,7 +126,9 @@ def test_rand_under_guard_draws_only_free_configurations(server: ServerThread, c
 @pytest.mark.parametrize(
     ("line", "error"),
     [
-        ("object t box -1,1,1 0,0,0,0,0,0", "object: size -1 must be > 0"),
+        ("object t box -1,1,1 0,0,0,0,0,0", "object: size -1 m is outside 1e-06..100 m"),
+        ("object big box 1e308,1,1 0,0,0,0,0,0", "object: size 1e+308 m is outside 1e-06..100 m"),
+        ("object far sphere 0.1 0,2e3,0", "object: y = 2000 m is outside -1000..1000 m"),
         ("object t box 1,nan,1 0,0,0,0,0,0", "bad number 'nan'"),
         ("object t cone 1 0,0,0", "unknown shape 'cone'; choose box, sphere or cylinder"),
         ("object t mesh /etc/passwd 0,0,0,0,0,0", "unknown shape 'mesh'"),
@@ -139,6 +141,8 @@ def test_rand_under_guard_draws_only_free_configurations(server: ServerThread, c
     ],
     ids=[
         "negative",
+        "huge",
+        "far",
         "nan",
         "cone",
         "mesh-file",

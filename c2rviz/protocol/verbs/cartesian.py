@@ -1,7 +1,9 @@
 """Cartesian verbs: the tool point, inverse kinematics, and moves to a pose.
 
 Poses are ``x,y,z,roll,pitch,yaw`` in the robot's base frame: metres, and
-angles in the connection's unit, as ``pose`` and ``mark`` use them.
+angles in the connection's unit, as ``pose`` and ``mark`` use them. A target
+(``ik``, ``moveto``, ``movel``) may be ``x,y,z`` alone: the tool point goes
+there with any orientation (what an arm of fewer than six joints can reach).
 """
 
 from __future__ import annotations
@@ -9,17 +11,32 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ...errors import BadArguments
-from ..grammar import numbers_arg, one_word
+from ..grammar import numbers, numbers_arg, one_word
+from ..ranges import LSPEED_M_S, TOOL_M, check_pose
 from ..registry import usage, verb
 
-__all__ = ["Ik", "LinearSpeed", "MoveL", "MoveTo", "Tool"]
+__all__ = ["Ik", "LinearSpeed", "MoveL", "MoveTo", "PoseValues", "Tool"]
 
-PoseValues = tuple[float, float, float, float, float, float]
+PoseValues = tuple[float, ...]
+"""``x, y, z, roll, pitch, yaw`` (a target may be ``x, y, z`` alone: any orientation)."""
 
 
 def _pose(verb: str, words: list[str]) -> PoseValues:
-    x, y, z, roll, pitch, yaw = numbers_arg(verb, words, 6)
-    return (x, y, z, roll, pitch, yaw)
+    values = numbers_arg(verb, words, 6)
+    check_pose(verb, values)
+    return values
+
+
+def _target(verb: str, words: list[str]) -> PoseValues:
+    values = numbers(verb, one_word(verb, words))
+    if len(values) not in (3, 6):
+        raise BadArguments(
+            verb,
+            f"needs 3 values (x,y,z) or 6 (x,y,z,roll,pitch,yaw), got {len(values)}",
+            usage(verb),
+        )
+    check_pose(verb, values)
+    return values
 
 
 @verb(
@@ -36,14 +53,19 @@ class Tool:
 
     @staticmethod
     def parse(verb: str, words: list[str]) -> Tool:
-        return Tool(_pose(verb, words) if words else None)
+        if not words:
+            return Tool(None)
+        values = numbers_arg(verb, words, 6)
+        check_pose(verb, values, TOOL_M)
+        return Tool(values)
 
 
 @verb(
     "ik",
-    "x,y,z,roll,pitch,yaw",
+    "x,y,z[,roll,pitch,yaw]",
     "reply `ok v0,...,vn-1`: joint values within the limits that put the tool point at "
-    "that pose, nearest the arm's configuration; nothing moves",
+    "that pose (`x,y,z` alone: that point, any orientation), nearest the arm's "
+    "configuration; nothing moves",
 )
 @dataclass(frozen=True, slots=True)
 class Ik:
@@ -53,14 +75,14 @@ class Ik:
 
     @staticmethod
     def parse(verb: str, words: list[str]) -> Ik:
-        return Ik(_pose(verb, words))
+        return Ik(_target(verb, words))
 
 
 @verb(
     "moveto",
-    "x,y,z,roll,pitch,yaw | marker N",
-    "go to that tool pose (or to marker N, 1 the oldest) through joint space, like `joints` "
-    "with the IK solution",
+    "x,y,z[,roll,pitch,yaw] | marker N",
+    "go to that tool pose (`x,y,z` alone: that point, any orientation; or marker N, 1 the "
+    "oldest) through joint space, like `joints` with the IK solution",
 )
 @dataclass(frozen=True, slots=True)
 class MoveTo:
@@ -75,15 +97,15 @@ class MoveTo:
             if len(words) != 2 or not words[1].isdigit() or not 0 < int(words[1]) < 10**6:
                 raise BadArguments(verb, "marker needs a number from 1", usage(verb))
             return MoveTo(None, int(words[1]))
-        return MoveTo(_pose(verb, words))
+        return MoveTo(_target(verb, words))
 
 
 @verb(
     "movel",
-    "x,y,z,roll,pitch,yaw",
-    "the tool point travels a straight line to that pose (orientation by slerp) at this "
-    "connection's `lspeed`, slower where a joint cannot keep up; the whole line is "
-    "checked first; with `motion off` only its end is shown",
+    "x,y,z[,roll,pitch,yaw]",
+    "the tool point travels a straight line to that pose (orientation by slerp; `x,y,z` "
+    "alone: orientation free) at this connection's `lspeed`, slower where a joint cannot "
+    "keep up; the whole line is checked first; with `motion off` only its end is shown",
 )
 @dataclass(frozen=True, slots=True)
 class MoveL:
@@ -93,13 +115,13 @@ class MoveL:
 
     @staticmethod
     def parse(verb: str, words: list[str]) -> MoveL:
-        return MoveL(_pose(verb, words))
+        return MoveL(_target(verb, words))
 
 
 @verb(
     "lspeed",
     "[V]",
-    "this connection's `movel` tool speed, m/s (0 < V <= 5; default 0.25); alone, reply it",
+    "this connection's `movel` tool speed, m/s (0.001..5; default 0.25); alone, reply it",
 )
 @dataclass(frozen=True, slots=True)
 class LinearSpeed:
@@ -112,6 +134,7 @@ class LinearSpeed:
         if not words:
             return LinearSpeed(None)
         (value,) = numbers_arg(verb, [one_word(verb, words)], 1)
-        if not 0.0 < value <= 5.0:
-            raise BadArguments(verb, f"{value:g} m/s is outside 0..5 (0 excluded)", usage(verb))
+        low, high = LSPEED_M_S
+        if not low <= value <= high:
+            raise BadArguments(verb, f"{value:g} m/s is outside {low:g}..{high:g}", usage(verb))
         return LinearSpeed(value)

@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 from ...errors import BadArguments, shown
 from ..grammar import MARKER_SHAPES, numbers_arg, one_word
+from ..ranges import check_pose
 from ..registry import usage, verb
 
 __all__ = ["Clear", "Color", "Mark", "MarkerShape"]
@@ -44,6 +45,7 @@ class Mark:
         if not words:
             return Mark(None)
         x, y, z, roll, pitch, yaw = numbers_arg(verb, words, 6)
+        check_pose(verb, (x, y, z, roll, pitch, yaw))
         return Mark((x, y, z, roll, pitch, yaw), in_world)
 
 

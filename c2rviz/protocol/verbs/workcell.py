@@ -7,6 +7,7 @@ from dataclasses import dataclass
 
 from ...errors import BadArguments, shown
 from ..grammar import count, numbers, one_word
+from ..ranges import check_pose, check_sizes
 from ..registry import usage, verb
 
 __all__ = ["Collisions", "Guard", "ObjectEdit", "Objects"]
@@ -59,22 +60,22 @@ def _parse_object(verb: str, words: list[str]) -> ObjectEdit:
     if len(words) != 4:
         raise BadArguments(verb, f"{kind} takes a size and a pose", usage(verb))
     size = count(verb, numbers(verb, words[2]), sizes)
-    for value in size:
-        if value <= 0:
-            raise BadArguments(verb, f"size {value:g} must be > 0", usage(verb))
+    check_sizes(verb, size)
     pose = numbers(verb, words[3])
     if not oriented and len(pose) == 3:
         pose = (*pose, 0.0, 0.0, 0.0)
     x, y, z, roll, pitch, yaw = count(verb, pose, 6)
+    check_pose(verb, (x, y, z, roll, pitch, yaw))
     return ObjectEdit(name, kind, size, (x, y, z, roll, pitch, yaw))
 
 
 verb(
     "object",
     "NAME box sx,sy,sz x,y,z,roll,pitch,yaw | NAME sphere r x,y,z | "
-    "NAME cylinder r,length x,y,z,roll,pitch,yaw | NAME remove | all remove",
+    "NAME cylinder r,length x,y,z,roll,pitch,yaw | NAME remove",
     "add or replace a workcell object in the base frame (metres; angles in the "
-    "connection's unit; a cylinder along its z axis), or remove one or all",
+    "connection's unit; a cylinder along its z axis), or remove it; `object all remove` "
+    "removes every one",
     parse=_parse_object,
 )(ObjectEdit)
 

@@ -11,10 +11,10 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
-import pinocchio as pin
 
 from ...errors import ArmMoved, UnknownMarker
 from ...ik.line import plan_line
+from ...ik.target import PointTarget, Target
 from ...motion.line_play import LinePlay, ramp_limits
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
@@ -37,7 +37,8 @@ def tool(session: Session, command: Tool) -> str:
 
 @handler(Ik)
 async def ik(session: Session, command: Ik) -> str:
-    return replies.ok(replies.numbers(session.from_si(await _solve(session, command.pose))))
+    target = _target(session, command.pose)
+    return replies.ok(replies.numbers(session.from_si(await _solve(session, target))))
 
 
 @handler(MoveTo)
@@ -48,10 +49,11 @@ async def moveto(session: Session, command: MoveTo) -> str:
         if not 0 < index <= len(markers):
             raise UnknownMarker(index, len(markers))
         marker = markers[index - 1]
-        target = in_base(session.state.base, wxyz_se3(marker.position, marker.wxyz))
-        q = await _solve_se3(session, target)
+        q = await _solve(
+            session, in_base(session.state.base, wxyz_se3(marker.position, marker.wxyz))
+        )
     else:
-        q = await _solve(session, command.pose)
+        q = await _solve(session, _target(session, command.pose))
     return await _reply(session.go(q))
 
 
@@ -61,7 +63,7 @@ async def movel(session: Session, command: MoveL) -> str:
     if session.travel.active:
         raise ArmMoved("movel starts from rest: send wait (or stop) first")
     start = state.q
-    goal, tool_offset = session.pose_se3(command.pose), state.tool
+    goal, tool_offset = _target(session, command.pose), state.tool
     worker = session.services.worker
     solver = worker.ik_solver(state)
     line = await worker.run(lambda: plan_line(solver, start, goal, tool_offset))
@@ -89,11 +91,12 @@ def lspeed(session: Session, command: LinearSpeed) -> str:
     return replies.OK
 
 
-async def _solve(session: Session, pose: PoseValues) -> Sequence[float]:
-    return await _solve_se3(session, session.pose_se3(pose))
+def _target(session: Session, pose: PoseValues) -> Target:
+    """A pose as the connection wrote it; ``x,y,z`` alone is a point (any orientation)."""
+    return PointTarget.at(pose) if len(pose) == 3 else session.pose_se3(pose)
 
 
-async def _solve_se3(session: Session, target: pin.SE3) -> Sequence[float]:
+async def _solve(session: Session, target: Target) -> Sequence[float]:
     state, worker = session.state, session.services.worker
     seed, tool_offset = session.now(), state.tool
     solver = worker.ik_solver(state)
