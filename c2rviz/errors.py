@@ -56,9 +56,14 @@ class LineTooLong(LineError):
 class UnknownCommand(C2rvizError):
     """A verb that is not in the command language."""
 
-    def __init__(self, verb: str) -> None:
+    def __init__(self, verb: str, close: tuple[str, ...] = ()) -> None:
         self.verb = verb
-        super().__init__(f"unknown command {shown(verb)} (try 'help')")
+        self.close = close
+        if close:
+            hint = "did you mean " + " or ".join(f"'{word}'" for word in close) + "?"
+        else:
+            hint = "try 'help'"
+        super().__init__(f"unknown command {shown(verb)} ({hint})")
 
 
 class BadArguments(C2rvizError):

@@ -20,6 +20,7 @@ Grammar (see the README for the full table):
 
 from __future__ import annotations
 
+import difflib
 import math
 import re
 from collections.abc import Sequence
@@ -141,6 +142,8 @@ def one_word(verb: str, words: list[str]) -> str:
     """The single argument of ``verb``, else ``BadArguments``."""
     if len(words) != 1:
         problem = "needs an argument" if not words else f"takes 1 argument, got {len(words)}"
+        if len(words) > 1 and all(_NUMBER_RE.fullmatch(word) for word in words):
+            problem += " (separate values with commas: 1,2,3)"
         raise BadArguments(verb, problem, usage(verb))
     return words[0]
 
@@ -193,7 +196,9 @@ def parse_line(line: str) -> object | None:
     if entry is None:
         if _HTTP_RE.fullmatch(line.strip()):
             raise ForeignProtocol()
-        raise UnknownCommand(words[0])
+        typed = words[0].lower()
+        close = tuple(difflib.get_close_matches(typed, LOOKUP, n=2, cutoff=0.75))
+        raise UnknownCommand(words[0], close if len(typed) <= 40 else ())
     args = words[1:]
     if len(args) > 1 and "," in line:
         args = _AROUND_COMMA_RE.sub(",", " ".join(args)).split()

@@ -215,6 +215,8 @@ BAD = [
     ("record a b c", BadArguments, "takes at most 2 arguments, got 3", "record-three"),
     ("degree 1", BadArguments, "(usage: degrees)", "alias-usage"),
     ("jump 1", UnknownCommand, "unknown command 'jump' (try 'help')", "unknown-verb"),
+    ("jonts 1,2", UnknownCommand, "unknown command 'jonts' (did you mean 'joints'?)", "typo"),
+    ("joints 0 0 0", BadArguments, "got 3 (separate values with commas: 1,2,3)", "spaces"),
     ("x" * 100, UnknownCommand, "'" + "x" * 40 + "...'", "unknown-long-verb-cut"),
     ("GET / HTTP/1.1", ForeignProtocol, "not HTTP", "http-get"),
     ("POST /api HTTP/1.0\r\n", ForeignProtocol, "not HTTP", "http-post"),
