@@ -31,6 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import ConfigError
+from ..ini import read_ini
 from ..robot.catalogue import CatalogueEntry, find_robot
 from .config import ROBOT_KEYS, number, read_robots
 
@@ -47,7 +48,8 @@ class CellMember:
         name: Its name in the cell (the member section's name).
         entry: Which robot it is (URDF, chain ends).
         origin: x, y, z [m], roll, pitch, yaw [rad] of its base in the cell frame.
-        port: Its command port (0 picks a free one).
+        port: Its command port as the ini fixes it (0 picks a free one; None: the base port
+            plus its index).
         extras: Its robot section's ``tool`` and motion limits, as written (``furnish``).
         ini: The file the cell was read from.
     """
@@ -55,7 +57,7 @@ class CellMember:
     name: str
     entry: CatalogueEntry
     origin: tuple[float, float, float, float, float, float]
-    port: int
+    port: int | None
     extras: tuple[tuple[str, str], ...] = ()
     ini: Path | None = None
 
@@ -84,11 +86,7 @@ def load_cell(spec: str, ini: Path | None) -> Cell:
         raise ConfigError(f"no cmdinterpreter.ini to find cell {spec!r} in (give --config)")
     else:
         wanted = spec
-    parser = configparser.ConfigParser(interpolation=None, inline_comment_prefixes=("#", ";"))
-    try:
-        parser.read(ini, encoding="utf-8")
-    except configparser.Error as exc:
-        raise ConfigError(f"cannot read {ini}: {exc}".replace("\n", " ")) from None
+    parser = read_ini(ini)
     cells = [s.removeprefix("cell:") for s in parser.sections() if s.startswith("cell:")]
     if wanted is None:
         if len(cells) != 1:
@@ -106,7 +104,7 @@ def load_cell(spec: str, ini: Path | None) -> Cell:
         seen: dict[object, str] = {}
         for member in members:
             value = getattr(member, attribute)
-            if attribute == "port" and value == 0:
+            if attribute == "port" and value in (0, None):
                 continue
             if value in seen:
                 raise ConfigError(
@@ -140,7 +138,8 @@ def _member(
                 f"[{name}] of {ini} needs robot = NAME (any name --robot takes) or urdf = PATH"
             )
         entry = find_robot(items["robot"], robots, ini)
-    port = number(f"[{name}] port", items.get("port", "0"), int, 0, 65535)
+    given = items.get("port")
+    port = None if given is None else number(f"[{name}] port", given, int, 0, 65535)
     extras = robots[entry.name].extras if entry.name in robots else ()
     origin = _origin(items.get("origin", "0,0,0,0,0,0"), name)
     return CellMember(name, entry, origin, port, extras, ini)

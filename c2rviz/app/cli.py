@@ -65,7 +65,12 @@ def build_parser() -> argparse.ArgumentParser:
     add("--base", metavar="LINK", help="first link of the chain")
     add("--eelink", metavar="LINK", help="end-effector link: last link of the chain")
     add("--host", help="address for the command server (default 127.0.0.1)")
-    add("--port", type=int, help="command port (default 31000; 0 picks a free one)")
+    add(
+        "--port",
+        type=int,
+        help="command port (default 31000; 0 picks a free one); with --cell the first "
+        "robot's, the others at the next ports",
+    )
     add(
         "--viser-host",
         dest="viewer_host",
@@ -181,6 +186,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         (k, getattr(args, k)) for k in MOTION_FLAGS if getattr(args, k) is not None
     )
     overrides["robot_flag"] = args.robot is not None
+    overrides["port_flag"] = args.port is not None
     overrides["urdf_flag"] = args.urdf is not None
     try:
         if args.list_robots:

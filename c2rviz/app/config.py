@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from ..ini import INI_NAME, find_ini, number, read_ini
+from ..ini import INI_NAME, PROJECT_DIR, find_ini, number, read_ini
 from ..robot.catalogue import catalogue, find_robot
 from ..robot.sources import split_package_path
 from ..session.settings import ServerLimits, SessionDefaults
@@ -33,7 +33,9 @@ __all__ = [
     "Settings",
     "find_ini",
     "load_settings",
+    "bundled_robots",
     "read_robots",
+    "replaced_bundled",
 ]
 
 
@@ -119,6 +121,8 @@ class Settings:
     """``--max-velocity`` and the like as given, (key, text), over every robot's ini ones."""
     robot_flag: bool = False
     """``--robot`` was given."""
+    port_flag: bool = False
+    """``--port`` was given (a cell's members then take it as their base port)."""
     urdf_flag: bool = False
     """``--urdf`` was given (the robot is then named by its model unless ``--robot`` is)."""
 
@@ -219,9 +223,48 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
     return values, robots
 
 
+BUNDLED_INI = PROJECT_DIR / INI_NAME
+"""The project's own ini: its robot sections are the bundled robots."""
+
+
+def bundled_robots() -> dict[str, RobotEntry]:
+    """The bundled robots (the robot sections of the project's own ini)."""
+    return _read_ini(BUNDLED_INI)[1] if BUNDLED_INI.is_file() else {}
+
+
 def read_robots(ini: Path | None) -> dict[str, RobotEntry]:
-    """The robot sections of ``ini`` (none without an ini)."""
-    return _read_ini(ini)[1] if ini is not None else {}
+    """The robots an ini can name: the bundled ones, then ``ini``'s own sections, which win
+    on a name clash (``replaced_bundled`` says which did)."""
+    robots = bundled_robots()
+    if ini is not None and not _is_bundled_ini(ini):
+        robots.update(_read_ini(ini)[1])
+    return robots
+
+
+def replaced_bundled(robots: Mapping[str, RobotEntry]) -> list[str]:
+    """The bundled robots whose name a user's ini section took with another robot (another
+    URDF or other chain ends; a copy of the bundled section, or one that adds a tool, is
+    the same robot)."""
+    bundled = bundled_robots()
+
+    def same(a: RobotEntry, b: RobotEntry) -> bool:
+        return (a.urdf, a.base, a.eelink) == (b.urdf, b.base, b.eelink)
+
+    return [
+        name
+        for name, entry in robots.items()
+        if name in bundled
+        and entry.ini is not None
+        and not _is_bundled_ini(entry.ini)
+        and not same(entry, bundled[name])
+    ]
+
+
+def _is_bundled_ini(ini: Path) -> bool:
+    try:
+        return ini.resolve() == BUNDLED_INI.resolve()
+    except OSError:
+        return False
 
 
 def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
@@ -231,9 +274,9 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
         ConfigError: a bad ini value, or a robot name with no section.
     """
     values: dict[str, Any] = {}
-    robots: dict[str, RobotEntry] = {}
     if ini is not None:
-        values, robots = _read_ini(ini)
+        values, _ = _read_ini(ini)
+    robots = read_robots(ini)
     given = {k: v for k, v in overrides.items() if v is not None}
     for key, (name, _kind, low, high) in _OPTIONS.items():
         if name in given and not low <= given[name] <= high:

@@ -49,7 +49,7 @@ def members(settings: Settings) -> tuple[list[Member], str | None]:
     if settings.cell is not None:
         cell = load_cell(settings.cell, settings.ini)
         found: list[Member] = []
-        for part in cell.members:
+        for index, part in enumerate(cell.members):
             found_robot = part.entry
             robot = Robot.from_urdf(
                 found_robot.urdf,
@@ -64,7 +64,7 @@ def members(settings: Settings) -> tuple[list[Member], str | None]:
                     part.name,
                     robot,
                     pose_se3(part.origin),
-                    part.port,
+                    _cell_port(settings, part.port, index),
                     found_robot.name,
                     given,
                     part.ini,
@@ -90,6 +90,14 @@ def members(settings: Settings) -> tuple[list[Member], str | None]:
         name, robot, pin.SE3.Identity(), settings.port, name, given, settings.ini, True
     )
     return [member], None
+
+
+def _cell_port(settings: Settings, fixed: int | None, index: int) -> int:
+    """A cell member's command port: the base port plus its index, unless the ini fixes it
+    and no ``--port`` was given (a flag wins over the ini); port 0 picks free ones."""
+    if fixed is not None and not settings.port_flag:
+        return fixed
+    return settings.port + index if settings.port else 0
 
 
 def furnish(world: World, member: Member) -> None:

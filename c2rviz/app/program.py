@@ -24,7 +24,7 @@ from ..world.clock import Clock
 from ..world.effects import NullScene, Scene
 from ..world.state import RobotState
 from ..world.world import World
-from .config import Settings
+from .config import Settings, replaced_bundled
 from .doors import close_doors, open_doors
 from .members import Member, furnish
 
@@ -73,12 +73,18 @@ def _open_scene(settings: Settings, services: Services, title: str | None) -> Sc
     )
 
 
-def _cannot_listen(host: str, port: int, exc: OSError) -> str:
+def _cannot_listen(host: str, port: int, exc: OSError, cell: str | None) -> str:
     """Why the command server cannot start, in one sentence."""
     if exc.errno == errno.EADDRINUSE:
+        how = (
+            f"choose the cell's first port with --port (the others follow; 0 picks free ones) "
+            f"or fix each member's port in [cell:{cell}]'s members"
+            if cell is not None
+            else "choose another with --port (0 picks a free one)"
+        )
         return (
             f"cannot listen for commands on {host}:{port}: the port is in use "
-            "(another c2rviz?); choose another with --port (0 picks a free one)"
+            f"(another c2rviz?); {how}"
         )
     return f"cannot listen for commands on {host}:{port}: {exc.strerror or exc}"
 
@@ -129,7 +135,9 @@ async def serve(
         try:
             host, port = await server.start(settings.host, member.port)
         except OSError as exc:
-            print(f"c2rviz: {_cannot_listen(settings.host, member.port, exc)}", file=sys.stderr)
+            print(
+                f"c2rviz: {_cannot_listen(settings.host, member.port, exc, cell)}", file=sys.stderr
+            )
             for started in servers:
                 await started.stop()
             return 2
@@ -161,6 +169,12 @@ async def serve(
     scene.start(loop)
     for sig in _STOP_SIGNALS:
         loop.add_signal_handler(sig, stop.set)
+    for name in replaced_bundled(settings.robots):
+        print(
+            f"c2rviz: note: [{name}] of {settings.robots[name].ini} replaces the bundled robot "
+            "of that name",
+            flush=True,
+        )
     if cell is not None:
         print(f"c2rviz: cell {cell}: {', '.join(m.name for m in members)}", flush=True)
     for member in members:

@@ -70,6 +70,8 @@ class _IniRobot(Protocol):
     def package_paths(self) -> tuple[str | Path, ...]: ...
     @property
     def xacro_args(self) -> tuple[str, ...]: ...
+    @property
+    def ini(self) -> Path | None: ...
 
 
 @dataclass(frozen=True)
@@ -147,7 +149,9 @@ def catalogue(
     where = f"{ini}" if ini is not None else "cmdinterpreter.ini"
     ini_robots = ini_robots or {}
     entries = {
-        name: CatalogueEntry(name, r.urdf, r.base, r.eelink, r.package_paths, where, r.xacro_args)
+        name: CatalogueEntry(
+            name, r.urdf, r.base, r.eelink, r.package_paths, str(r.ini or where), r.xacro_args
+        )
         for name, r in ini_robots.items()
     }
     for name, entry in example_robots().items():

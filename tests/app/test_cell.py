@@ -460,3 +460,95 @@ def test_a_guarded_move_into_the_other_robot_is_refused() -> None:
         b.close()
     finally:
         cell.stop()
+
+
+BUNDLED_ONLY_CELL = """
+[cell:pair]
+robots = a b
+
+[a]
+robot = motoman_sia20d
+
+[b]
+robot = kuka_lwr
+origin = 1.5,0,0,0,0,180
+"""
+
+
+def serve_until_ports(args: list[str], cwd: Path, count: int) -> tuple[subprocess.Popen, dict]:
+    """Start ``python -m c2rviz ARGS`` in ``cwd``; return it once ``count`` ports are up."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "c2rviz", *args, "--no-viewer"],
+        cwd=cwd,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    assert proc.stdout is not None
+    ports: dict[str, int] = {}
+    lines = []
+    while len(ports) < count:
+        line = proc.stdout.readline()
+        if not line:
+            proc.wait(timeout=60)
+            proc.stdout.close()
+            raise AssertionError("c2rviz stopped:\n" + "".join(lines))
+        lines.append(line)
+        if m := re.search(r"c2rviz: (?:(\w+): )?commands on [\d.]+:(\d+)", line):
+            ports[m.group(1) or "robot"] = int(m.group(2))
+    return proc, ports
+
+
+def stop(proc: subprocess.Popen, port: int) -> None:
+    client = Client("127.0.0.1", port)
+    assert client.ask("quit") == "ok"
+    client.close()
+    assert proc.wait(timeout=60) == 0
+    assert proc.stdout is not None
+    proc.stdout.close()
+
+
+def free_port_pair() -> int:
+    """A port P such that P and P + 1 are free now."""
+    for _ in range(100):
+        with socket.socket() as probe:
+            probe.bind(("127.0.0.1", 0))
+            port = probe.getsockname()[1]
+        if port < 65535:
+            with socket.socket() as a, socket.socket() as b:
+                try:
+                    a.bind(("127.0.0.1", port))
+                    b.bind(("127.0.0.1", port + 1))
+                except OSError:
+                    continue
+            return port
+    raise AssertionError("no two free ports in a row")
+
+
+def test_a_cell_file_and_a_users_ini_name_the_bundled_robots(tmp_path: Path):
+    """Issue 30.1: a cell file of its own, and an ini with only the user's robot, can
+    name motoman_sia20d and kuka_lwr (the bundled robots), from any folder."""
+    cell = tmp_path / "pair.ini"
+    cell.write_text(BUNDLED_ONLY_CELL)
+    proc, ports = serve_until_ports(["--cell", str(cell), "--port", "0"], tmp_path, 2)
+    stop(proc, ports["a"])
+    own = tmp_path / "cmdinterpreter.ini"
+    own.write_text(
+        f"[myarm]\nurdf = {ROOT / 'robots/fanuc_lrmate200id/robot.urdf'}\n"
+        "base = base_link\neelink = link_6\n"
+    )
+    proc, ports = serve_until_ports(["--robot", "motoman_sia20d", "--port", "0"], tmp_path, 1)
+    client = Client("127.0.0.1", ports["robot"])
+    assert client.ask("names").startswith("ok motoman_sia20d joint_s,")
+    client.close()
+    stop(proc, ports["robot"])
+
+
+def test_port_gives_a_cell_its_first_port(tmp_path: Path):
+    """Issue 30.2: `--cell twoarms --port P` serves its members at P and P + 1 (the flag wins
+    over the ports the ini fixes)."""
+    base = free_port_pair()
+    proc, ports = serve_until_ports(["--cell", "twoarms", "--port", str(base)], ROOT, 2)
+    assert ports == {"left": base, "right": base + 1}
+    stop(proc, base)
