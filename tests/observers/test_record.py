@@ -459,3 +459,39 @@ def test_the_recorded_page_plays_in_a_browser_without_a_server(
     wait_until(lambda: (changed(first, shot(page)) > 500, None), "the recording playing")
     # The four markers dropped during the run are there by its end.
     wait_until(lambda: ((n := page.evaluate(RECORDED_MARKERS)) == 4, n), "the recorded markers")
+
+
+def test_recordings_land_in_the_working_directory_by_default(tmp_path: Path):
+    """Issue 30.3: started from an empty folder (the project's ini is read), `record demo`
+    writes ./recordings/demo.txt there, not into the project's folder."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "c2rviz", "--no-viewer", "--port", "0"],
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    assert proc.stdout is not None
+    try:
+        port = None
+        while port is None:
+            line = proc.stdout.readline()
+            assert line, "c2rviz stopped"
+            if m := re.search(r"commands on [\d.]+:(\d+)", line):
+                port = int(m.group(1))
+        client = Client("127.0.0.1", port)
+        where = (tmp_path / "recordings").resolve()
+        assert client.ask("record demo") == f"ok recording demo into {where}"
+        assert client.ask("record stop").startswith("ok recorded demo")
+        client.close()
+        assert (tmp_path / "recordings" / "demo.txt").is_file()
+    finally:
+        proc.send_signal(signal.SIGTERM)
+        proc.wait(timeout=60)
+        proc.stdout.close()
