@@ -19,6 +19,7 @@ from ..errors import C2rvizError
 from ..robot.model import Robot
 
 __all__ = [
+    "LIMIT_RANGE",
     "ACCELERATION_PER_VELOCITY",
     "DEFAULT_PRISMATIC_VELOCITY",
     "DEFAULT_REVOLUTE_VELOCITY",
@@ -46,15 +47,25 @@ class MotionLimitError(C2rvizError):
         super().__init__(f"{key}: {problem}")
 
 
+LIMIT_RANGE = (1e-6, 1e9)
+"""Every velocity, acceleration and jerk limit lies in this range (per s, s^2, s^3): a
+limit of 1e-300 passes "> 0" and then plans a move of 1e300 s, which ruckig refuses."""
+
+
 def _positive(key: str, values: Sequence[float], n: int) -> tuple[float, ...]:
-    """``values`` as floats, or MotionLimitError unless ``n`` finite numbers > 0."""
+    """``values`` as floats, or MotionLimitError unless ``n`` finite numbers in LIMIT_RANGE."""
     if len(values) != n:
         raise MotionLimitError(key, f"{len(values)} values for {n} joints; give 1 or {n}")
+    low, high = LIMIT_RANGE
     for i, value in enumerate(values):
         if isinstance(value, bool) or not (
             isinstance(value, numbers.Real) and math.isfinite(value) and value > 0
         ):
             raise MotionLimitError(key, f"joint {i} is {value!r}; it must be a finite number > 0")
+        if not low <= value <= high:
+            raise MotionLimitError(
+                key, f"joint {i} is {value!r}; it must be within {low:g}..{high:g}"
+            )
     return tuple(float(value) for value in values)
 
 
@@ -143,6 +154,12 @@ def motion_limits(
         limit = float(model.velocityLimit[model.joints[model.getJointId(joint.name)].idx_v])
         if not 0 < limit < _UNBOUNDED:
             limit = DEFAULT_PRISMATIC_VELOCITY if joint.prismatic else DEFAULT_REVOLUTE_VELOCITY
+        elif limit < LIMIT_RANGE[0] and max_velocity is None:
+            raise MotionLimitError(
+                "velocity",
+                f"{joint.name}'s URDF velocity limit {limit:g} is below {LIMIT_RANGE[0]:g}: "
+                "give it a real limit in the URDF, or one with --max-velocity",
+            )
         urdf.append(limit)
     velocity = _override("max_velocity", max_velocity, urdf, n)
     acceleration = _override(

@@ -36,13 +36,30 @@ from .xacro import expand_xacro, parse_xacro_args
 __all__ = [
     "MissingMesh",
     "RobotSource",
+    "MAX_JOINTS",
+    "MAX_LINKS",
+    "MAX_MESH_BYTES",
+    "MAX_URDF_BYTES",
+    "check_size",
     "check_urdf_root",
     "load_source",
     "parse_xacro_args",
     "split_package_path",
 ]
 
+MAX_URDF_BYTES = 16 << 20
+"""Longest robot description (the URDF, or a xacro file's expansion) [bytes]."""
+MAX_JOINTS = 128
+"""Most joints in a robot description (a two-armed robot with hands has about 60; a
+128-joint chain takes about 400 MB with its page and collision model, 500 took 7 GB)."""
+MAX_LINKS = MAX_JOINTS + 1
+"""Most links in a robot description (a tree has one link more than joints)."""
+MAX_MESH_BYTES = 256 << 20
+"""Most bytes of mesh files a robot's description may name, all together."""
+
 _NAME = re.compile(r"<name>\s*([^<\s]+)\s*</name>")
+_LINK_TAG = re.compile(r"<link[\s/>]")
+_JOINT_TAG = re.compile(r"<joint[\s/>]")
 _MESH = re.compile(r"""<mesh\b[^>]*\bfilename\s*=\s*["']([^"']+)["']""")
 _PACKAGE_NAME = re.compile(r"[A-Za-z0-9_.-]+")
 _SCAN_DEPTH = 4  # how far below a package-path entry package.xml files are looked for
@@ -244,6 +261,71 @@ def check_urdf_root(xml: str, where: Path) -> None:
         raise RobotError(f"{where} is not a URDF: its root element is <{tag}>, not <robot>{what}")
 
 
+def check_size(source: RobotSource, where: Path) -> None:
+    """Raise RobotError, in one sentence, for a description past the documented limits
+    (``MAX_URDF_BYTES``, ``MAX_LINKS``, ``MAX_JOINTS``, ``MAX_MESH_BYTES``): checked before
+    any model is built, since a model of thousands of links takes gigabytes."""
+    xml = source.xml
+    if len(xml) > MAX_URDF_BYTES:
+        raise RobotError(
+            f"{where} is {len(xml) / 2**20:.1f} MiB of robot description, over the limit "
+            f"of {MAX_URDF_BYTES >> 20} MiB"
+        )
+    for what, pattern, most in (
+        ("links", _LINK_TAG, MAX_LINKS),
+        ("joints", _JOINT_TAG, MAX_JOINTS),
+    ):
+        count = len(pattern.findall(xml))
+        if count > most:
+            raise RobotError(f"{where} has {count} {what}, over the limit of {most}")
+    problem = _tree_problem(xml)
+    if problem is not None:
+        raise RobotError(f"{where} is not a tree of links: {problem}")
+    total = 0
+    for uri in source.mesh_uris():
+        found = source.resolve(uri)
+        if found is not None:
+            try:
+                total += found.stat().st_size
+            except OSError:
+                continue
+    if total > MAX_MESH_BYTES:
+        raise RobotError(
+            f"{where} names {total:,} bytes of mesh files, over the limit of "
+            f"{MAX_MESH_BYTES:,} ({MAX_MESH_BYTES >> 20} MiB)"
+        )
+
+
+def _tree_problem(xml: str) -> str | None:
+    """Why the joints of ``xml`` do not make a tree (a link with two parents, a cycle), in
+    words, or None (urdfdom says only "no root link found")."""
+    try:
+        root = ET.fromstring(xml)
+    except ET.ParseError:
+        return None  # Pinocchio's parser says what is wrong with the XML itself
+    parent: dict[str, tuple[str, str]] = {}  # child link -> (parent link, joint)
+    for joint in root.iter("joint"):
+        above, below = joint.find("parent"), joint.find("child")
+        if above is None or below is None:
+            continue
+        name, child = joint.get("name", "?"), below.get("link", "?")
+        if child in parent:
+            return f"link {child!r} is the child of two joints ({parent[child][1]!r} and {name!r})"
+        parent[child] = (above.get("link", "?"), name)
+    for start in parent:
+        seen = [start]
+        link = start
+        while link in parent:
+            link = parent[link][0]
+            if link == start:
+                through = ", ".join(parent[a][1] for a in seen)
+                return f"its joints form a cycle: link {start!r} is its own ancestor ({through})"
+            if link in seen:
+                break  # a cycle that does not pass through start: found from its own links
+            seen.append(link)
+    return None
+
+
 def _split_env(value: str | None) -> tuple[Path, ...]:
     return tuple(Path(p) for p in (value or "").split(os.pathsep) if p)
 
@@ -307,4 +389,5 @@ def load_source(
     scans = source._scans
     source = replace(source, xml=xml)
     source._scans.update(scans)  # keep the package.xml scans made while expanding
+    check_size(source, path)
     return source

@@ -286,3 +286,17 @@ def test_session_defaults_and_workcell_limits_from_the_ini_and_from_flags(tmp_pa
         assert client.ask("collisions") == "ok base_link~link_u"  # the SRDF's pairs are off
     finally:
         client.close()
+
+
+@pytest.mark.parametrize("what", ["config", "cell"])
+def test_a_stray_byte_in_an_ini_or_cell_file_is_one_sentence(tmp_path, capsys, what):
+    """Issue 23.10: a 0xFF byte was a traceback and exit 1; it is exit 2 and one sentence."""
+    bad = tmp_path / "bad.ini"
+    bad.write_bytes(b"[options]\nport = 31000\n# \xff\n")
+    flag = "--config" if what == "config" else "--cell"
+    assert main([flag, str(bad), "--no-viewer"]) == 2
+    err = capsys.readouterr().err
+    assert (
+        err.startswith(f"c2rviz: cannot read {bad}: byte 0xff at offset ") and err.count("\n") == 1
+    )
+    assert "is not UTF-8 text" in err

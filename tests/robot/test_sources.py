@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 import warnings
 from pathlib import Path
@@ -232,3 +233,73 @@ def test_a_urdf_with_a_declaration_comments_and_a_doctype_is_a_urdf(tmp_path, ca
         encoding="utf-8",
     )
     assert Robot.from_urdf(path).joint_names == ("j",)
+
+
+def snake(joints: int) -> str:
+    """A URDF chain of ``joints`` revolute joints."""
+    links = "".join(f'<link name="l{i}"/>' for i in range(joints + 1))
+    chain = "".join(
+        f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        for i in range(1, joints + 1)
+    )
+    return f'<?xml version="1.0"?><robot name="snake">{links}{chain}</robot>'
+
+
+def test_a_robot_past_the_size_limits_is_refused_before_any_model(tmp_path):
+    """Issue 23.7: 500 joints took 7 GB and never started; past MAX_JOINTS (or MAX_LINKS, or
+    MAX_MESH_BYTES of meshes) the robot is refused in one sentence."""
+    from c2rviz.robot.sources import MAX_JOINTS, MAX_LINKS, MAX_MESH_BYTES
+
+    ok = tmp_path / "ok.urdf"
+    ok.write_text(snake(MAX_JOINTS))
+    assert Robot.from_urdf(ok).n == MAX_JOINTS
+    big = tmp_path / "big.urdf"
+    big.write_text(snake(500))
+    with pytest.raises(RobotError, match=rf"big.urdf has 501 links, over the limit of {MAX_LINKS}"):
+        load_source(big)
+    heavy = tmp_path / "heavy.urdf"
+    (tmp_path / "huge.stl").write_bytes(b"\0" * 1024)
+    os.truncate(tmp_path / "huge.stl", MAX_MESH_BYTES + 1)  # sparse: no disk is used
+    heavy.write_text(
+        '<robot name="h"><link name="a"><visual><geometry><mesh filename="huge.stl"/>'
+        "</geometry></visual></link></robot>"
+    )
+    with pytest.raises(
+        RobotError, match=r"names 268,435,457 bytes of mesh files, over the limit of 268,435,456"
+    ):
+        load_source(heavy)
+
+
+def test_a_cyclic_urdf_names_the_cycle(tmp_path):
+    """Issue 23.10: urdfdom says only "no root link"; we name the cycle, or the link with
+    two parents."""
+    limit = '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>'
+
+    def joint(name: str, above: str, below: str) -> str:
+        parent, child = f'<parent link="{above}"/>', f'<child link="{below}"/>'
+        return f'<joint name="{name}" type="revolute">{parent}{child}{limit}</joint>'
+
+    links = '<link name="a"/><link name="b"/><link name="c"/>'
+    cyclic = tmp_path / "cyc.urdf"
+    cyclic.write_text(
+        f'<robot name="c">{links}{joint("j1", "a", "b")}{joint("j2", "b", "c")}'
+        f"{joint('j3', 'c', 'a')}</robot>"
+    )
+    with pytest.raises(RobotError, match=r"not a tree of links: its joints form a cycle: link"):
+        load_source(cyclic)
+    twice = tmp_path / "twice.urdf"
+    twice.write_text(
+        f'<robot name="t">{links}{joint("j1", "a", "c")}{joint("j2", "b", "c")}</robot>'
+    )
+    with pytest.raises(RobotError, match=r"link 'c' is the child of two joints \('j1' and 'j2'\)"):
+        load_source(twice)
+
+
+def test_a_vanishing_velocity_limit_is_refused_at_start(tmp_path, capsys):
+    """Issue 23.10: velocity="1e-300" passed as > 0 and broke the first move in ruckig."""
+    urdf = tmp_path / "slow.urdf"
+    urdf.write_text(snake(2).replace('velocity="1"', 'velocity="1e-300"', 1))
+    assert main(["--urdf", str(urdf), "--no-viewer", "--port", "0"]) == 2
+    err = capsys.readouterr().err
+    assert "j1's URDF velocity limit 1e-300 is below 1e-06" in err and err.count("\n") == 1, err
