@@ -20,4 +20,5 @@ python3 -m venv .venv
 .venv/bin/python -m ruff check .
 .venv/bin/python -m ruff format --check .
 .venv/bin/python -m mypy
+.venv/bin/lint-imports --no-cache
 .venv/bin/python -m pytest "$@"
