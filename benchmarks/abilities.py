@@ -22,11 +22,11 @@ import sys
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-from processes import ROOT, Launched, free_port, launch, pin_cpus
 from abilities_cartesian import ArmPlan, measure_cartesian, measure_guard, measure_ik_bystander
 from abilities_cell import cell_supported, measure_cell
-from line_clients import Figure
 from abilities_motion import MotionPlan, measure_motion
+from line_clients import Figure
+from processes import ROOT, Launched, free_port, launch, pin_cpus
 from report import machine
 
 ROBOTS = {"motoman_sia20d": "motoman", "fanuc_lrmate200id": "fanuc", "kuka_lwr": "kuka"}

@@ -26,8 +26,8 @@ from dataclasses import dataclass
 
 import loadgen
 import numpy as np
-from processes import Launched
 from line_clients import Bystander, Figure, LineClient, percentile, round_trips
+from processes import Launched
 
 __all__ = ["ArmPlan", "measure_cartesian", "measure_guard", "measure_ik_bystander"]
 

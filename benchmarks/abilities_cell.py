@@ -19,8 +19,8 @@ import time
 from pathlib import Path
 
 import loadgen
-from processes import HOST, ROOT, Launched, free_port, launch
 from line_clients import Figure
+from processes import HOST, ROOT, Launched, free_port, launch
 
 __all__ = ["CELL_ROBOTS", "cell_supported", "measure_cell"]
 

@@ -34,8 +34,8 @@ from typing import Any
 import loadgen
 import numpy as np
 import pinocchio as pin
-from processes import ROOT, Launched
 from line_clients import Bystander, Figure, LineClient, percentile
+from processes import ROOT, Launched
 
 sys.path.insert(0, str(ROOT))  # this tree's c2rviz, not an installed one
 
@@ -57,10 +57,6 @@ class MotionPlan:
     """% of the limits: a 2 rad move of the motoman's joint 0 then lasts ~3.2 s."""
     bystander_s: float = 6.0
     idle_s: float = 2.0
-
-
-def ws_url(http_url: str) -> str:
-    return re.sub(r"^http", "ws", http_url.rstrip("/"))
 
 
 class JointReader:
@@ -145,7 +141,7 @@ async def measure_motion(proc: Launched, plan: MotionPlan) -> dict[str, Figure]:
             if m.get("type") == "SetOrientationMessage" and m.get("name") == reader.node:
                 angles.append((at, reader.angle(m["wxyz"])))
 
-    viewer = loadgen.ViewerClient(ws_url(proc.url))
+    viewer = loadgen.ViewerClient(loadgen.ws_url(proc.url))
     viewer.on_messages = on_messages
     task = asyncio.create_task(viewer.run())
     a, b = LineClient(proc.address), LineClient(proc.address)

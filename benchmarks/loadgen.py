@@ -13,6 +13,7 @@ import asyncio
 import gc
 import itertools
 import math
+import re
 import select
 import socket
 import threading
@@ -276,6 +277,11 @@ class Frame:
     types: list[str]
     poses: int
     """How many of its messages move a scene node."""
+
+
+def ws_url(http_url: str) -> str:
+    """The websocket address of a page served at ``http_url``."""
+    return re.sub(r"^http", "ws", http_url.rstrip("/"))
 
 
 @dataclass

@@ -16,7 +16,6 @@ from __future__ import annotations
 import argparse
 import asyncio
 import os
-import re
 import socket
 import sys
 import time
@@ -62,10 +61,6 @@ def percentile(values: Sequence[float], q: float) -> float:
     return ordered[min(len(ordered) - 1, int(q / 100 * len(ordered)))]
 
 
-def ws_url(http_url: str) -> str:
-    return re.sub(r"^http", "ws", http_url.rstrip("/"))
-
-
 def _has_mesh(frame: loadgen.Frame) -> bool:
     return any("Mesh" in kind or "Glb" in kind or "Box" in kind for kind in frame.types)
 
@@ -77,7 +72,7 @@ async def _scene_ready(proc: Launched) -> float:
     box): a page that connects then draws the robot.
     """
     assert proc.url is not None
-    viewer = loadgen.ViewerClient(ws_url(proc.url))
+    viewer = loadgen.ViewerClient(loadgen.ws_url(proc.url))
     got_mesh = asyncio.Event()
     viewer.on_frame = lambda frame: got_mesh.set() if _has_mesh(frame) else None
     task = asyncio.create_task(viewer.run())
@@ -95,7 +90,7 @@ async def _scene_ready(proc: Launched) -> float:
 async def _frame_latency(proc: Launched, samples: int) -> list[float]:
     """Seconds from sending ``move`` to the first websocket frame that moves a node."""
     assert proc.url is not None
-    viewer = loadgen.ViewerClient(ws_url(proc.url))
+    viewer = loadgen.ViewerClient(loadgen.ws_url(proc.url))
     waiting: list[asyncio.Future[float]] = []
 
     def on_frame(frame: loadgen.Frame) -> None:
@@ -136,7 +131,7 @@ async def _frame_latency(proc: Launched, samples: int) -> list[float]:
 async def _flood_frames(proc: Launched, seconds: float) -> tuple[float, float]:
     """Frames/s reaching the viewer and commands/s while one client floods ``joints``."""
     assert proc.url is not None
-    viewer = loadgen.ViewerClient(ws_url(proc.url))
+    viewer = loadgen.ViewerClient(loadgen.ws_url(proc.url))
     task = asyncio.create_task(viewer.run())
     try:
         await asyncio.wait_for(viewer.replay_done.wait(), 30)

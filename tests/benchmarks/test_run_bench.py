@@ -61,3 +61,16 @@ def test_quick_run_prints_every_row() -> None:
         assert re.fullmatch(NUMBER, ours), f"{label}: c2rviz figure {ours!r}"
         assert re.fullmatch(NUMBER, ceiling), f"{label}: ceiling figure {ceiling!r}"
         assert re.fullmatch(NUMBER, ratio), f"{label}: ratio {ratio!r}"
+
+
+def test_the_many_robots_benchmark_prints_its_rows():
+    """benchmarks/many_robots.py --quick runs a cell of 8 with a page and prints every row
+    (no timing is checked)."""
+    stdout, cells = quick_table("many_robots.py", 600)
+    for row in (
+        "server CPU [cores]",
+        "page frames/s, lowest robot",
+        "page frames/s, median robot",
+        "bystander where p99 [ms]",
+    ):
+        assert re.fullmatch(r"\d+\.\d\d", cells[row][1]), stdout
