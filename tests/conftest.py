@@ -121,3 +121,15 @@ def browser() -> Iterator[Any]:
             yield chromium
         finally:
             chromium.close()
+
+
+BROWSER_TIMEOUT_S = 900
+"""A browser test's own time limit [s]: it starts the program and Chromium and waits for
+pictures, each wait bounded by browser_support.DEADLINE_S (180 s). The suite's 120 s
+limit cut such a test short on a busy 2-core machine before its own waits failed."""
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    for item in items:
+        if item.get_closest_marker("browser") and not item.get_closest_marker("timeout"):
+            item.add_marker(pytest.mark.timeout(BROWSER_TIMEOUT_S))
