@@ -16,7 +16,7 @@ and handled once, by a function on the session side::
     @handler(Move)
     def move(session: Session, command: Move) -> Reply: ...
 
-``help``, the README's command table and the parser tests are all made from
+``help``, the command table (docs/commands.md) and the parser tests are all made from
 ``VERBS``. This module has no I/O and imports nothing heavy: the clients use it
 (through ``protocol.parse_line``) without loading Pinocchio.
 """
@@ -57,7 +57,7 @@ class Verb:
     Attributes:
         name: The verb as ``help`` lists it.
         args: Its argument pattern (``""`` for none).
-        summary: What it does, for the README's table.
+        summary: What it does, for the command table.
         command: The frozen dataclass the parser returns.
         parse: ``parse(verb, words) -> command``; raises ``BadArguments``.
         aliases: Other spellings of the verb.
@@ -143,7 +143,7 @@ def help_text() -> str:
 
 
 def readme_table() -> str:
-    """The README's command table, one row per verb (a test keeps the README equal to it)."""
+    """The command table of docs/commands.md, one row per verb (a test keeps them equal)."""
     rows = ["| command | meaning |", "|---|---|"]
     for v in VERBS.values():
         spelled = " / ".join(f"`{word}`" for word in v.aliases)

@@ -1,4 +1,4 @@
-"""The verb registry: one entry per verb, a handler for each, and the README made from it."""
+"""The verb registry: one entry per verb, a handler for each, and the command table made from it."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from c2rviz.protocol import replies
 from c2rviz.protocol.grammar import parse_line
 from c2rviz.protocol.registry import HANDLERS, LOOKUP, VERBS, help_text, readme_table
 
-README = ROOT / "README.md"
+COMMANDS_DOC = ROOT / "docs" / "commands.md"
 
 
 def test_every_verb_has_one_handler_and_parses_to_its_class():
@@ -41,9 +41,9 @@ def test_help_lists_every_verb_and_alias_once():
 
 
 def test_the_readme_command_table_is_the_registry():
-    text = README.read_text()
+    text = COMMANDS_DOC.read_text()
     found = re.search(r"<!-- commands:[^\n]*-->\n(.*?)\n<!-- /commands -->", text, re.S)
-    assert found, "README.md lost its <!-- commands --> markers"
+    assert found, "docs/commands.md lost its <!-- commands --> markers"
     assert found.group(1) == readme_table(), (
-        "README.md's command table differs from the registry; paste this:\n" + readme_table()
+        "docs/commands.md's command table differs from the registry; paste this:\n" + readme_table()
     )
