@@ -11,28 +11,46 @@ from __future__ import annotations
 
 import asyncio
 import logging
-from typing import TYPE_CHECKING
+from collections import Counter
+from collections.abc import Callable
+from typing import Any, Protocol
 
 from websockets.asyncio.server import ServerConnection
 from websockets.exceptions import ConnectionClosed
 
 from ...errors import C2rvizError
 from . import protocol, rosapi
+from .bridge import Bridge
 from .outbox import Outbox
+from .policy import RosbridgePolicy
 from .protocol import LEVELS, SUPPORTED_OPS, FrameId, RosbridgeError, resolve_name
 
-if TYPE_CHECKING:
-    from .server import RosbridgeServer
-
-__all__ = ["Connection"]
+__all__ = ["Connection", "Host"]
 
 log = logging.getLogger("c2rviz.rosbridge")
+
+
+class Host(Protocol):
+    """What a connection needs of its server (``server.RosbridgeServer``)."""
+
+    bridge: Bridge
+    policy: RosbridgePolicy
+    stats: Counter[str]
+    sent_probe: Callable[[float], None] | None
+
+    def graph(self) -> rosapi.Graph:
+        """What rosapi tells of c2rviz now."""
+        ...
+
+    def encode(self, spelling: str, msg: dict[str, Any]) -> str | None:
+        """The ``publish`` frame of ``msg`` on ``spelling`` (None: it cannot be sent)."""
+        ...
 
 
 class Connection:
     """One client: its status level, subscriptions and advertised topics."""
 
-    def __init__(self, server: RosbridgeServer, websocket: ServerConnection) -> None:
+    def __init__(self, server: Host, websocket: ServerConnection) -> None:
         self.server, self.websocket = server, websocket
         self.bridge, self.policy = server.bridge, server.policy
         host, port = websocket.remote_address[:2]
