@@ -40,6 +40,14 @@ class Bridge(Protocol):
         """Parameters by name for ``/rosapi/get_param``: ``robot_description`` (URDF text)."""
         ...
 
+    def opened(self, source: str) -> None:
+        """A client connected: ``source`` (``rosbridge 127.0.0.1:50412``) names it from now on."""
+        ...
+
+    def closed(self, source: str) -> None:
+        """The client ``source`` is gone (its subscriptions are already stopped)."""
+        ...
+
     def subscribe(self, topic: str, deliver: Deliver) -> object:
         """Start calling ``deliver(msg)`` for each message of ``topic``; return a handle.
 

@@ -36,7 +36,7 @@ class Host(Protocol):
     bridge: Bridge
     policy: RosbridgePolicy
     stats: Counter[str]
-    sent_probe: Callable[[float], None] | None
+    sent_probe: Callable[[float, dict[str, Any]], None] | None
 
     def graph(self) -> rosapi.Graph:
         """What rosapi tells of c2rviz now."""
@@ -62,22 +62,35 @@ class Connection:
         self._serving: asyncio.Future[None] | None = None
 
     async def run(self) -> None:
-        """Serve the connection's frames in order until it closes or the server stops."""
+        """Serve the connection's frames in order until it closes or the server stops.
+
+        A client that leaves while its request waits (a service call on a long
+        move) gives that request up at once: nobody is left to answer.
+        """
+        gone = asyncio.ensure_future(self.websocket.wait_closed())
         try:
             async for frame in self.websocket:
                 if self.stopping:
                     break
-                self._serving = asyncio.ensure_future(self.handle(frame))
+                serving = self._serving = asyncio.ensure_future(self.handle(frame))
                 try:
-                    await self._serving
-                except asyncio.CancelledError:
-                    if self.stopping:
+                    await asyncio.wait((serving, gone), return_when=asyncio.FIRST_COMPLETED)
+                    if not serving.done():  # the client left while its request waited
+                        serving.cancel()
+                        await asyncio.gather(serving, return_exceptions=True)
                         break
+                    serving.result()
+                except asyncio.CancelledError:
+                    if self.stopping or serving.cancelled():
+                        break
+                    serving.cancel()  # this task is cancelled: its request goes with it
                     raise
                 finally:
                     self._serving = None
         except ConnectionClosed:
             pass
+        finally:
+            gone.cancel()
 
     def stop(self) -> None:
         """Give up the request being served (a service call that waits) and read no more."""

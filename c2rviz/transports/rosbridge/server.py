@@ -53,7 +53,8 @@ class RosbridgeServer:
         policy: Origins, token and limits.
         node_name: The node ``/rosapi/nodes`` names.
         sent_probe: Called with the monotonic time [s] of each message's
-            delivery just after its frame was written (benchmarks; None).
+            delivery and the message, just after its frame was written
+            (benchmarks; None).
 
     Attributes:
         stats: Counts: ``sent`` frames of subscriptions, ``thinned`` messages
@@ -67,7 +68,7 @@ class RosbridgeServer:
         policy: RosbridgePolicy | None = None,
         *,
         node_name: str = "/c2rviz",
-        sent_probe: Callable[[float], None] | None = None,
+        sent_probe: Callable[[float, dict[str, Any]], None] | None = None,
     ) -> None:
         self.bridge = bridge
         self.policy = policy or RosbridgePolicy()
@@ -168,6 +169,7 @@ class RosbridgeServer:
             return
         connection = Connection(self, websocket)
         self._connections.add(connection)
+        self.bridge.opened(connection.source)
         try:
             await connection.run()
             if connection.stopping:  # as websockets closes the others when the server stops
@@ -175,3 +177,4 @@ class RosbridgeServer:
         finally:
             self._connections.discard(connection)
             await connection.close()
+            self.bridge.closed(connection.source)

@@ -51,6 +51,7 @@ class CounterBridge:
         self.unsubscribed: queue.Queue[str] = queue.Queue()
         self.published: queue.Queue[tuple[str, str, Any]] = queue.Queue()
         self.calls: queue.Queue[str] = queue.Queue()
+        self.sources: queue.Queue[tuple[str, str]] = queue.Queue()
         self.release = asyncio.Event()  # a service call "hold" waits for it (set on the loop)
         self.release.set()
 
@@ -62,6 +63,12 @@ class CounterBridge:
 
     def params(self) -> dict[str, object]:
         return {"robot_description": "<robot name='counter'/>"}
+
+    def opened(self, source: str) -> None:
+        self.sources.put(("opened", source))
+
+    def closed(self, source: str) -> None:
+        self.sources.put(("closed", source))
 
     def subscribe(self, topic: str, deliver: Callable[[dict[str, Any]], None]) -> object:
         if topic not in ("/counter", "/latched"):
