@@ -57,14 +57,15 @@ class RosbridgeDoor:
         policy = RosbridgePolicy(extra_origins=settings.viewer_origins, token=self.token)
         self.bridge = RobotBridge(services, cell=settings.cell is not None, on_quit=on_quit)
         self.server = RosbridgeServer(self.bridge, policy)
-        self.url = ""
+        self.host, self.port, self.url = "", 0, ""
+        """Where it listens, once started (``url`` with the token, if any)."""
 
     async def start(self, host: str, port: int) -> RosbridgeDoor:
-        """Listen on ``host:port`` (0: a free port); ``url`` then says where."""
-        bound_host, bound_port = await self.server.start(host, port)
-        shown = f"[{bound_host}]" if ":" in bound_host else bound_host
+        """Listen on ``host:port`` (0: a free port); ``host``, ``port`` and ``url`` say where."""
+        self.host, self.port = await self.server.start(host, port)
+        shown = f"[{self.host}]" if ":" in self.host else self.host
         query = f"?token={self.token}" if self.token is not None else ""
-        self.url = f"ws://{shown}:{bound_port}/{query}"
+        self.url = f"ws://{shown}:{self.port}/{query}"
         return self
 
     async def stop(self) -> None:

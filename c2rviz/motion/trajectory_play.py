@@ -67,12 +67,14 @@ class PlannedTrajectory:
 
     Attributes:
         times: Knot times [s] from the start: 0, then each point's.
+        knots: The positions at those times [rad or m], one row each.
         coefficients: Shape (segments, 6, joints): ``q(t) = sum c[i] (t - times[k])**i``.
         peak_rate: Each joint's largest speed along the path [rad/s or m/s] (for braking).
         limits: The limits it was checked against.
     """
 
     times: np.ndarray
+    knots: np.ndarray
     coefficients: np.ndarray
     peak_rate: np.ndarray
     limits: MotionLimits
@@ -83,7 +85,12 @@ class PlannedTrajectory:
         return float(self.times[-1])
 
     def sample(self, s: float) -> np.ndarray:
-        """Positions [rad or m] at path time ``s`` [s] (clamped to the path)."""
+        """Positions [rad or m] at path time ``s`` [s]: the first or last knot exactly
+        before the start and from the end on."""
+        if s <= 0.0:
+            return self.knots[0].copy()
+        if s >= self.times[-1]:
+            return self.knots[-1].copy()
         return self._derivative(s, 0)
 
     def _derivative(self, s: float, order: int) -> np.ndarray:
@@ -238,7 +245,7 @@ def _plan(
             for k in range(len(knots) - 1)
         ]
     )
-    return PlannedTrajectory(knots, coefficients, np.zeros(qs.shape[1]), limits)
+    return PlannedTrajectory(knots, qs, coefficients, np.zeros(qs.shape[1]), limits)
 
 
 def _check(
@@ -254,7 +261,7 @@ def _check(
         ("velocity", 1, np.asarray(limits.velocity), "/s"),
         ("acceleration", 2, np.asarray(limits.acceleration), "/s^2"),
     )
-    knots = planned.coefficients[:, 0, :]  # each segment's first knot; the start is checked
+    knots = planned.knots  # the first is where the arm is
     for k in range(1, len(knots)):
         for j, value in enumerate(knots[k].tolist()):
             if not within_limit(value, float(lower[j]), float(upper[j])):
