@@ -7,8 +7,8 @@ from collections.abc import Iterator
 
 import pytest
 import roslibpy
-from roslibpy.ros import set_rosapi_timeout
 from rosbridge_support import CounterBridge, ServerThread
+from roslibpy.ros import set_rosapi_timeout
 from support import load_robot
 from world_support import WAIT_S, WorldServer
 
