@@ -123,7 +123,7 @@ def _pchip_velocities(times: np.ndarray, q: np.ndarray) -> np.ndarray:
     h0, h1 = h[:-1], h[1:]
     w1, w2 = 2 * h1 + h0, h1 + 2 * h0
     same = (before * after) > 0
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         mean = (w1 + w2) / (w1 / before + w2 / after)
     v[1:-1] = np.where(same, mean, 0.0)
     return v

@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 import queue
 import time
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -19,46 +18,21 @@ import pinocchio as pin
 import pytest
 import roslibpy
 from roslibpy.core import ServiceException
-from support import Client, load_robot
-from world_support import WAIT_S, WorldServer
-
-from c2rviz.transports.rosbridge import COMMAND_SERVICE_TYPE
+from support import load_robot
+from world_support import (
+    WAIT_S,
+    WorldServer,
+    ask,
+    command_service,
+    in_root,
+    listen,
+    seconds,
+    text_client,
+    tf_tree,
+    until,
+)
 
 Q1 = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7]
-
-
-def listen(ros: roslibpy.Ros, topic: str, kind: str) -> queue.Queue[dict[str, Any]]:
-    """Subscribe and return the queue its messages land in."""
-    received: queue.Queue[dict[str, Any]] = queue.Queue()
-    roslibpy.Topic(ros, topic, kind).subscribe(received.put)
-    return received
-
-
-def until(
-    received: queue.Queue[dict[str, Any]], wanted: Callable[[dict[str, Any]], bool]
-) -> dict[str, Any]:
-    """The first message that is ``wanted`` (others are skipped)."""
-    deadline = time.monotonic() + WAIT_S
-    while True:
-        msg = received.get(timeout=max(0.01, deadline - time.monotonic()))
-        if wanted(msg):
-            return msg
-
-
-def seconds(stamp: dict[str, int]) -> float:
-    return stamp["sec"] + stamp["nanosec"] * 1e-9
-
-
-def text_client(server: WorldServer, robot: str = "motoman_sia20d") -> Client:
-    return Client("127.0.0.1", server.ports[robot], timeout=WAIT_S)
-
-
-def command_service(ros: roslibpy.Ros, name: str = "/c2rviz/command") -> roslibpy.Service:
-    return roslibpy.Service(ros, name, COMMAND_SERVICE_TYPE)
-
-
-def ask(service: roslibpy.Service, line: str) -> dict[str, Any]:
-    return service.call(roslibpy.ServiceRequest({"command": line}), timeout=WAIT_S)
 
 
 def test_joint_states_show_a_joints_command(world_server: WorldServer, ros_world: roslibpy.Ros):
@@ -147,26 +121,6 @@ def test_latched_topics_reach_a_late_subscriber(ros_world: roslibpy.Ros) -> None
     assert isinstance(static.get(timeout=WAIT_S)["transforms"], list)
 
 
-def _tree(*messages: dict[str, Any]) -> dict[str, tuple[str, pin.SE3]]:
-    """child frame -> (parent frame, placement) from TFMessages."""
-    tree = {}
-    for msg in messages:
-        for item in msg["transforms"]:
-            t, r = item["transform"]["translation"], item["transform"]["rotation"]
-            xyzquat = np.array([t["x"], t["y"], t["z"], r["x"], r["y"], r["z"], r["w"]])
-            tree[item["child_frame_id"]] = (item["header"]["frame_id"], pin.XYZQUATToSE3(xyzquat))
-    return tree
-
-
-def _in_root(tree: dict[str, tuple[str, pin.SE3]], frame: str) -> tuple[str, pin.SE3]:
-    placement = pin.SE3.Identity()
-    while frame in tree:
-        parent, step = tree[frame]
-        placement = step * placement
-        frame = parent
-    return frame, placement
-
-
 def test_tf_is_the_robot_as_pinocchio_places_it(
     world_server: WorldServer, ros_world: roslibpy.Ros
 ) -> None:
@@ -179,7 +133,7 @@ def test_tf_is_the_robot_as_pinocchio_places_it(
     wanted = data.oMf[robot.model.getFrameId("link_t", pin.BODY)]
 
     def at_q1(msg: dict[str, Any]) -> bool:
-        root, placement = _in_root(_tree(static, msg), "link_t")
+        root, placement = in_root(tf_tree(static, msg), "link_t")
         return root == "base_link" and placement.isApprox(wanted, 1e-9)
 
     until(moving, at_q1)

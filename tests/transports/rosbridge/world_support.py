@@ -4,29 +4,91 @@ rosbridge door, wired as the program wires them, on one event loop in a thread.
 ``WorldServer`` starts everything on 127.0.0.1 port 0. Tests talk to it as clients
 would: roslibpy (its asyncio transport), a raw websockets client, and the text port
 through ``support.Client``. ``Notes`` is an observer that keeps the world's commands
-with the clock time each was noted (a trajectory starts at its note's time).
+with the clock time each was noted (a trajectory starts at its note's time). The
+helpers subscribe with roslibpy, call the command service and compose TF.
 """
 
 from __future__ import annotations
 
 import asyncio
+import queue
 import threading
+import time
 from collections.abc import Callable, Coroutine, Mapping, Sequence
 from concurrent.futures import Future
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
 import pinocchio as pin
+import roslibpy
+from support import Client
 
 from c2rviz.app.config import Settings
 from c2rviz.app.rosbridge_door import RosbridgeDoor
 from c2rviz.robot.model import Robot
 from c2rviz.session import Services
+from c2rviz.transports.rosbridge import COMMAND_SERVICE_TYPE
 from c2rviz.transports.tcp_text import CommandServer
 from c2rviz.world.effects import Observer
 from c2rviz.world.world import World
 
 WAIT_S = 20.0  # generous: the machine is shared; a passing test never waits this long
+
+
+def listen(ros: roslibpy.Ros, topic: str, kind: str) -> queue.Queue[dict[str, Any]]:
+    """Subscribe and return the queue its messages land in."""
+    received: queue.Queue[dict[str, Any]] = queue.Queue()
+    roslibpy.Topic(ros, topic, kind).subscribe(received.put)
+    return received
+
+
+def until(
+    received: queue.Queue[dict[str, Any]], wanted: Callable[[dict[str, Any]], bool]
+) -> dict[str, Any]:
+    """The first message that is ``wanted`` (others are skipped)."""
+    deadline = time.monotonic() + WAIT_S
+    while True:
+        msg = received.get(timeout=max(0.01, deadline - time.monotonic()))
+        if wanted(msg):
+            return msg
+
+
+def seconds(stamp: dict[str, int]) -> float:
+    return stamp["sec"] + stamp["nanosec"] * 1e-9
+
+
+def text_client(server: WorldServer, robot: str = "motoman_sia20d") -> Client:
+    return Client("127.0.0.1", server.ports[robot], timeout=WAIT_S)
+
+
+def command_service(ros: roslibpy.Ros, name: str = "/c2rviz/command") -> roslibpy.Service:
+    return roslibpy.Service(ros, name, COMMAND_SERVICE_TYPE)
+
+
+def ask(service: roslibpy.Service, line: str) -> dict[str, Any]:
+    return service.call(roslibpy.ServiceRequest({"command": line}), timeout=WAIT_S)
+
+
+def tf_tree(*messages: dict[str, Any]) -> dict[str, tuple[str, pin.SE3]]:
+    """child frame -> (parent frame, placement) from TFMessages (later ones win)."""
+    tree = {}
+    for msg in messages:
+        for item in msg["transforms"]:
+            t, r = item["transform"]["translation"], item["transform"]["rotation"]
+            xyzquat = np.array([t["x"], t["y"], t["z"], r["x"], r["y"], r["z"], r["w"]])
+            tree[item["child_frame_id"]] = (item["header"]["frame_id"], pin.XYZQUATToSE3(xyzquat))
+    return tree
+
+
+def in_root(tree: dict[str, tuple[str, pin.SE3]], frame: str) -> tuple[str, pin.SE3]:
+    """The root of ``frame``'s tree, and ``frame``'s placement in it."""
+    placement = pin.SE3.Identity()
+    while frame in tree:
+        parent, step = tree[frame]
+        placement = step * placement
+        frame = parent
+    return frame, placement
 
 
 @dataclass(frozen=True)
