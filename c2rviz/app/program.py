@@ -183,6 +183,9 @@ async def serve(
             file=sys.stderr,
             flush=True,
         )
+    for entry in doors:
+        if entry.warning is not None:
+            print(f"c2rviz: warning: {entry.warning}", file=sys.stderr, flush=True)
     try:
         await stop.wait()
     finally:

@@ -108,7 +108,15 @@ async def open_rosbridge(
         return []
     spaces = [t.namespace for t in door.bridge.robots.values() if t.namespace]
     where = f"robots under /{', /'.join(spaces)}" if spaces else "/joint_states, /tf"
-    return [Opened(door, f"rosbridge at {door.url} ({where}; roslibpy, roslibjs, Foxglove)")]
+    warning = None
+    if not _is_loopback(settings.host):
+        made = " (generated for this run; --viewer-token sets one)"
+        warning = (
+            f"rosbridge listens on {settings.host}: anyone who can reach it and has its URL "
+            f"with the token can move the robot{made if settings.viewer_token is None else ''}"
+        )
+    banner = f"rosbridge at {door.url} ({where}; roslibpy, roslibjs, Foxglove)"
+    return [Opened(door, banner, warning)]
 
 
 OPENERS.append(open_rosbridge)
