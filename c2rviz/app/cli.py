@@ -98,7 +98,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--rosbridge-port",
         type=int,
         metavar="PORT",
-        help="port of the rosbridge websocket for ROS tools (roslibpy, roslibjs, Foxglove) on "
+        help="port of the rosbridge websocket for ROS tools (roslibpy, roslibjs) on "
         "--host (default 9090; 0 picks a free one; docs/rosbridge.md)",
     )
     add(

@@ -115,7 +115,7 @@ async def open_rosbridge(
             f"rosbridge listens on {settings.host}: anyone who can reach it and has its URL "
             f"with the token can move the robot{made if settings.viewer_token is None else ''}"
         )
-    banner = f"rosbridge at {door.url} ({where}; roslibpy, roslibjs, Foxglove)"
+    banner = f"rosbridge at {door.url} ({where}; docs/rosbridge.md)"
     return [Opened(door, banner, warning)]
 
 
