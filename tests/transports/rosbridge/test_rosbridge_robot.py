@@ -112,6 +112,7 @@ def test_discovery(world_server: WorldServer, ros_world: roslibpy.Ros) -> None:
     assert ros_world.get_nodes() == ["/c2rviz"]
     urdf = load_robot("motoman_sia20d").source.xml
     assert ros_world.get_param("robot_description") == urdf
+    assert world_server.call(lambda: world_server.services.client_count) == 1  # the page says so
 
 
 def test_latched_topics_reach_a_late_subscriber(ros_world: roslibpy.Ros) -> None:

@@ -375,3 +375,25 @@ def test_the_port_is_free_after_stop(bridge: CounterBridge) -> None:
         probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         probe.bind(("127.0.0.1", server.port))
         probe.listen()
+
+
+def test_the_bridge_hears_each_client_come_and_go(rosbridge: ServerThread) -> None:
+    with connect(rosbridge.url) as ws:
+        assert command(ws, "hi")["result"] is True
+        kind, source = rosbridge.bridge.sources.get(timeout=WAIT_S)
+        assert kind == "opened" and source.startswith("rosbridge 127.0.0.1:")
+    assert rosbridge.bridge.sources.get(timeout=WAIT_S) == ("closed", source)
+
+
+def test_a_client_leaving_gives_up_its_waiting_request(rosbridge: ServerThread) -> None:
+    rosbridge.call(rosbridge.bridge.release.clear)  # "hold" waits until released: never here
+    with connect(rosbridge.url) as ws:
+        ws.send(
+            json.dumps(
+                {"op": "call_service", "service": "/c2rviz/command", "args": {"command": "hold"}}
+            )
+        )
+        assert rosbridge.bridge.calls.get(timeout=WAIT_S) == "hold"
+    assert rosbridge.bridge.sources.get(timeout=WAIT_S)[0] == "opened"
+    assert rosbridge.bridge.sources.get(timeout=WAIT_S)[0] == "closed"  # without the release
+    assert rosbridge.server.connections == 0
