@@ -25,7 +25,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from ...errors import ArmMoved, C2rvizError, JointLimitError
-from ...motion.trajectory_play import TrajectoryPlay, plan_trajectory
+from ...motion.trajectory import plan_trajectory
+from ...motion.trajectory_play import TrajectoryPlay
 from ...protocol import replies
 from ...robot.model import Robot
 from ...session.session import Session
