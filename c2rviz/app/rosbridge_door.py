@@ -23,6 +23,7 @@ from ..errors import C2rvizError, ConfigError
 from ..session.services import Services
 from ..transports.rosbridge import PolicyError, RosbridgePolicy, RosbridgeServer
 from ..transports.rosbridge.robot_bridge import RobotBridge
+from ..view.policy import DoorPolicy
 from .config import Settings
 from .doors import OPENERS, Door, Opened, open_port
 from .members import Member
@@ -80,9 +81,16 @@ async def open_rosbridge(
     members: Sequence[Member],
     on_quit: Callable[[], None],
 ) -> list[Opened]:
-    """Open the rosbridge door as the settings say (none with ``--no-rosbridge``)."""
+    """Open the rosbridge door as the settings say (none with ``--no-rosbridge``).
+
+    Raises:
+        C2rvizError: a bad ``--viewer-origin`` or ``--viewer-token`` (as the viewer
+            words it), or a named port that is taken.
+    """
     if not settings.rosbridge:
         return []
+    # The origins and token are the viewer's settings: a bad one is refused in its words.
+    DoorPolicy(settings.viewer_origins, settings.viewer_token, settings.max_viewers)
     try:
         door = RosbridgeDoor(services, settings, on_quit)
     except PolicyError as exc:  # a --viewer-origin or --viewer-token that cannot work
