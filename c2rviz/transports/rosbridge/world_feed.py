@@ -13,8 +13,9 @@ that changed and only for topics someone reads:
 * ``/tf``: every robot's moving joints (one message holds them all, so a slow
   subscriber that keeps only the latest loses no robot), stamped likewise;
 * ``[NS]/visualization_marker_array``: markers added (and those pushed out past
-  ``MAX_MARKERS`` deleted, or all deleted after a ``clear``), and the workcell
-  objects as a whole when they changed.
+  ``MAX_MARKERS`` deleted; all deleted after a ``clear``, or when more went than
+  half of those left, then all sent again), and the workcell objects as a whole
+  when they changed.
 
 ``/tf_static`` and ``[NS]/robot_description`` are latched from the start;
 events (``watch``'s texts) go out on ``[NS]/c2rviz/events`` as they happen.
@@ -213,10 +214,12 @@ class WorldFeed(Observer):
         if feed.markers_changed:
             shown = {k for k, _ in feed.markers}
             if wanted:
-                if feed.cleared:
+                gone = feed.sent - shown
+                if feed.cleared or len(gone) > len(shown) // 2:  # a flood: start afresh
                     msgs.append(topics.markers_cleared(t))
                     feed.sent.clear()
-                msgs.extend(topics.marker_gone(t, k) for k in sorted(feed.sent - shown))
+                    gone.clear()
+                msgs.extend(topics.marker_gone(t, k) for k in sorted(gone))
                 msgs.extend(topics.marker(t, k, m) for k, m in feed.markers if k not in feed.sent)
             feed.sent = shown
         if feed.objects_changed and wanted:

@@ -226,3 +226,32 @@ def test_a_bad_message_is_answered_with_a_status(
     assert status["level"] == "error"
     assert "'elbow' is not a joint of motoman_sia20d's chain" in status["msg"]
     assert world_server.q() == load_robot("motoman_sia20d").home  # nothing moved
+
+
+def test_a_marker_flood_leaves_a_subscriber_with_the_newest_thousand(
+    world_server: WorldServer, ros_world: roslibpy.Ros
+) -> None:
+    markers = listen(ros_world, "/visualization_marker_array", "visualization_msgs/MarkerArray")
+    shown: dict[int, float] = {}  # id -> x, as RViz would hold them
+
+    def apply(msg: dict[str, Any]) -> bool:
+        for marker in msg["markers"]:
+            if marker["ns"] != "markers":
+                continue
+            if marker["action"] == 3:
+                shown.clear()
+            elif marker["action"] == 2:
+                del shown[marker["id"]]
+            else:
+                shown[marker["id"]] = marker["pose"]["position"]["x"]
+        return max(shown, default=-1) == 1499
+
+    client = text_client(world_server)
+    try:
+        client.send("".join(f"mark {k / 1000},0,0.5,0,0,0\n" for k in range(1500)))
+        assert [client.read_line() for _ in range(1500)][-1] == "ok"
+    finally:
+        client.close()
+    until(markers, apply)
+    assert sorted(shown) == list(range(500, 1500))
+    assert shown[1499] == pytest.approx(1.499)
