@@ -9,7 +9,8 @@ Three processes:
   app's rosbridge door), its connection cap raised to 64 for the 50 subscribers;
   it notes, for each ``/joint_states`` frame written, the time from the world's
   change (the message's stamp: the world's clock, this machine's monotonic
-  clock) to the frame leaving (the websocket write returning), and its own CPU;
+  clock) to the frame leaving (the websocket write returning: the server's
+  ``sent_probe``, paired with the message delivered at that time), and its own CPU;
 - the subscribers (``--client-of``, run under ``nice -n 10`` so that this
   instrument yields the CPU to what it measures): N raw websockets clients each
   subscribed to ``/joint_states``, noting when each frame arrives;
@@ -34,7 +35,9 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import bisect
 import json
+import math
 import re
 import sys
 import time
@@ -71,7 +74,11 @@ async def serve() -> None:
     from c2rviz.robot.model import Robot
     from c2rviz.session import Services
     from c2rviz.transports.rosbridge import RosbridgePolicy
-    from c2rviz.transports.tcp_text import CommandServer
+
+    try:
+        from c2rviz.transports.tcp_server import CommandServer
+    except ImportError:  # where the text door's server still lives beside its connections
+        from c2rviz.transports.tcp_text import CommandServer  # type: ignore[no-redef]
     from c2rviz.world.world import World
 
     robot = Robot.from_urdf(ROOT / "robots/motoman_sia20d/robot.urdf", "base_link", "link_t")
@@ -84,23 +91,25 @@ async def serve() -> None:
     await door.start("127.0.0.1", 0)
     server, hub = door.server, door.bridge.hub
     leaving: list[float] = []
-    published = [0]
+    published: list[tuple[float, float]] = []  # (when handed to the subscribers, stamp) [s]
     measuring = [False]
 
-    def probe(delivered: float, msg: dict[str, Any]) -> None:
-        header = msg.get("header")
-        if header is not None and measuring[0]:
-            stamp = header["stamp"]
-            leaving.append(time.monotonic() - (stamp["sec"] + stamp["nanosec"] * 1e-9))
+    def probe(delivered: float) -> None:
+        """A frame left: pair its delivery with the /joint_states message delivered then."""
+        if measuring[0] and published:
+            k = bisect.bisect_right(published, (delivered, math.inf)) - 1
+            if k >= 0:
+                leaving.append(time.monotonic() - published[k][1])
 
     original = hub.publish
 
-    def counting(topic: str, msg: dict[str, Any]) -> None:
-        if topic == "/joint_states":
-            published[0] += 1
-        original(topic, msg)
+    def noting(topic: str, msg: dict[str, Any]) -> None:
+        if topic == "/joint_states" and measuring[0]:
+            stamp = msg["header"]["stamp"]
+            published.append((time.monotonic(), stamp["sec"] + stamp["nanosec"] * 1e-9))
+        original(topic, msg)  # each outbox notes its delivery time, after ours
 
-    hub.publish = counting  # type: ignore[method-assign]
+    hub.publish = noting  # type: ignore[method-assign]
     server.sent_probe = probe  # outboxes take it when made: set before anyone subscribes
     print(f"ports {text_port} {door.port}", flush=True)
     loop = asyncio.get_running_loop()
@@ -109,17 +118,17 @@ async def serve() -> None:
         command = (await loop.run_in_executor(None, sys.stdin.readline)).strip()
         if command == "start":
             leaving.clear()
+            published.clear()
             measuring[0] = True
             stats = server.stats
             started = (time.monotonic(), time.process_time(), stats["sent"], stats["thinned"], 0)
-            published[0] = 0
         elif command == "stop":
             wall, cpu = time.monotonic() - started[0], time.process_time() - started[1]
             measuring[0] = False
             lags = [1000 * lag for lag in leaving]
             figures = {
                 "cpu_pct": 100 * cpu / wall,
-                "published_per_s": published[0] / wall,
+                "published_per_s": len(published) / wall,
                 "sent_per_s": (server.stats["sent"] - started[2]) / wall,
                 "thinned": server.stats["thinned"] - started[3],
                 "leave_p50": percentile(lags, 0.5),

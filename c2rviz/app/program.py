@@ -23,10 +23,10 @@ from ..world.clock import Clock
 from ..world.effects import NullScene, Scene
 from ..world.state import RobotState
 from ..world.world import World
-from . import rosbridge_door  # noqa: F401 (its opener joins doors.OPENERS)
 from .config import Settings
 from .doors import close_doors, open_doors
 from .members import Member, furnish
+from .rosbridge_door import open_rosbridge  # noqa: F401 (importing it adds it to OPENERS)
 
 __all__ = ["serve", "write_page"]
 

@@ -36,15 +36,11 @@ class Host(Protocol):
     bridge: Bridge
     policy: RosbridgePolicy
     stats: Counter[str]
-    sent_probe: Callable[[float, dict[str, Any]], None] | None
+    sent_probe: Callable[[float], None] | None
 
-    def graph(self) -> rosapi.Graph:
-        """What rosapi tells of c2rviz now."""
-        ...
+    def graph(self) -> rosapi.Graph: ...
 
-    def encode(self, spelling: str, msg: dict[str, Any]) -> str | None:
-        """The ``publish`` frame of ``msg`` on ``spelling`` (None: it cannot be sent)."""
-        ...
+    def encode(self, spelling: str, msg: dict[str, Any]) -> str | None: ...
 
 
 class Connection:

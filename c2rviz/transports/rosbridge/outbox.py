@@ -43,9 +43,8 @@ class Outbox:
         send: Sends one text frame to the client.
         encode: Makes the frame for ``(spelling, msg)``; None if it cannot be sent.
         stats: Counts ``thinned`` (messages pushed out unsent) and ``sent``.
-        sent_probe: Called with the monotonic time [s] a message was delivered
-            and the message, just after its frame was written; for benchmarks,
-            None otherwise.
+        sent_probe: Called with the monotonic time [s] a message was delivered,
+            just after its frame was written; for benchmarks, None otherwise.
     """
 
     def __init__(
@@ -54,7 +53,7 @@ class Outbox:
         send: Callable[[str], Awaitable[None]],
         encode: Encode,
         stats: Counter[str],
-        sent_probe: Callable[[float, dict[str, Any]], None] | None = None,
+        sent_probe: Callable[[float], None] | None = None,
     ) -> None:
         self.spelling = spelling
         self.handle: object = None
@@ -147,7 +146,7 @@ class Outbox:
                     last_sent = loop.time()
                     self._stats["sent"] += 1
                     if self._probe is not None:
-                        self._probe(delivered, msg)
+                        self._probe(delivered)
         except ConnectionClosed:
             pass  # the connection's handler sees it too, and closes this outbox
         except Exception:

@@ -53,8 +53,7 @@ class RosbridgeServer:
         policy: Origins, token and limits.
         node_name: The node ``/rosapi/nodes`` names.
         sent_probe: Called with the monotonic time [s] of each message's
-            delivery and the message, just after its frame was written
-            (benchmarks; None).
+            delivery just after its frame was written (benchmarks; None).
 
     Attributes:
         stats: Counts: ``sent`` frames of subscriptions, ``thinned`` messages
@@ -68,7 +67,7 @@ class RosbridgeServer:
         policy: RosbridgePolicy | None = None,
         *,
         node_name: str = "/c2rviz",
-        sent_probe: Callable[[float, dict[str, Any]], None] | None = None,
+        sent_probe: Callable[[float], None] | None = None,
     ) -> None:
         self.bridge = bridge
         self.policy = policy or RosbridgePolicy()
