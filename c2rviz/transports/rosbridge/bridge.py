@@ -64,6 +64,16 @@ class Bridge(Protocol):
         """
         ...
 
+    def snapshot(self, topic: str) -> dict[str, Any] | None:
+        """The whole state of ``topic`` now, for a subscriber that missed some of its messages.
+
+        The server asks when a slow subscriber's outbox pushed a message out. Return
+        None where each message is whole (a joint state: the latest is enough); a
+        topic of changes (markers added and deleted) returns one message that
+        replaces all before it.
+        """
+        ...
+
     def unsubscribe(self, handle: object) -> None:
         """Stop the deliveries of ``handle`` (from ``subscribe``); idempotent."""
         ...

@@ -13,6 +13,7 @@ import asyncio
 import logging
 from collections import Counter
 from collections.abc import Callable
+from functools import partial
 from typing import Any, Protocol
 
 from websockets.asyncio.server import ServerConnection
@@ -182,11 +183,17 @@ class Connection:
             outbox.request(op.id, op.throttle_rate_ms, length)
             return
         server = self.server
+        name = resolve_name(op.topic)
         outbox = Outbox(
-            op.topic, self.websocket.send, server.encode, server.stats, server.sent_probe
+            op.topic,
+            self.websocket.send,
+            server.encode,
+            server.stats,
+            server.sent_probe,
+            snapshot=partial(self.bridge.snapshot, name),
         )
         outbox.request(op.id, op.throttle_rate_ms, length)
-        outbox.handle = self.bridge.subscribe(resolve_name(op.topic), outbox.deliver)
+        outbox.handle = self.bridge.subscribe(name, outbox.deliver)
         self.outboxes[op.topic] = outbox
         outbox.start()
 

@@ -143,6 +143,9 @@ class RobotBridge:
     def unsubscribe(self, handle: object) -> None:
         self.hub.unsubscribe(handle)
 
+    def snapshot(self, topic: str) -> dict[str, Any] | None:
+        return self.hub.snapshot(topic)
+
     def _published(self) -> list[str]:
         return [topic for topic, _ in self._types if topic not in self._taken]
 

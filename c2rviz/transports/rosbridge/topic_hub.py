@@ -9,7 +9,9 @@ topic's greeting is its last message (``/tf_static``, ``/robot_description``);
 others give the state now (``/joint_states``: where the arm is, so a dashboard
 opened beside a resting arm shows it). A topic may also have a *watcher*, told
 when its first subscriber comes and its last goes (``/c2rviz/events`` listens
-to the watch hub only while someone reads it).
+to the watch hub only while someone reads it). A topic of *changes* (markers
+added and deleted) hands its greeting, the whole state, to a subscriber that
+missed some of its messages (``snapshot``).
 """
 
 from __future__ import annotations
@@ -44,12 +46,23 @@ class TopicHub:
         self._subscribers: dict[str, dict[_Handle, Deliver]] = {}
         self._greetings: dict[str, Greeting] = {}
         self._watchers: dict[str, Watcher] = {}
+        self._changes: set[str] = set()
 
     def add_topic(
-        self, topic: str, greeting: Greeting | None = None, watcher: Watcher | None = None
+        self,
+        topic: str,
+        greeting: Greeting | None = None,
+        watcher: Watcher | None = None,
+        changes: bool = False,
     ) -> None:
-        """Publish ``topic`` from now on (with what a new subscriber gets, and who is told)."""
+        """Publish ``topic`` from now on (with what a new subscriber gets, and who is told).
+
+        ``changes``: its messages are changes (markers added, deleted), so a subscriber
+        that missed one is brought up to date with the greeting (``snapshot``).
+        """
         self._subscribers.setdefault(topic, {})
+        if changes:
+            self._changes.add(topic)
         if greeting is not None:
             self._greetings[topic] = greeting
         if watcher is not None:
@@ -90,6 +103,11 @@ class TopicHub:
             watcher = self._watchers.get(handle.topic)
             if watcher is not None:
                 watcher(False)
+
+    def snapshot(self, topic: str) -> dict[str, Any] | None:
+        """The greeting of a topic of changes (its whole state now); None for the others."""
+        greeting = self._greetings.get(topic) if topic in self._changes else None
+        return greeting() if greeting is not None else None
 
     def wanted(self, topic: str) -> bool:
         """Whether anyone subscribes to ``topic`` now (else its messages need not be made)."""

@@ -19,7 +19,9 @@ that changed and only for topics someone reads:
 
 ``/tf_static`` and ``[NS]/robot_description`` are latched from the start;
 events (``watch``'s texts) go out on ``[NS]/c2rviz/events`` as they happen.
-New subscribers of joints, TF and markers get the state now at once.
+New subscribers of joints, TF and markers get the state now at once; a marker
+subscriber too slow to take every change gets that whole state again instead
+of the changes it missed (a topic of changes: ``TopicHub.snapshot``).
 """
 
 from __future__ import annotations
@@ -93,7 +95,7 @@ class WorldFeed(Observer):
             model = world.contacts.models.get(name)  # built only if it has objects or checks
             feed.objects = model.object_list() if model is not None else ()
             hub.add_topic(topics.joint_states, partial(self._joints_now, topics))
-            hub.add_topic(topics.markers, partial(self._markers_now, feed))
+            hub.add_topic(topics.markers, partial(self._markers_now, feed), changes=True)
             hub.add_topic(topics.events, watcher=self._events_read)
             hub.add_topic(topics.reply)
             hub.add_topic(topics.robot_description)

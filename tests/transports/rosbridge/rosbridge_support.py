@@ -52,6 +52,7 @@ class CounterBridge:
         self.published: queue.Queue[tuple[str, str, Any]] = queue.Queue()
         self.calls: queue.Queue[str] = queue.Queue()
         self.sources: queue.Queue[tuple[str, str]] = queue.Queue()
+        self.changes = False
         self.release = asyncio.Event()  # a service call "hold" waits for it (set on the loop)
         self.release.set()
 
@@ -79,6 +80,10 @@ class CounterBridge:
             deliver(self.latched)
         self.subscribed.put(topic)
         return handle
+
+    def snapshot(self, topic: str) -> dict[str, Any] | None:
+        """With ``changes`` set, /counter's messages count as changes: its whole state."""
+        return {"data": f"all {self.count}"} if self.changes and topic == "/counter" else None
 
     def unsubscribe(self, handle: object) -> None:
         entry = self.deliveries.pop(handle, None)

@@ -197,6 +197,18 @@ def test_latest_wins_when_messages_come_faster_than_they_go(
     assert rosbridge.server.stats["thinned"] == 5
 
 
+def test_a_topic_of_changes_sends_its_whole_state_after_a_thinning(
+    rosbridge: ServerThread, client: ClientConnection
+) -> None:
+    rosbridge.bridge.changes = True  # /counter's messages are changes now (as markers are)
+    subscribe(client, rosbridge, "/counter")
+    rosbridge.call(rosbridge.bridge.tick, 6)  # six before the outbox can send one: 5 pushed out
+    assert receive(client)["msg"] == {"data": "all 6"}  # the whole state, not the last change
+    rosbridge.call(rosbridge.bridge.tick)
+    assert receive(client)["msg"] == {"data": "7"}  # then changes again
+    assert rosbridge.server.stats["thinned"] == 5
+
+
 def test_queue_length_keeps_the_newest_few(
     rosbridge: ServerThread, client: ClientConnection
 ) -> None:
