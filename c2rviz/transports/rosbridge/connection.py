@@ -13,7 +13,6 @@ import asyncio
 import logging
 from collections import Counter
 from collections.abc import Callable
-from functools import partial
 from typing import Any, Protocol
 
 from websockets.asyncio.server import ServerConnection
@@ -190,7 +189,7 @@ class Connection:
             server.encode,
             server.stats,
             server.sent_probe,
-            snapshot=partial(self.bridge.snapshot, name),
+            snapshot=lambda: self.bridge.snapshot(name),
         )
         outbox.request(op.id, op.throttle_rate_ms, length)
         outbox.handle = self.bridge.subscribe(name, outbox.deliver)
