@@ -19,11 +19,11 @@ import secrets
 import sys
 from collections.abc import Callable, Sequence
 
-from ..errors import C2rvizError, ConfigError
+from ..errors import C2rvizError, ConfigError, shown
 from ..session.services import Services
 from ..transports.rosbridge import PolicyError, RosbridgePolicy, RosbridgeServer
+from ..transports.rosbridge.policy import normalize_origin
 from ..transports.rosbridge.robot_bridge import RobotBridge
-from ..view.policy import DoorPolicy
 from .config import Settings
 from .doors import OPENERS, Door, Opened, open_port
 from .members import Member
@@ -41,6 +41,23 @@ def _is_loopback(host: str) -> bool:
         return ipaddress.ip_address(host).is_loopback
     except ValueError:
         return False
+
+
+def _check_viewer_settings(settings: Settings) -> None:
+    """Refuse a ``--viewer-origin`` or ``--viewer-token`` that cannot work, in the viewer's
+    words: the door shares them and opens first (the page is not loaded to check them).
+
+    Raises:
+        ConfigError: naming the setting and what it must be.
+    """
+    for origin in settings.viewer_origins:
+        if normalize_origin(origin) is None:
+            raise ConfigError(
+                f"viewer origin {shown(origin)} is not scheme://host[:port] (http or https)"
+            )
+    token = settings.viewer_token
+    if token is not None and not (token.isascii() and token.isprintable()):
+        raise ConfigError(f"viewer token {shown(token)} is not printable ASCII")
 
 
 class RosbridgeDoor:
@@ -89,8 +106,7 @@ async def open_rosbridge(
     """
     if not settings.rosbridge:
         return []
-    # The origins and token are the viewer's settings: a bad one is refused in its words.
-    DoorPolicy(settings.viewer_origins, settings.viewer_token, settings.max_viewers)
+    _check_viewer_settings(settings)
     try:
         door = RosbridgeDoor(services, settings, on_quit)
     except PolicyError as exc:  # a --viewer-origin or --viewer-token that cannot work
