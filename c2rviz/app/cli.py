@@ -99,6 +99,20 @@ def build_parser() -> argparse.ArgumentParser:
         "default: none on loopback, else one generated at start)",
     )
     add("--max-viewers", type=int, metavar="N", help="viewer tabs at once (default 16)")
+    add(
+        "--rosbridge-port",
+        type=int,
+        metavar="PORT",
+        help="port of the rosbridge websocket for ROS tools (roslibpy, roslibjs) on "
+        "--host (default 9090; 0 picks a free one; docs/rosbridge.md)",
+    )
+    add(
+        "--no-rosbridge",
+        dest="rosbridge",
+        action="store_const",
+        const=False,
+        help="serve no rosbridge websocket",
+    )
     add("--hz", type=float, help="most scene updates per second (default 100)")
     add(
         "--motion",

@@ -93,6 +93,11 @@ class Settings:
     """The token the page needs (``?token=``); None: none, unless bound beyond loopback."""
     max_viewers: int = 16
     """Viewer tabs connected at once."""
+    rosbridge: bool = True
+    """Serve rosbridge (``--no-rosbridge``: not)."""
+    rosbridge_port: int | None = None
+    """The rosbridge websocket's port (``--rosbridge-port``, ini ``rosbridge_port``); None:
+    the default 9090, which costs only the door when taken."""
     robot: str = "motoman_sia20d"
     urdf: Path | None = None
     base: str | None = None
@@ -142,6 +147,7 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "trail_points": ("trail_points", int, 16, 10_000_000),
     "max_objects": ("max_objects", int, 0, 10_000),
     "max_viewers": ("max_viewers", int, 1, 1024),
+    "rosbridge_port": ("rosbridge_port", int, 0, 65535),
 }
 _TEXT_OPTIONS = (
     "host",

@@ -36,10 +36,12 @@ class Door(Protocol):
 
 @dataclass(frozen=True)
 class Opened:
-    """A door that opened, and the line the banner says of it."""
+    """A door that opened, the line the banner says of it, and a warning if it has one
+    (printed with the program's, e.g. listening beyond loopback)."""
 
     door: Door
     banner: str
+    warning: str | None = None
 
 
 Opener = Callable[

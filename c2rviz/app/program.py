@@ -27,6 +27,7 @@ from ..world.world import World
 from .config import Settings, replaced_bundled
 from .doors import close_doors, open_doors
 from .members import Member, furnish
+from .rosbridge_door import open_rosbridge  # noqa: F401 (importing it adds it to OPENERS)
 
 __all__ = ["serve", "write_page"]
 
@@ -199,6 +200,9 @@ async def serve(
             file=sys.stderr,
             flush=True,
         )
+    for entry in doors:
+        if entry.warning is not None:
+            print(f"c2rviz: warning: {entry.warning}", file=sys.stderr, flush=True)
     try:
         await stop.wait()
     finally:

@@ -23,8 +23,10 @@ lines, and the unread-replies limit does not count them.
 
 ``WatchHub`` is one per world (the app makes it, and hands it to the sessions
 and the doors): the observer that fans the world's effects out to the active
-streams (it is in the world's observers only while someone watches, so an
-unwatched server pays nothing). ``WatchStream`` is one per connection.
+streams, and the event texts to its listeners (``listen``: consumers without a
+socket, such as rosbridge's ``/c2rviz/events``). It is in the world's
+observers only while someone watches or listens, so an unwatched server pays
+nothing. ``WatchStream`` is one per connection.
 """
 
 from __future__ import annotations
@@ -32,7 +34,7 @@ from __future__ import annotations
 import asyncio
 import math
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Protocol
 
 from ..errors import C2rvizError
@@ -45,6 +47,7 @@ from ..world.world import World
 
 __all__ = [
     "MAX_EVENTS",
+    "EventListener",
     "STREAM_ALLOWANCE_BYTES",
     "STREAM_HIGH_BYTES",
     "NotAConnection",
@@ -63,6 +66,12 @@ STREAM_ALLOWANCE_BYTES = STREAM_HIGH_BYTES + MAX_EVENTS * 1024
 """Most stream output that can sit in a connection's write buffer: one write past the
 high-water mark (the dropped count, every held event, a state). The unread-replies limit
 counts only what is beyond it."""
+
+
+EventListener = Callable[[str | None, str], None]
+"""``listener(robot, text)``: an event of ``robot`` (None: of every robot), its text as a
+``watch`` line gives it after ``event `` (``arrived``, ``marker x,y,z,roll,pitch,yaw SHAPE
+r,g,b`` with angles in radians); for consumers without a socket (rosbridge's events topic)."""
 
 
 class NotAConnection(C2rvizError):
@@ -224,6 +233,7 @@ class WatchHub(Observer):
         """Clock time [s] that ``state`` lines count from (the server's start)."""
         self.streams: dict[Watcher, WatchStream] = {}
         self.active: list[WatchStream] = []
+        self.listeners: list[EventListener] = []
         self._seq = 0
 
     @property
@@ -259,8 +269,7 @@ class WatchHub(Observer):
             raise NotAConnection(session.source)
         stream.start(self.default_hz if hz is None else hz)
         if stream not in self.active:
-            if not self.active:
-                self.world.add_observers([self])
+            self._engage()
             self.active.append(stream)
 
     def unwatch(self, session: Watcher) -> bool:
@@ -275,16 +284,40 @@ class WatchHub(Observer):
         stream.stop()
         if stream in self.active:
             self.active.remove(stream)
-            if not self.active:
-                self.world.remove_observer(self)
+            self._disengage()
+
+    # Listeners: event texts for consumers without a socket.
+
+    def listen(self, listener: EventListener) -> None:
+        """Call ``listener(robot, text)`` with every event from now on."""
+        self._engage()
+        self.listeners.append(listener)
+
+    def unlisten(self, listener: EventListener) -> None:
+        """Stop calling ``listener``; idempotent."""
+        if listener in self.listeners:
+            self.listeners.remove(listener)
+            self._disengage()
+
+    def _engage(self) -> None:
+        """Someone is about to need the world's effects: be among its observers."""
+        if not self.active and not self.listeners:
+            self.world.add_observers([self])
+
+    def _disengage(self) -> None:
+        """Nobody needs them any more: an unwatched server pays nothing."""
+        if not self.active and not self.listeners:
+            self.world.remove_observer(self)
 
     def event(self, text: str, robot: str | None = None) -> None:
-        """Tell every watcher (of ``robot``, or all) ``event TEXT``."""
+        """Tell every watcher (of ``robot``, or all) ``event TEXT``, and every listener."""
         seq = self.next_seq()
         line = f"event {text}"
         for stream in self.active:
             if robot is None or stream.robot == robot:
                 stream.event(line, seq)
+        for listener in list(self.listeners):
+            listener(robot, text)
 
     # The world's effects.
 
@@ -306,6 +339,10 @@ class WatchHub(Observer):
                 angle = stream.session.angle_scale
                 pose = replies.numbers([x, y, z, roll / angle, pitch / angle, yaw / angle])
                 stream.event(f"event marker {pose} {marker.shape} {rgb}", seq)
+        if self.listeners:
+            text = f"marker {replies.numbers([x, y, z, roll, pitch, yaw])} {marker.shape} {rgb}"
+            for listener in list(self.listeners):
+                listener(robot, text)
 
     def on_clear_markers(self, robot: str) -> None:
         self.event("clear", robot)

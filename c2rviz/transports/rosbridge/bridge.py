@@ -40,6 +40,14 @@ class Bridge(Protocol):
         """Parameters by name for ``/rosapi/get_param``: ``robot_description`` (URDF text)."""
         ...
 
+    def opened(self, source: str) -> None:
+        """A client connected: ``source`` (``rosbridge 127.0.0.1:50412``) names it from now on."""
+        ...
+
+    def closed(self, source: str) -> None:
+        """The client ``source`` is gone (its subscriptions are already stopped)."""
+        ...
+
     def subscribe(self, topic: str, deliver: Deliver) -> object:
         """Start calling ``deliver(msg)`` for each message of ``topic``; return a handle.
 
@@ -53,6 +61,16 @@ class Bridge(Protocol):
 
         Raises:
             C2rvizError: ``topic`` is not one c2rviz publishes.
+        """
+        ...
+
+    def snapshot(self, topic: str) -> dict[str, Any] | None:
+        """The whole state of ``topic`` now, for a subscriber that missed some of its messages.
+
+        The server asks when a slow subscriber's outbox pushed a message out. Return
+        None where each message is whole (a joint state: the latest is enough); a
+        topic of changes (markers added and deleted) returns one message that
+        replaces all before it.
         """
         ...
 

@@ -58,22 +58,35 @@ class Connection:
         self._serving: asyncio.Future[None] | None = None
 
     async def run(self) -> None:
-        """Serve the connection's frames in order until it closes or the server stops."""
+        """Serve the connection's frames in order until it closes or the server stops.
+
+        A client that leaves while its request waits (a service call on a long
+        move) gives that request up at once: nobody is left to answer.
+        """
+        gone = asyncio.ensure_future(self.websocket.wait_closed())
         try:
             async for frame in self.websocket:
                 if self.stopping:
                     break
-                self._serving = asyncio.ensure_future(self.handle(frame))
+                serving = self._serving = asyncio.ensure_future(self.handle(frame))
                 try:
-                    await self._serving
-                except asyncio.CancelledError:
-                    if self.stopping:
+                    await asyncio.wait((serving, gone), return_when=asyncio.FIRST_COMPLETED)
+                    if not serving.done():  # the client left while its request waited
+                        serving.cancel()
+                        await asyncio.gather(serving, return_exceptions=True)
                         break
+                    serving.result()
+                except asyncio.CancelledError:
+                    if self.stopping or serving.cancelled():
+                        break
+                    serving.cancel()  # this task is cancelled: its request goes with it
                     raise
                 finally:
                     self._serving = None
         except ConnectionClosed:
             pass
+        finally:
+            gone.cancel()
 
     def stop(self) -> None:
         """Give up the request being served (a service call that waits) and read no more."""
@@ -169,11 +182,17 @@ class Connection:
             outbox.request(op.id, op.throttle_rate_ms, length)
             return
         server = self.server
+        name = resolve_name(op.topic)
         outbox = Outbox(
-            op.topic, self.websocket.send, server.encode, server.stats, server.sent_probe
+            op.topic,
+            self.websocket.send,
+            server.encode,
+            server.stats,
+            server.sent_probe,
+            snapshot=lambda: self.bridge.snapshot(name),
         )
         outbox.request(op.id, op.throttle_rate_ms, length)
-        outbox.handle = self.bridge.subscribe(resolve_name(op.topic), outbox.deliver)
+        outbox.handle = self.bridge.subscribe(name, outbox.deliver)
         self.outboxes[op.topic] = outbox
         outbox.start()
 

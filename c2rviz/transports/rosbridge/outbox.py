@@ -11,6 +11,11 @@ that arrives when it is full pushes out the oldest (latest wins, counted as
 ``thinned``). A subscriber that reads slowly, or a throttle, thus thins the
 stream and never grows memory: the websocket's write buffer (``write_limit``)
 plus this outbox is all a subscriber can hold.
+
+Latest wins only where each message is whole (a joint state). A topic whose
+messages are changes (markers added, deleted) gives a ``snapshot``: once a
+message was pushed out, the next frame sent is the snapshot, the whole state
+then, instead of what waits; the subscriber misses nothing but time.
 """
 
 from __future__ import annotations
@@ -45,6 +50,8 @@ class Outbox:
         stats: Counts ``thinned`` (messages pushed out unsent) and ``sent``.
         sent_probe: Called with the monotonic time [s] a message was delivered,
             just after its frame was written; for benchmarks, None otherwise.
+        snapshot: Gives the topic's whole state (None: its messages are whole),
+            sent instead of what waits after a message was pushed out.
     """
 
     def __init__(
@@ -54,8 +61,11 @@ class Outbox:
         encode: Encode,
         stats: Counter[str],
         sent_probe: Callable[[float], None] | None = None,
+        snapshot: Callable[[], dict[str, Any] | None] | None = None,
     ) -> None:
         self.spelling = spelling
+        self._snapshot = snapshot
+        self._behind = False  # a message was pushed out: send the snapshot next
         self.handle: object = None
         self.requests: dict[FrameId, tuple[int, int]] = {}
         self._send, self._encode, self._stats, self._probe = send, encode, stats, sent_probe
@@ -111,6 +121,7 @@ class Outbox:
             return
         if len(self._queue) == self._queue.maxlen:
             self._stats["thinned"] += 1
+            self._behind = self._snapshot is not None
         self._queue.append((msg, delivered))
         self._wake.set()
 
@@ -126,6 +137,15 @@ class Outbox:
             self._task.cancel()
             await asyncio.gather(self._task, return_exceptions=True)
 
+    def _catch_up(self) -> None:
+        """Put the topic's whole state in place of what waits (if its messages are changes)."""
+        self._behind = False
+        assert self._snapshot is not None
+        whole = self._snapshot()
+        if whole is not None:
+            self._queue.clear()
+            self._queue.append((whole, time.monotonic()))
+
     async def _pump(self) -> None:
         loop = asyncio.get_running_loop()
         last_sent = -float("inf")
@@ -138,6 +158,8 @@ class Outbox:
                     if wait_s > 0:
                         await asyncio.sleep(wait_s)  # newer messages push older ones out meanwhile
                         continue
+                    if self._behind:
+                        self._catch_up()
                     msg, delivered = self._queue.popleft()
                     text = self._encode(self.spelling, msg)
                     if text is None:

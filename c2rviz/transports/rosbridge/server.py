@@ -168,6 +168,7 @@ class RosbridgeServer:
             return
         connection = Connection(self, websocket)
         self._connections.add(connection)
+        self.bridge.opened(connection.source)
         try:
             await connection.run()
             if connection.stopping:  # as websockets closes the others when the server stops
@@ -175,3 +176,4 @@ class RosbridgeServer:
         finally:
             self._connections.discard(connection)
             await connection.close()
+            self.bridge.closed(connection.source)

@@ -51,6 +51,8 @@ class CounterBridge:
         self.unsubscribed: queue.Queue[str] = queue.Queue()
         self.published: queue.Queue[tuple[str, str, Any]] = queue.Queue()
         self.calls: queue.Queue[str] = queue.Queue()
+        self.sources: queue.Queue[tuple[str, str]] = queue.Queue()
+        self.changes = False
         self.release = asyncio.Event()  # a service call "hold" waits for it (set on the loop)
         self.release.set()
 
@@ -63,6 +65,12 @@ class CounterBridge:
     def params(self) -> dict[str, object]:
         return {"robot_description": "<robot name='counter'/>"}
 
+    def opened(self, source: str) -> None:
+        self.sources.put(("opened", source))
+
+    def closed(self, source: str) -> None:
+        self.sources.put(("closed", source))
+
     def subscribe(self, topic: str, deliver: Callable[[dict[str, Any]], None]) -> object:
         if topic not in ("/counter", "/latched"):
             raise C2rvizError(f"{topic} is not published here")
@@ -72,6 +80,10 @@ class CounterBridge:
             deliver(self.latched)
         self.subscribed.put(topic)
         return handle
+
+    def snapshot(self, topic: str) -> dict[str, Any] | None:
+        """With ``changes`` set, /counter's messages count as changes: its whole state."""
+        return {"data": f"all {self.count}"} if self.changes and topic == "/counter" else None
 
     def unsubscribe(self, handle: object) -> None:
         entry = self.deliveries.pop(handle, None)

@@ -197,6 +197,18 @@ def test_latest_wins_when_messages_come_faster_than_they_go(
     assert rosbridge.server.stats["thinned"] == 5
 
 
+def test_a_topic_of_changes_sends_its_whole_state_after_a_thinning(
+    rosbridge: ServerThread, client: ClientConnection
+) -> None:
+    rosbridge.bridge.changes = True  # /counter's messages are changes now (as markers are)
+    subscribe(client, rosbridge, "/counter")
+    rosbridge.call(rosbridge.bridge.tick, 6)  # six before the outbox can send one: 5 pushed out
+    assert receive(client)["msg"] == {"data": "all 6"}  # the whole state, not the last change
+    rosbridge.call(rosbridge.bridge.tick)
+    assert receive(client)["msg"] == {"data": "7"}  # then changes again
+    assert rosbridge.server.stats["thinned"] == 5
+
+
 def test_queue_length_keeps_the_newest_few(
     rosbridge: ServerThread, client: ClientConnection
 ) -> None:
@@ -375,3 +387,25 @@ def test_the_port_is_free_after_stop(bridge: CounterBridge) -> None:
         probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         probe.bind(("127.0.0.1", server.port))
         probe.listen()
+
+
+def test_the_bridge_hears_each_client_come_and_go(rosbridge: ServerThread) -> None:
+    with connect(rosbridge.url) as ws:
+        assert command(ws, "hi")["result"] is True
+        kind, source = rosbridge.bridge.sources.get(timeout=WAIT_S)
+        assert kind == "opened" and source.startswith("rosbridge 127.0.0.1:")
+    assert rosbridge.bridge.sources.get(timeout=WAIT_S) == ("closed", source)
+
+
+def test_a_client_leaving_gives_up_its_waiting_request(rosbridge: ServerThread) -> None:
+    rosbridge.call(rosbridge.bridge.release.clear)  # "hold" waits until released: never here
+    with connect(rosbridge.url) as ws:
+        ws.send(
+            json.dumps(
+                {"op": "call_service", "service": "/c2rviz/command", "args": {"command": "hold"}}
+            )
+        )
+        assert rosbridge.bridge.calls.get(timeout=WAIT_S) == "hold"
+    assert rosbridge.bridge.sources.get(timeout=WAIT_S)[0] == "opened"
+    assert rosbridge.bridge.sources.get(timeout=WAIT_S)[0] == "closed"  # without the release
+    assert rosbridge.server.connections == 0

@@ -1,0 +1,163 @@
+"""Joint positions and trajectories from ROS clients, checked whole and run on a ``Session``.
+
+A ``sensor_msgs/msg/JointState`` on ``[NS]/joint_command`` is a move like
+``move``: the named chain joints go to their positions [rad or m] (the others
+keep their target), through ``Session.go`` (the session's motion mode, speed and
+guard apply). A ``trajectory_msgs/msg/JointTrajectory`` on
+``[NS]/joint_trajectory`` is timed motion: it starts now from where the arm is
+(which must be at rest), passes each point at its ``time_from_start`` and is
+played on the world's clock (``motion.trajectory_play``); chain joints it does
+not name hold still. It is refused whole if any point or any instant between
+breaks a position, velocity or acceleration limit (the robot's motion limits at
+full speed, whatever the session's ``speed``), or, with ``guard on``, if any
+instant of it collides.
+
+Either is noted among the world's commands (the page's "last commands") as
+``/joint_command joint_s=0.5,...`` or ``/joint_trajectory N points, T s``,
+with whether it was accepted. Units are SI whatever the session's ``degrees``.
+"""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import Sequence
+
+import numpy as np
+
+from ...errors import ArmMoved, C2rvizError, JointLimitError
+from ...motion.trajectory import plan_trajectory
+from ...motion.trajectory_play import TrajectoryPlay
+from ...protocol import replies
+from ...robot.model import Robot
+from ...session.session import Session
+from ...tolerance import within_limit
+from .messages import JointPositions, JointTrajectory
+
+__all__ = ["MAX_GUARD_SAMPLES", "UnknownJointName", "joint_command", "joint_trajectory"]
+
+MAX_GUARD_SAMPLES = 2000
+"""Most instants of a trajectory checked for collisions (one per frame, or fewer)."""
+
+
+class UnknownJointName(C2rvizError):
+    """A joint name that is not one of the robot's chain joints."""
+
+    def __init__(self, field: str, name: str, robot: Robot, robot_name: str) -> None:
+        self.field, self.name = field, name
+        shown = name if len(name) <= 60 else name[:60] + "..."
+        super().__init__(
+            f"{field}: {shown!r} is not a joint of {robot_name}'s chain "
+            f"{robot.base} -> {robot.eelink} (its joints: {', '.join(robot.joint_names)})"
+        )
+
+
+def _indices(session: Session, field: str, names: Sequence[str]) -> list[int]:
+    index = {name: i for i, name in enumerate(session.robot.joint_names)}
+    out = []
+    for k, name in enumerate(names):
+        if name not in index:
+            raise UnknownJointName(f"{field}[{k}]", name, session.robot, session.state.name)
+        out.append(index[name])
+    return out
+
+
+def _units(robot: Robot) -> list[str]:
+    return ["m" if prismatic else "rad" for prismatic in robot.prismatic]
+
+
+def _note(session: Session, text: str, accepted: bool) -> None:
+    session.world.note(session.source, text, accepted)
+
+
+def joint_command(session: Session, command: JointPositions) -> None:
+    """Send the named joints to their positions now (or travelling, as the session moves).
+
+    Raises:
+        UnknownJointName: A name that is not a chain joint.
+        JointLimitError: A position outside its joint's limits.
+        PathCollides: With ``guard on``, the target or the way there collides.
+    """
+    text = "/joint_command " + ",".join(
+        f"{name}={replies.numbers([value])}"
+        for name, value in zip(command.names, command.positions)
+    )
+    try:
+        robot = session.robot
+        q = list(session.state.target)
+        units = _units(robot)
+        for i, value in zip(_indices(session, "name", command.names), command.positions):
+            lower, upper = robot.lower[i], robot.upper[i]
+            if not within_limit(value, lower, upper):
+                raise JointLimitError(robot.joint_names[i], i, value, lower, upper, units[i])
+            q[i] = min(max(value, lower), upper)
+        reply = session.go(q)
+    except C2rvizError:
+        _note(session, text, False)
+        raise
+    _note(session, text, True)
+    if isinstance(reply, asyncio.Future):  # motion on: nobody waits for the arrival
+        reply.add_done_callback(_forget)
+
+
+def _forget(future: asyncio.Future[str]) -> None:
+    if not future.cancelled():
+        future.exception()  # retrieved: a preempted move is no error here
+
+
+def joint_trajectory(session: Session, trajectory: JointTrajectory) -> None:
+    """Check ``trajectory`` whole, then play it from now on the world's clock.
+
+    Raises:
+        UnknownJointName: A name that is not a chain joint.
+        ArmMoved: The arm is moving (a trajectory starts from rest).
+        TrajectoryError: A point or an instant between points breaks a limit.
+        PathCollides: With ``guard on``, an instant of it collides.
+    """
+    points = trajectory.points
+    text = f"/joint_trajectory {len(points)} points, {points[-1].time_from_start_s:g} s"
+    try:
+        _play(session, trajectory)
+    except C2rvizError:
+        _note(session, text, False)
+        raise
+    _note(session, text, True)
+
+
+def _play(session: Session, trajectory: JointTrajectory) -> None:
+    indices = _indices(session, "joint_names", trajectory.joint_names)
+    if session.travel.active:
+        raise ArmMoved(
+            "a trajectory starts from rest and the arm is moving: send stop (or wait) first"
+        )
+    robot, state, world = session.robot, session.state, session.world
+    start = np.asarray(state.q, dtype=float)
+    zeros = np.zeros(robot.n)
+
+    def chain(values: Sequence[float], base: np.ndarray) -> np.ndarray:
+        full = base.copy()
+        full[indices] = values
+        return full
+
+    def given(values: Sequence[float] | None) -> np.ndarray | None:
+        return None if values is None else chain(values, zeros)
+
+    points = trajectory.points
+    planned = plan_trajectory(
+        start,
+        [p.time_from_start_s for p in points],
+        [chain(p.positions, start) for p in points],
+        [given(p.velocities) for p in points],
+        [given(p.accelerations) for p in points],
+        world.motion_limits(state.name),
+        robot.joint_names,
+        _units(robot),
+    )
+    if session.guard:
+        count = min(MAX_GUARD_SAMPLES, max(2, int(planned.duration / world.frame_s) + 1))
+        times = np.unique(
+            np.concatenate([np.linspace(0.0, planned.duration, count), planned.times])
+        )
+        path = [tuple(planned.sample(float(s)).tolist()) for s in times]
+        session.check_path(path[-1], path=path)
+    play = TrajectoryPlay(planned, world.clock.now())
+    world.travels.play(state, play, session.source, wait=False)
