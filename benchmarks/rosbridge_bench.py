@@ -74,11 +74,7 @@ async def serve() -> None:
     from c2rviz.robot.model import Robot
     from c2rviz.session import Services
     from c2rviz.transports.rosbridge import RosbridgePolicy
-
-    try:
-        from c2rviz.transports.tcp_server import CommandServer
-    except ImportError:  # where the text door's server still lives beside its connections
-        from c2rviz.transports.tcp_text import CommandServer  # type: ignore[no-redef]
+    from c2rviz.transports.tcp_server import CommandServer
     from c2rviz.world.world import World
 
     robot = Robot.from_urdf(ROOT / "robots/motoman_sia20d/robot.urdf", "base_link", "link_t")

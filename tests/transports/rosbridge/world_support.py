@@ -29,13 +29,9 @@ from c2rviz.app.rosbridge_door import RosbridgeDoor
 from c2rviz.robot.model import Robot
 from c2rviz.session import Services
 from c2rviz.transports.rosbridge import COMMAND_SERVICE_TYPE
+from c2rviz.transports.tcp_server import CommandServer
 from c2rviz.world.effects import Observer
 from c2rviz.world.world import World
-
-try:
-    from c2rviz.transports.tcp_server import CommandServer
-except ImportError:  # where the text door's server still lives beside its connections
-    from c2rviz.transports.tcp_text import CommandServer  # type: ignore[no-redef]
 
 WAIT_S = 20.0  # generous: the machine is shared; a passing test never waits this long
 
