@@ -242,6 +242,11 @@ class World:
         for observer in self.observers:
             observer.on_command(source, line, accepted)
 
+    def replied(self, source: str, line: str, reply: str) -> None:
+        """``source``'s ``line`` got ``reply``; tell the observers (recordings keep it)."""
+        for observer in self.observers:
+            observer.on_reply(source, line, reply)
+
     def add_observers(self, observers: Iterable[Observer]) -> None:
         self.observers.extend(observers)
 
