@@ -107,6 +107,9 @@ class Recorder(Observer):
         self.more_sources = 0
         self.frames = 0
         self.error: str | None = None
+        """Why its own files stopped early (a write error), if they did."""
+        self.early: str | None = None
+        """Why the recording stopped early, if it did (its own error, or its bag's)."""
         self.closed = False
         self._due = -np.inf  # when the next frame may be written [clock s]
         self._pending: Sequence[float] | None = None  # the latest state, not yet written
@@ -301,7 +304,8 @@ class Recorder(Observer):
         if self.more_sources:
             sources += f" and {self.more_sources} more"
         robot = self.state.robot.name
-        early = "" if self.error is None else f"# stopped early: {self.error}\n"
+        why = self.error or self.early
+        early = "" if why is None else f"# stopped early: {why}\n"
         return (
             f"# c2rviz recording {self.name}: play it back with c2rviz-play {self.name}.txt\n"
             f"# robot: {robot}\n"

@@ -269,6 +269,8 @@ class Recordings:
         # Called from inside the world's fan-out: leave its list of observers alone now.
         for recording in {id(r): r for r in self.running.values()}.values():
             if match(recording):
+                for recorder in recording.recorders.values():
+                    recorder.early = recorder.early or error
                 asyncio.get_running_loop().call_soon(self._end, recording, error)
                 return
 

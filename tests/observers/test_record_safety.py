@@ -193,3 +193,65 @@ def test_record_flag_says_what_it_records_and_may_overwrite(
     text = " ".join(helped.stdout.split())
     for named in ("NAME.txt", "NAME.csv", "NAME.html", "NAME/", "--record-overwrite"):
         assert named in text, named
+
+
+def test_a_file_size_limit_ends_the_recording_readable(tmp_path: Path):
+    """A real kernel write error (RLIMIT_FSIZE: EFBIG) mid-recording: the recording stops
+    with an event, the server goes on, and every file is whole up to the error, in place."""
+
+    def limited() -> None:  # in the child, before exec: both survive it
+        import resource
+
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (2_500_000, resource.RLIM_INFINITY))
+
+    popen = subprocess.Popen(
+        [sys.executable, "-m", "c2rviz", "--no-viewer", "--port", "0", "--hz", "1000"]
+        + ["--record-dir", str(tmp_path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        preexec_fn=limited,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    try:
+        assert popen.stdout is not None
+        port = None
+        while port is None:
+            line = popen.stdout.readline()
+            assert line, "c2rviz did not start"
+            if "commands on" in line:
+                port = int(line.split("commands on ")[1].split(":")[1].split()[0])
+        watcher, client = Client("127.0.0.1", port), Client("127.0.0.1", port)
+        assert watcher.ask("watch 1") == "ok"
+        assert client.ask("record big").startswith("ok recording big")
+        sent = 0
+        while True:  # a new state every 2 ms: a frame each, until the bag is too big
+            client.send("".join(f"move 0 {(sent + k) % 1000 / 2000}\nsleep 0.002\n"
+                                for k in range(100)))  # fmt: skip
+            for _ in range(200):
+                assert client.read_line() == "ok"
+            sent += 100
+            if client.ask("record") == "ok not recording":
+                break
+            assert sent < 20_000, "the bag never reached the limit"
+        seen = ""
+        while not seen.startswith("event record-stopped"):
+            seen = watcher.read_line()
+        assert seen == "event record-stopped big: write error: File too large"
+        assert client.ask("move 0 0.3") == "ok"  # the server goes on
+        deadline = time.monotonic() + 60
+        while not (tmp_path / "big.html").exists() and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert client.ask("quit") == "ok"
+        watcher.close()
+        client.close()
+        assert popen.wait(timeout=60) == 0
+    finally:
+        if popen.poll() is None:
+            popen.kill()
+        popen.communicate(timeout=60)
+    joints, rows, states = frames_of(tmp_path, "big")
+    assert 0 < states <= rows and joints == rows > 500  # the bag keeps its whole chunks
+    assert "# stopped early: write error: File too large" in (tmp_path / "big.txt").read_text()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["big", "big.csv", "big.html", "big.txt"]
