@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import itertools
 import os
 import time
 from collections import deque
@@ -302,7 +303,7 @@ def _go(
     try:
         setup = ["radians", f"motion {args.motion or 'off'}"]
         while args.loop == 0 or loops < args.loop:
-            if stream(client, [*setup, *command_lines(span)], args.window, err, name):
+            if stream(client, itertools.chain(setup, command_lines(span)), args.window, err, name):
                 return 1
             loops += 1
             setup = []
@@ -335,7 +336,8 @@ def play_in_repl(client: Client, path: str, rate: float, out: TextIO) -> int:
     with contextlib.closing(span.bag):
         for warning in warnings:
             print(f"warning: {path}: {warning}", file=out, flush=True)
-        errors = stream(client, ["radians", "motion off", *command_lines(span)], 2, out, path)
+        setup = ["radians", "motion off"]
+        errors = stream(client, itertools.chain(setup, command_lines(span)), 2, out, path)
     restore = ["degrees"] * degrees + ([f"motion {motion}"] if motion not in (None, "off") else [])
     errors += stream(client, restore, 1, out, path)  # the connection as it was
     if not errors:

@@ -234,3 +234,24 @@ def test_bad_flags(server: ServerThread, mcap_bag: Path, capsys) -> None:
     assert play(server, mcap_bag, "--duration", "-1") == 1
     assert "duration -1.0 s is not a positive time" in capsys.readouterr().err
     assert shown(server) == []
+
+
+def test_lines_are_sent_as_the_bag_is_read(
+    server: ServerThread, mcap_bag: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Streamed, never gathered: when the 100th line is read from the bag, the lines before
+    it have been answered already (memory stays flat however long the bag)."""
+    from c2rviz.clients import bag_play
+
+    answered_then: list[int] = []
+    read = bag_play.command_lines
+
+    def watched(span: bag_play.BagSpan):  # type: ignore[no-untyped-def]
+        for k, line in enumerate(read(span)):
+            if k == 100:
+                answered_then.append(len(heard(server)))
+            yield line
+
+    monkeypatch.setattr(bag_play, "command_lines", watched)
+    assert play(server, mcap_bag, "--window", "1") == 0
+    assert answered_then and answered_then[0] >= 4 + 99  # names, limits, radians, motion off
