@@ -19,7 +19,8 @@ or for several robots of a cell at once:
   or changed, DELETE when removed), in the frames the page shows them in;
 - ``/c2rviz/commands``: each accepted command as ``SOURCE: LINE``, and
   ``/c2rviz/replies``: each reply as ``SOURCE: LINE -> REPLY``, from every source
-  (as NAME.txt's ``# sources``).
+  (as NAME.txt's ``# sources``); the lines of one frame (``1/hz``) are one message,
+  a line each, stamped with the first one's time and written when the frame is over.
 
 NS is the robot's name in a cell (``/left/joint_states``, frames
 ``left/base_link``), none for a robot alone. Every stamp, header and log time
@@ -43,6 +44,7 @@ from ..ros import markers as mk
 from ..ros.bag_writer import BagWriter
 from ..ros.messages import Msg
 from ..ros.robot_bag import BagRobot
+from ..world.clock import Clock, Timer
 from ..world.effects import Observer
 from ..world.state import MAX_MARKERS, Marker, RobotState
 from ..world.world import World
@@ -97,6 +99,36 @@ class _Arm:
     last: tuple[float, Sequence[float]] | None = None  # the previous frame: (t [s], q)
 
 
+class _Lines:
+    """The lines of a text topic within one frame, written as one ``String`` when the frame
+    is over (a flood of commands costs a list append each, not a bag message each)."""
+
+    def __init__(self, writer: BagWriter, topic: str, clock: Clock, t0: float, period_s: float):
+        self.writer = writer
+        self.topic = topic
+        self.clock = clock
+        self.t0 = t0
+        self.period_s = period_s
+        self.t_s = 0.0  # the first line's time [s from the start]
+        self.lines: list[str] = []
+        self.timer: Timer | None = None
+
+    def add(self, text: str) -> None:
+        if not self.lines:
+            now = self.clock.now()
+            self.t_s = max(0.0, now - self.t0)
+            self.timer = self.clock.call_at(now + self.period_s, self.flush)
+        self.lines.append(text)
+
+    def flush(self) -> None:
+        if self.timer is not None:
+            self.timer.cancel()
+            self.timer = None
+        if self.lines:
+            self.writer.text(self.topic, self.t_s, "\n".join(self.lines))
+            self.lines = []
+
+
 class BagRecorder(Observer):
     """The bag of one recording (one robot, or a cell's robots); on the asyncio thread."""
 
@@ -129,6 +161,9 @@ class BagRecorder(Observer):
         self.peers: list[Recorder] = []
         """The recorders whose frames come here (their due frames are written first)."""
         self.writer = BagWriter(path, on_error=self._failed)
+        lines = (world.clock, t0, world.frame_s)
+        self.commands = _Lines(self.writer, "/c2rviz/commands", *lines)
+        self.replies = _Lines(self.writer, "/c2rviz/replies", *lines)
         in_cell = len(world.robots) > 1
         spaces = namespaces(list(world.robots)) if in_cell else {}
         self.arms: dict[str, _Arm] = {}
@@ -223,20 +258,26 @@ class BagRecorder(Observer):
 
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         if accepted and not self.closed:
-            self.writer.text("/c2rviz/commands", self._t(), f"{source}: {line}")
+            self.commands.add(f"{source}: {line}")
 
     def on_reply(self, source: str, line: str, reply: str) -> None:
         if not self.closed:
-            self.writer.text("/c2rviz/replies", self._t(), f"{source}: {line} -> {reply}")
+            self.replies.add(f"{source}: {line} -> {reply}")
 
     # The end.
 
     def _failed(self, error: str) -> None:
         self.closed = True
+        for lines in (self.commands, self.replies):
+            if lines.timer is not None:
+                lines.timer.cancel()
         self.on_failed(self, error)
 
     def stop(self) -> None:
-        """No more messages (on the asyncio thread); ``close`` ends the bag."""
+        """Write what waits and take no more (on the asyncio thread); ``close`` ends the bag."""
+        if not self.closed:
+            self.commands.flush()
+            self.replies.flush()
         self.closed = True
 
     def close(self) -> str | None:

@@ -178,14 +178,17 @@ def test_the_bag_reads_back_with_rosbags(recorded: dict[str, Any]) -> None:
 
     # Each accepted command with its source, each reply with its line (refused ones too).
     source = recorded["source"]
-    commands = [message.data for _, message in by_topic["/c2rviz/commands"]]
+    def lines(topic: str) -> list[str]:  # a frame's lines are one message, a line each
+        return [line for _, message in by_topic[topic] for line in message.data.split("\n")]
+
+    commands = lines("/c2rviz/commands")
     accepted = [line for line in recorded["lines"] if line != "jonts 1"]
     assert commands == [
         f"{source}: record take",
         *(f"{source}: {line}" for line in accepted),
         f"{source}: where",
     ]
-    replies = [message.data for _, message in by_topic["/c2rviz/replies"]]
+    replies = lines("/c2rviz/replies")
     assert replies[0].startswith(f"{source}: record take -> ok recording take into ")
     assert replies[1:] == [
         *(f"{source}: {line} -> {recorded['replies'][line]}" for line in recorded["lines"]),
