@@ -187,7 +187,7 @@ async def serve(
     finally:
         # The recordings stop first and are awaited whatever closing the doors does (a
         # signal meanwhile changes nothing: the handlers stay until they are complete).
-        finishing = asyncio.ensure_future(services.recordings.close("the program stopped"))
+        finishing = services.recordings.close("the program stopped")  # stopped here, now
         try:
             await close_doors(doors)
             for server in servers:

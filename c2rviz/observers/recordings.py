@@ -25,8 +25,9 @@ import asyncio
 import logging
 import re
 import shutil
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Coroutine, Sequence
 from pathlib import Path
+from typing import Any
 
 from ..errors import C2rvizError
 from ..world.effects import Observer
@@ -274,11 +275,15 @@ class Recordings:
                 asyncio.get_running_loop().call_soon(self._end, recording, error)
                 return
 
-    async def close(self, why: str) -> list[Recorded]:
-        """Stop every recording and wait for every one to be finished (the program's end);
-        return what was finished, in the order they stopped."""
+    def close(self, why: str) -> Coroutine[Any, Any, list[Recorded]]:
+        """Stop every recording now; return a coroutine that waits for every one to be
+        finished, those stopped earlier too (the program's end), and gives what was
+        finished, in the order they stopped."""
         for recording in list({id(r): r for r in self.running.values()}.values()):
             self._end(recording, why)
+        return self._all_finished()
+
+    async def _all_finished(self) -> list[Recorded]:
         finished: list[Recorded] = []
         while self._in_flight:
             waiting = list(self._in_flight)
