@@ -178,6 +178,7 @@ def test_the_bag_reads_back_with_rosbags(recorded: dict[str, Any]) -> None:
 
     # Each accepted command with its source, each reply with its line (refused ones too).
     source = recorded["source"]
+
     def lines(topic: str) -> list[str]:  # a frame's lines are one message, a line each
         return [line for _, message in by_topic[topic] for line in message.data.split("\n")]
 
