@@ -31,57 +31,32 @@ alike, is the recording's time: seconds [s] from its start on the world's clock
 
 from __future__ import annotations
 
-import re
+import logging
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import pinocchio as pin
-
 from ..ros import markers as mk
 from ..ros.bag_writer import BagWriter
-from ..ros.messages import Msg
+from ..ros.messages import INT32, Msg
 from ..ros.robot_bag import BagRobot
-from ..world.clock import Clock, Timer
 from ..world.effects import Observer
 from ..world.state import MAX_MARKERS, Marker, RobotState
 from ..world.world import World
+from .bag_topics import TextLines, marker_message, namespaces, object_message, xyz_xyzw
 
 if TYPE_CHECKING:
     from ..collision.workcell import WorkcellObject
     from .recorder import Recorder
 
-__all__ = ["MARKER_SIZE_M", "WORLD_FRAME", "BagRecorder", "namespaces"]
+__all__ = ["WORLD_FRAME", "BagRecorder"]
+
+log = logging.getLogger("c2rviz.record")
 
 WORLD_FRAME = "world"
 """The cell's frame in a bag of a cell."""
-MARKER_SIZE_M = 0.03
-"""A marker's size as the page draws it (``view.markers``) [m]."""
-_S = MARKER_SIZE_M
-_SCALES = {  # visualization_msgs scale of each marker shape, as the page draws it
-    "sphere": (_S, _S, _S),
-    "cube": (_S, _S, _S),
-    "cylinder": (2 * _S / 3, 2 * _S / 3, _S),
-    "arrow": (1.7 * _S, _S / 4, 2 * _S / 3),
-}
-_NOT_ROS = re.compile(r"[^A-Za-z0-9_]")
-
-
-def namespaces(names: Sequence[str]) -> dict[str, str]:
-    """A ROS namespace for each robot name, unique: characters other than letters, digits
-    and ``_`` become ``_``, a leading digit or ``_`` gets ``r`` before it."""
-    out: dict[str, str] = {}
-    for name in names:
-        ns = _NOT_ROS.sub("_", name)
-        ns = ns if ns[:1].isalpha() else "r" + ns
-        base, k = ns, 1
-        while ns in out.values():
-            k += 1
-            ns = f"{base}_{k}"
-        out[name] = ns
-    return out
 
 
 @dataclass(eq=False)
@@ -95,38 +70,9 @@ class _Arm:
     live: deque[int] = field(default_factory=deque)  # marker ids shown, oldest first
     next_id: int = 0
     objects: dict[str, WorkcellObject] = field(default_factory=dict)
-    object_ids: dict[str, int] = field(default_factory=dict)
+    object_ids: dict[str, int] = field(default_factory=dict)  # of the objects there now
+    next_object: int = 0
     last: tuple[float, Sequence[float]] | None = None  # the previous frame: (t [s], q)
-
-
-class _Lines:
-    """The lines of a text topic within one frame, written as one ``String`` when the frame
-    is over (a flood of commands costs a list append each, not a bag message each)."""
-
-    def __init__(self, writer: BagWriter, topic: str, clock: Clock, t0: float, period_s: float):
-        self.writer = writer
-        self.topic = topic
-        self.clock = clock
-        self.t0 = t0
-        self.period_s = period_s
-        self.t_s = 0.0  # the first line's time [s from the start]
-        self.lines: list[str] = []
-        self.timer: Timer | None = None
-
-    def add(self, text: str) -> None:
-        if not self.lines:
-            now = self.clock.now()
-            self.t_s = max(0.0, now - self.t0)
-            self.timer = self.clock.call_at(now + self.period_s, self.flush)
-        self.lines.append(text)
-
-    def flush(self) -> None:
-        if self.timer is not None:
-            self.timer.cancel()
-            self.timer = None
-        if self.lines:
-            self.writer.text(self.topic, self.t_s, "\n".join(self.lines))
-            self.lines = []
 
 
 class BagRecorder(Observer):
@@ -161,9 +107,11 @@ class BagRecorder(Observer):
         self.peers: list[Recorder] = []
         """The recorders whose frames come here (their due frames are written first)."""
         self.writer = BagWriter(path, on_error=self._failed)
-        lines = (world.clock, t0, world.frame_s)
-        self.commands = _Lines(self.writer, "/c2rviz/commands", *lines)
-        self.replies = _Lines(self.writer, "/c2rviz/replies", *lines)
+        lines = (world.clock, t0, world.frame_s, self._broken)
+        self.error: str | None = None
+        """Why the bag stopped early, if it did."""
+        self.commands = TextLines(self.writer, "/c2rviz/commands", *lines)
+        self.replies = TextLines(self.writer, "/c2rviz/replies", *lines)
         in_cell = len(world.robots) > 1
         spaces = namespaces(list(world.robots)) if in_cell else {}
         self.arms: dict[str, _Arm] = {}
@@ -172,7 +120,7 @@ class BagRecorder(Observer):
             ns = spaces.get(name, "")
             arm = BagRobot(self.writer, state.robot, ns)
             placed = in_cell or (not state.origin.isIdentity() and arm.tree.root != WORLD_FRAME)
-            arm.start(0.0, _xyz_xyzw(state.origin) if placed else None, WORLD_FRAME)
+            arm.start(0.0, xyz_xyzw(state.origin) if placed else None, WORLD_FRAME)
             prefix = ns + "/" if ns else ""
             self.arms[name] = _Arm(
                 state,
@@ -199,7 +147,10 @@ class BagRecorder(Observer):
         for peer in self.peers:  # a cell's /tf stays in time order
             if peer.robot != robot:
                 peer.flush_due(at)
-        arm.bag.frame(t_s, q, self._velocity(arm, t_s, at, q))
+        try:
+            arm.bag.frame(t_s, q, self._velocity(arm, t_s, at, q))
+        except Exception as exc:
+            self._broken(exc)
         arm.last = (t_s, q)
 
     def _velocity(self, arm: _Arm, t_s: float, at: float, q: Sequence[float]) -> Sequence[float]:
@@ -223,10 +174,10 @@ class BagRecorder(Observer):
         out = []
         if len(arm.live) >= MAX_MARKERS:  # the world dropped its oldest marker
             out.append(mk.delete_marker(t_s, arm.marker_frame, "markers", arm.live.popleft()))
-        out.append(_marker(t_s, arm.marker_frame, arm.next_id, marker))
+        out.append(marker_message(t_s, arm.marker_frame, arm.next_id, marker))
         arm.live.append(arm.next_id)
-        arm.next_id += 1
-        self.writer.markers(t_s, mk.marker_array(out), arm.bag.namespace)
+        arm.next_id = (arm.next_id + 1) % INT32  # ids are int32; the live ones stay apart
+        self._markers(t_s, out, arm)
 
     def on_clear_markers(self, robot: str) -> None:
         arm = self.arms.get(robot)
@@ -235,7 +186,7 @@ class BagRecorder(Observer):
         t_s = self._t()
         gone = [mk.delete_marker(t_s, arm.marker_frame, "markers", k) for k in arm.live]
         arm.live.clear()
-        self.writer.markers(t_s, mk.marker_array(gone), arm.bag.namespace)
+        self._markers(t_s, gone, arm)
 
     def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
         arm = self.arms.get(robot)
@@ -244,17 +195,25 @@ class BagRecorder(Observer):
         t_s = self._t()
         now = {obj.name: obj for obj in objects}
         out = [
-            mk.delete_marker(t_s, arm.object_frame, "workcell", arm.object_ids[name])
+            mk.delete_marker(t_s, arm.object_frame, "workcell", arm.object_ids.pop(name))
             for name in arm.objects
             if name not in now
         ]
         for name, obj in now.items():
             if arm.objects.get(name) is not obj:
-                number = arm.object_ids.setdefault(name, len(arm.object_ids))
-                out.append(_object(t_s, arm.object_frame, number, obj))
+                if name not in arm.object_ids:
+                    arm.object_ids[name] = arm.next_object
+                    arm.next_object = (arm.next_object + 1) % INT32
+                out.append(object_message(t_s, arm.object_frame, arm.object_ids[name], obj))
         arm.objects = now
         if out:
-            self.writer.markers(t_s, mk.marker_array(out), arm.bag.namespace)
+            self._markers(t_s, out, arm)
+
+    def _markers(self, t_s: float, markers: list[Msg], arm: _Arm) -> None:
+        try:
+            self.writer.markers(t_s, mk.marker_array(markers), arm.bag.namespace)
+        except Exception as exc:
+            self._broken(exc)
 
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         if accepted and not self.closed:
@@ -266,7 +225,14 @@ class BagRecorder(Observer):
 
     # The end.
 
+    def _broken(self, exc: Exception) -> None:
+        """Something the writer refused (a bug, never the command's fault): the bag stops."""
+        log.exception("bag %s: %s", self.path, exc, exc_info=exc)
+        if not self.closed:  # no more writes; close() still ends the file
+            self._failed(f"bag: {exc}")
+
     def _failed(self, error: str) -> None:
+        self.error = self.error or error
         self.closed = True
         for lines in (self.commands, self.replies):
             if lines.timer is not None:
@@ -285,32 +251,4 @@ class BagRecorder(Observer):
         stopped early, if it did."""
         self.closed = True
         self.writer.close()
-        return self.writer.error
-
-
-def _xyz_xyzw(placement: pin.SE3) -> tuple[Sequence[float], Sequence[float]]:
-    x, y, z, qx, qy, qz, qw = pin.SE3ToXYZQUAT(placement).tolist()
-    return (x, y, z), (qx, qy, qz, qw)
-
-
-def _marker(t_s: float, frame: str, number: int, marker: Marker) -> Msg:
-    w, x, y, z = marker.wxyz
-    return mk.marker(
-        t_s,
-        frame,
-        "markers",
-        number,
-        mk.SHAPES[marker.shape],
-        marker.position,
-        (x, y, z, w),
-        _SCALES.get(marker.shape, (_S, _S, _S)),
-        (*marker.rgb, 1.0),
-    )
-
-
-def _object(t_s: float, frame: str, number: int, obj: WorkcellObject) -> Msg:
-    translation, quat = _xyz_xyzw(obj.placement)
-    uri = obj.mesh_path.as_uri() if obj.mesh_path is not None else ""
-    return mk.object_marker(
-        t_s, frame, "workcell", number, obj.shape, obj.size, translation, quat, obj.rgba, uri
-    )
+        return self.writer.error or self.error

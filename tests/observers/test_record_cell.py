@@ -24,6 +24,7 @@ from support import Client, load_robot
 
 from c2rviz.app.program import write_page
 from c2rviz.clients import player
+from c2rviz.observers.bag_topics import namespaces
 from c2rviz.session import ServerLimits, Services
 from c2rviz.transports.tcp_text import CommandServer
 from c2rviz.world.effects import RecordingScene
@@ -167,3 +168,15 @@ def test_record_all_records_every_robot_at_once(
         if x.header.frame_id == "world"
     }  # fmt: skip
     assert set(placed) == {"left/base_link", "right/base_link"}
+
+
+@pytest.mark.parametrize(
+    ("names", "spaces"),
+    [
+        (["left", "right"], ["left", "right"]),
+        (["arm-1", "arm.2", "2nd", "_x"], ["arm_1", "arm_2", "r2nd", "r_x"]),
+        (["a-b", "a_b", "a b"], ["a_b", "a_b_2", "a_b_3"]),
+    ],
+)
+def test_each_robot_gets_a_ros_namespace(names: list[str], spaces: list[str]) -> None:
+    assert list(namespaces(names).values()) == spaces
