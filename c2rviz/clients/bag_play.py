@@ -74,7 +74,12 @@ def is_bag(name: str | Path) -> bool:
 
 def add_bag_args(parser: argparse.ArgumentParser) -> None:
     """The flags that apply when FILE is a bag."""
-    group = parser.add_argument_group("when FILE is a ROS bag (docs/recording.md)")
+    group = parser.add_argument_group(
+        "when FILE is a ROS bag (docs/recording.md)",
+        "its JointState topic is checked over the whole span first, then played as timed "
+        "joints lines ('motion off' unless --motion); a bag that cannot be played: exit 1, "
+        "nothing sent",
+    )
     add = group.add_argument
     add("--topic", metavar="NAME", help="the JointState topic (default: the only one)")
     add("--start", type=float, default=0.0, metavar="S", help="from S s into the bag (0)")
