@@ -10,6 +10,7 @@ from ..errors import C2rvizError
 __all__ = [
     "AlreadyRecording",
     "LinkedName",
+    "NotABagFolder",
     "NameInUse",
     "NotRecording",
     "NotYourRecording",
@@ -101,4 +102,15 @@ class LinkedName(RecordingError):
         super().__init__(
             f"record: {path} is a symbolic link, and recordings never write through links; "
             "remove it or choose another name"
+        )
+
+
+class NotABagFolder(RecordingError):
+    """NAME/ is a folder holding more than a recording's bag: never replaced."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        super().__init__(
+            f"record: {path} is a folder that is not a recording's bag, and 'overwrite' "
+            "replaces only recordings; move it or choose another name"
         )

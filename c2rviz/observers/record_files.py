@@ -22,16 +22,26 @@ their last flush (see docs/recording.md: the end states).
 from __future__ import annotations
 
 import contextlib
+import logging
 import os
 import secrets
 import shutil
 from pathlib import Path
 from typing import TextIO
 
-__all__ = ["FINAL_SUFFIXES", "RecordFiles", "cut_to_line", "existing", "join_body", "links"]
+__all__ = [
+    "FINAL_SUFFIXES",
+    "RecordFiles",
+    "cut_to_line",
+    "existing",
+    "is_bag_folder",
+    "join_body",
+    "links",
+]
 
 FINAL_SUFFIXES = (".txt", ".csv", ".html", "")
 """The names a recording takes: NAME.txt, NAME.csv, NAME.html and the bag folder NAME/."""
+log = logging.getLogger("c2rviz.record")
 _CREATE = os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC
 
 
@@ -43,6 +53,17 @@ def links(folder: Path, name: str) -> list[Path]:
 def existing(folder: Path, name: str) -> list[Path]:
     """The final names of ``name`` in ``folder`` that exist (a dangling link counts)."""
     return [p for p in _finals(folder, name) if os.path.lexists(p)]
+
+
+def is_bag_folder(path: Path, name: str) -> bool:
+    """Whether the folder ``path`` holds a recording's bag ``name`` and nothing else (so it
+    may be replaced), or nothing at all."""
+    allowed = {"metadata.yaml", f"{name}.mcap", ".c2rviz-reserve"}
+    try:
+        with os.scandir(path) as entries:
+            return all(e.name in allowed and e.is_file(follow_symlinks=False) for e in entries)
+    except OSError:
+        return False
 
 
 def _finals(folder: Path, name: str) -> list[Path]:
@@ -113,9 +134,10 @@ class RecordFiles:
     def publish_bag(self) -> Path:
         """Put the bag folder in its final place ``NAME/``, replacing what was there.
 
-        A folder already there (an earlier recording, ``overwrite``) is moved aside
-        under a private name first, then deleted; a file or link there is removed (a
-        link itself, never what it points to).
+        A bag already there (an earlier recording, ``overwrite``) is moved aside under
+        a private name first, then deleted; a folder holding anything else is moved
+        aside and kept (``.NAME.TOKEN.old``, with a warning); a file or link there is
+        removed (a link itself, never what it points to).
 
         Raises:
             OSError: the bag cannot be moved there.
@@ -129,8 +151,10 @@ class RecordFiles:
         os.rename(self.bag_parent / self.name, final)
         with contextlib.suppress(OSError):
             os.rmdir(self.bag_parent)
-        if aside.exists():
+        if aside.is_dir() and is_bag_folder(aside, self.name):
             shutil.rmtree(aside, ignore_errors=True)
+        elif aside.exists():
+            log.warning("%s held more than a bag: it is kept as %s", final, aside)
         return final
 
     def discard(self, *suffixes: str) -> None:

@@ -38,13 +38,14 @@ from .record_errors import (
     AlreadyRecording,
     LinkedName,
     NameInUse,
+    NotABagFolder,
     NotRecording,
     NotYourRecording,
     RecordFolderError,
     RecordingError,
     RecordingExists,
 )
-from .record_files import RecordFiles, existing, links
+from .record_files import RecordFiles, existing, is_bag_folder, links
 from .record_finish import Exporter, Recording, finish
 from .recorded import Recorded
 from .recorder import Recorder
@@ -57,6 +58,7 @@ __all__ = [
     "Exporter",
     "LinkedName",
     "NameInUse",
+    "NotABagFolder",
     "NotRecording",
     "NotYourRecording",
     "RecordFolderError",
@@ -179,6 +181,9 @@ class Recordings:
             linked = links(folder, stem)
             if linked:
                 raise LinkedName(linked[0])
+        bag = folder / name
+        if bag.is_dir() and not is_bag_folder(bag, name):
+            raise NotABagFolder(bag)
         if not overwrite and any(
             existing(folder, stem) or stem in self._finishing for stem in stems
         ):

@@ -256,3 +256,21 @@ def test_a_file_size_limit_ends_the_recording_readable(tmp_path: Path):
     assert 0 < states <= rows and joints == rows > 500  # the bag keeps its whole chunks
     assert "# stopped early: write error: File too large" in (tmp_path / "big.txt").read_text()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["big", "big.csv", "big.html", "big.txt"]
+
+
+def test_overwrite_replaces_only_a_recording(
+    server: ServerThread, connect: Callable[..., Client], tmp_path: Path
+):
+    record_into(server, tmp_path)
+    (tmp_path / "data").mkdir()
+    (tmp_path / "data" / "notes.txt").write_text("mine\n")
+    client = connect(server)
+    assert client.ask("record data overwrite") == (
+        f"error: record: {tmp_path / 'data'} is a folder that is not a recording's bag, and "
+        "'overwrite' replaces only recordings; move it or choose another name"
+    )
+    assert (tmp_path / "data" / "notes.txt").read_text() == "mine\n"
+    for _ in range(2):  # a recording's own bag is replaced
+        assert client.ask("record take overwrite").startswith("ok recording take")
+        assert client.ask("record stop").startswith("ok recorded take: ")
+    assert sorted(p.name for p in (tmp_path / "take").iterdir()) == ["metadata.yaml", "take.mcap"]
