@@ -63,11 +63,11 @@ class Mover(Observer):
         asyncio.get_running_loop().call_soon(self.go, robot)
 
 
-async def cpu_share(seconds: float) -> tuple[float, int]:
+async def cpu_share(seconds: float) -> float:
     """CPU time of this process over ``seconds`` of wall time, as a share of one core [%]."""
     cpu, wall = time.process_time(), time.perf_counter()
     await asyncio.sleep(seconds)
-    return (time.process_time() - cpu) / (time.perf_counter() - wall) * 100, 0
+    return (time.process_time() - cpu) / (time.perf_counter() - wall) * 100
 
 
 async def measure(count: int, seconds: float, folder: Path) -> dict[str, float]:
@@ -79,12 +79,12 @@ async def measure(count: int, seconds: float, folder: Path) -> dict[str, float]:
     for name in names:
         mover.go(name)
     await asyncio.sleep(1.0)  # everything moving, caches warm
-    shares = {"moving": (await cpu_share(seconds))[0]}
+    shares = {"moving": await cpu_share(seconds)}
     for label, bag in (("txt+csv", False), ("+bag", True)):
         desk = Recordings(world, folder, bag=bag)
         desk.start(f"{label.strip('+')}{count}", names[0], every=True)
         await asyncio.sleep(0.5)
-        shares[label] = (await cpu_share(seconds))[0]
+        shares[label] = await cpu_share(seconds)
         await desk.close("done")
     world.close()
     return shares
