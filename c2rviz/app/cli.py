@@ -173,7 +173,16 @@ def build_parser() -> argparse.ArgumentParser:
     add(
         "--record",
         metavar="NAME",
-        help="record from start to exit into NAME.txt and NAME.csv in the recording folder",
+        help="record from start to exit into the recording folder: NAME.txt (a command file "
+        "c2rviz-play replays), NAME.csv (one row per frame), NAME.html (a page that plays it) "
+        "and NAME/ (a rosbag2 bag); in a cell every robot: NAME.ROBOT.txt, .csv, .html each "
+        "and one bag NAME/ (docs/recording.md)",
+    )
+    add(
+        "--record-overwrite",
+        action="store_const",
+        const=True,
+        help="--record may replace an existing NAME (default: refuse to start)",
     )
     add(
         "--record-dir",

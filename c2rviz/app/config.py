@@ -110,6 +110,8 @@ class Settings:
     """Where ``record NAME`` writes (the ini's is relative to the ini file)."""
     record: str | None = None
     """Record from start to exit under this name (``--record``)."""
+    record_overwrite: bool = False
+    """``--record NAME`` may replace an existing NAME (``--record-overwrite``)."""
     trail_points: int = 20_000
     """Points a ``trail`` keeps at most."""
     limits: ServerLimits = field(default_factory=ServerLimits)

@@ -206,16 +206,20 @@ async def serve(
     try:
         await stop.wait()
     finally:
-        for sig in _STOP_SIGNALS:
-            loop.remove_signal_handler(sig)
-        # Each step runs whatever the one before it met: the recording is finished even if
-        # a door's stop failed.
-        await _step("closing the doors", close_doors(doors))
-        for server in servers:
-            await _step("stopping a command server", server.stop())
-        services.close()
-        await _step("finishing the recording", _stop_recording(services))
-        scene.stop()
+        # The recordings stop first and are awaited whatever closing the doors does (a
+        # signal meanwhile changes nothing: the handlers stay until they are complete);
+        # each step runs whatever the one before it met.
+        finishing = services.recordings.close("the program stopped")  # stopped here, now
+        try:
+            await _step("closing the doors", close_doors(doors))
+            for server in servers:
+                await _step("stopping a command server", server.stop())
+            services.close()
+        finally:
+            _recorded(await finishing)
+            for sig in _STOP_SIGNALS:
+                loop.remove_signal_handler(sig)
+            scene.stop()
     print("c2rviz: stopped", flush=True)
     return 0
 
@@ -244,16 +248,35 @@ def _banner(member: Member, host: str, port: int | None, in_cell: bool) -> None:
 
 
 def _record_from_start(services: Services, settings: Settings) -> None:
-    """``--record NAME`` begins now."""
-    if settings.record is not None:
-        if Record.parse("record", [settings.record]).stop:  # the verb's rules for a name
-            raise ConfigError("--record needs a name; 'stop' is not one")
-        services.recordings.start(settings.record, services.world.default)
-
-
-async def _stop_recording(services: Services) -> None:
+    """``--record NAME`` begins now (every robot of a cell); say so, and where."""
+    if settings.record is None:
+        return
+    if Record.parse("record", [settings.record]).stop:  # the verb's rules for a name
+        raise ConfigError("--record needs a name; 'stop' is not one")
     desk = services.recordings
-    if desk.current is not None:
-        done = await desk.stop("the program stopped")
-        where = done.txt if done.error is None else f"{done.csv} ({done.error})"
+    world = services.world
+    recording = desk.start(
+        settings.record, world.default, settings.record_overwrite, len(world.robots) > 1
+    )
+    files = ", ".join(
+        f"{recorder.name}{suffix}"
+        for recorder in recording.recorders.values()
+        for suffix in (".txt", ".csv", ".html")
+    )
+    print(
+        f"c2rviz: recording {recording.name} into {desk.folder.resolve()} until exit: "
+        f"{files} and the bag {recording.name}/",
+        flush=True,
+    )
+
+
+def _recorded(finished: Sequence[Recorded]) -> None:
+    """Say what each recording finished at exit holds."""
+    for done in finished:
+        if done.error is None and done.txt is not None:
+            where = f"{done.txt} (and {done.csv.name}"
+            where += "".join(f", {p.name}" for p in (done.html,) if p is not None)
+            where += f", {done.bag.name}/)" if done.bag is not None else ")"
+        else:
+            where = f"{done.csv} ({done.error})"
         print(f"c2rviz: recorded {done.name}: {done.frames} frames, {where}", flush=True)

@@ -34,6 +34,8 @@ from typing import TextIO
 from ..errors import C2rvizError
 from ..protocol.verbs.connection import Bye, Quit, Sleep
 from ..protocol.verbs.motion import MOTION_MODES, MotionMode
+from .bag_play import add_bag_args, is_bag
+from .bag_play import run as play_bag
 from .client import (
     Client,
     ConnectionLost,
@@ -150,14 +152,20 @@ def build_parser() -> argparse.ArgumentParser:
         "opening comments names the robot it is for.",
     )
     add = parser.add_argument
-    add("file", metavar="FILE", help="command file, e.g. commands/motoman.txt")
+    add(
+        "file",
+        metavar="FILE",
+        help="command file, e.g. commands/motoman.txt, or a ROS bag: a rosbag2 folder, an "
+        ".mcap or .db3 file, or a ROS 1 .bag, whose JointState topic is played",
+    )
     add_connection_args(parser)
     add(
         "--speed",
+        "--rate",
         type=_positive,
         default=1.0,
         metavar="X",
-        help="divide every sleep by X (default 1)",
+        help="divide every sleep by X (default 1): X times the file's or the bag's pace",
     )
     add(
         "--motion",
@@ -182,6 +190,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="lines sent ahead of their replies (default 1); above 1 is faster, but "
         "after an error the lines already sent have run",
     )
+    add_bag_args(parser)
     return parser
 
 
@@ -204,6 +213,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``c2rviz-play``; returns the exit status."""
     args = build_parser().parse_args(argv)
     out, err = sys.stdout, sys.stderr
+    if is_bag(args.file):
+        return play_bag(args, out, err)
     if args.loop < 0 or args.window < 1:
         print("c2rviz-play: --loop must be >= 0 and --window >= 1", file=err)
         return 2

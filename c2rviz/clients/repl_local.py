@@ -19,6 +19,7 @@ from ..protocol.grammar import parse_line
 from ..protocol.verbs.connection import Sleep
 from ..protocol.verbs.joints import Joints
 from ..protocol.verbs.observe import Watch
+from .bag_play import is_bag, play_in_repl
 from .client import Client, ConnectionLost, find_script
 from .goto import step, target_problem, travel
 from .player import Progress, play
@@ -28,7 +29,10 @@ from .watch import watch_lines
 __all__ = ["DEFAULT_STEP_DEG", "LOCAL_USAGE", "LocalCommands"]
 
 LOCAL_USAGE = {
-    "file": ("file NAME [speed=X]", "play a command file (here, else commands/); X divides sleeps"),
+    "file": (
+        "file NAME [speed=X]",
+        "play a command file (here, else commands/) or a ROS bag; X divides sleeps",
+    ),
     "sleep": ("sleep S", "wait S seconds here"),
     "where": ("where", "joint names and values, in this connection's units"),
     "goto": (
@@ -124,6 +128,10 @@ class LocalCommands:
         rest, options = _options("file", words, ["speed"])
         if len(rest) != 1:
             raise BadArguments("file", "needs one file name", LOCAL_USAGE["file"][0])
+        if is_bag(rest[0]):  # a ROS bag's joint states, checked whole, then streamed
+            speed = options.get("speed", self.speed)
+            self.errors += play_in_repl(self.client, rest[0], speed, self.out)
+            return True
         try:
             script = load_script(find_script(rest[0]), rest[0])
         except OSError as exc:

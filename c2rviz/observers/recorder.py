@@ -17,11 +17,14 @@ and replays alike) that writes, in the recording folder:
 It never slows the command path: states are coalesced to at most one frame per
 ``1/hz`` of the world's clock (a state superseded within a frame is dropped; the
 latest is written at the frame's time, when it was what the arm showed), and
-files are written through large buffers, flushed once a second. A write error
-(a full disk) stops the recording with one warning and an ``event
-record-stopped`` to watchers; the server goes on. The command file's header
-needs the sources, known only at the end, so its body is written to
-``.NAME.txt.part`` and ``NAME.txt`` is put together when the recording stops.
+files are written through large buffers, flushed once a second. Each frame also
+goes to a ``FrameSink`` if one is given (the bag, ``bag_recorder``), with the
+CSV's time. A write error (a full disk) stops the recording with one warning and
+an ``event record-stopped`` to watchers; the server goes on, and what was written
+is kept (each file cut after its last whole line). The files are written under
+private names (``record_files``) and put in place when the recording is
+finished; the command file's header needs the sources, known only at the end,
+so its body is written apart and ``finish`` puts the two together.
 """
 
 from __future__ import annotations
@@ -30,7 +33,6 @@ import contextlib
 import logging
 import os
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 from typing import TextIO
@@ -41,8 +43,10 @@ from ..protocol import replies
 from ..robot.frames import in_base, se3_pose, wxyz_se3
 from ..world.effects import Marker, Observer
 from ..world.world import World
+from .record_files import RecordFiles, cut_to_line, join_body
+from .recorded import FrameSink, Recorded
 
-__all__ = ["BUFFER_BYTES", "FLUSH_S", "Recorded", "Recorder"]
+__all__ = ["BUFFER_BYTES", "FLUSH_S", "FrameSink", "Recorded", "Recorder"]
 
 log = logging.getLogger("c2rviz.recorder")
 
@@ -51,36 +55,6 @@ BUFFER_BYTES = 1 << 18
 FLUSH_S = 1.0
 """Files are flushed at most this often [s of the world's clock] (and at the end)."""
 _MAX_SOURCES = 100  # sources named in the header; the rest are counted
-
-
-@dataclass(frozen=True)
-class Recorded:
-    """A finished recording (what an exporter needs to find and describe it).
-
-    Attributes:
-        name: Its name.
-        robot: The robot model's name (the ``# robot:`` header).
-        txt: The command file (None when a write error stopped it: see ``error``).
-        csv: The frames.
-        frames: Rows of the CSV.
-        duration_s: Recorded time [s].
-        started: When it began (UTC).
-        sources: Who sent commands meanwhile.
-        error: Why it stopped early, if it did.
-        html: NAME.html, the run as a page that plays in any browser.
-    """
-
-    name: str
-    robot: str
-    txt: Path | None
-    csv: Path
-    frames: int
-    duration_s: float
-    started: datetime
-    sources: tuple[str, ...]
-    error: str | None = None
-    html: Path | None = None
-    """The self-contained page (``view.record_page``), once written."""
 
 
 def _numbers(values: Sequence[float]) -> str:
@@ -96,36 +70,46 @@ class Recorder(Observer):
         world: World,
         robot: str,
         name: str,
-        folder: Path,
+        folder: Path | RecordFiles,
         on_failed: Callable[[Recorder, str], None],
+        *,
+        t0: float | None = None,
+        bag: FrameSink | None = None,
     ) -> None:
         """Open the files and write the state now (the caller checked the name and folder).
 
         Args:
             world: What is recorded.
             robot: The robot's name in the world.
-            name: The recording's name (files NAME.txt and NAME.csv in ``folder``).
-            folder: An existing folder.
+            name: The recording's name (files NAME.txt and NAME.csv).
+            folder: An existing folder, or the recording's ``RecordFiles`` in one.
             on_failed: Called once, on the asyncio thread, when a write error stops it.
+            t0: The clock time [s] its times count from (default: now).
+            bag: Where each frame also goes.
 
         Raises:
-            OSError: a file cannot be opened.
+            OSError: a file cannot be created.
         """
         self.world = world
         self.robot = robot
         self.name = name
+        self.files = folder if isinstance(folder, RecordFiles) else RecordFiles(folder, name)
         self.state = world.state(robot)
         self.period_s = world.frame_s
         self.on_failed = on_failed
+        self.bag = bag
         self.started = datetime.now(timezone.utc)
-        self.t0 = world.clock.now()
-        self.txt = folder / f"{name}.txt"
-        self.csv = folder / f"{name}.csv"
-        self.part = folder / f".{name}.txt.part"
+        self.t0 = world.clock.now() if t0 is None else t0
+        self.txt = self.files.private(".txt")  # put together by `finish`
+        self.csv = self.files.private(".csv")
+        self.part = self.files.private(".txt.part")
         self.sources: dict[str, None] = {}
         self.more_sources = 0
         self.frames = 0
         self.error: str | None = None
+        """Why its own files stopped early (a write error), if they did."""
+        self.early: str | None = None
+        """Why the recording stopped early, if it did (its own error, or its bag's)."""
         self.closed = False
         self._due = -np.inf  # when the next frame may be written [clock s]
         self._pending: Sequence[float] | None = None  # the latest state, not yet written
@@ -133,11 +117,12 @@ class Recorder(Observer):
         self._flushed = self.t0
         self._rgb = (1.0, 0.0, 0.0)  # a replaying session's marker style
         self._shape = "sphere"
-        self._body: TextIO = open(self.part, "w", buffering=BUFFER_BYTES, encoding="ascii")  # noqa: SIM115
+        self._body: TextIO = self.files.open_text(".txt.part", BUFFER_BYTES)
         try:
-            self._rows: TextIO = open(self.csv, "w", buffering=BUFFER_BYTES, encoding="ascii")  # noqa: SIM115
+            self._rows: TextIO = self.files.open_text(".csv", BUFFER_BYTES)
         except OSError:
             self._body.close()
+            self.files.discard(".txt.part")
             raise
         joints = ",".join(self.state.robot.joint_names)
         self._write(self._rows, f"time,{joints},x,y,z,roll,pitch,yaw\n")
@@ -159,9 +144,7 @@ class Recorder(Observer):
         if t < self._due:  # the hot path: a flood of commands within one frame
             self._pending = q
             return
-        if self._pending is not None:
-            self._frame(self._pending, self._due)  # it was still the arm's state then
-            self._pending = None
+        self.flush_due(t)
         if t >= self._due:
             self._frame(q, t)
         else:
@@ -188,11 +171,15 @@ class Recorder(Observer):
 
     # Writing.
 
+    def flush_due(self, t: float) -> None:
+        """Write the pending state if its frame came at or before clock time ``t`` [s]."""
+        if self._pending is not None and t >= self._due and not self.closed:
+            pending, self._pending = self._pending, None
+            self._frame(pending, self._due)  # it was still the arm's state then
+
     def _catch_up(self, t: float) -> None:
         """Write the pending state if its frame came before ``t``; then the time to ``t``."""
-        if self._pending is not None and t >= self._due:
-            self._frame(self._pending, self._due)
-            self._pending = None
+        self.flush_due(t)
         self._sleep_to(t)
 
     def _sleep_to(self, t: float) -> int:
@@ -210,6 +197,8 @@ class Recorder(Observer):
         self._write(self._body, f"joints {_numbers(q)}\n")  # exact: a replay is the same
         self._write(self._rows, f"{us / 1e6:.6f},{replies.numbers(q)},{pose}\n")
         self.frames += 1
+        if self.bag is not None:
+            self.bag.frame(self.robot, us / 1e6, t, q)
         if t - self._flushed >= FLUSH_S and not self.closed:
             self._flushed = t
             try:
@@ -242,11 +231,7 @@ class Recorder(Observer):
         """A write failed: stop here, keep what is on disk, tell the desk."""
         self.error = f"write error: {exc.strerror or exc}"
         log.warning(
-            "recording %s stopped by a %s; what was written is in %s and %s",
-            self.name,
-            self.error,
-            self.part,
-            self.csv,
+            "recording %s stopped by a %s; what was written up to it is kept", self.name, self.error
         )
         self._close_files()
         self.on_failed(self, self.error)
@@ -265,8 +250,8 @@ class Recorder(Observer):
             return
         now = self.world.clock.now()
         if self._pending is not None:
-            self._frame(self._pending, min(now, self._due))
-            self._pending = None
+            pending, self._pending = self._pending, None
+            self._frame(pending, min(now, self._due))
         self._sleep_to(now)
         if self.closed:
             return
@@ -278,21 +263,26 @@ class Recorder(Observer):
             self._fail(exc)
 
     def finish(self) -> Recorded:
-        """Put NAME.txt together (header, then the body); blocking file I/O, for a thread."""
+        """Put the command file together under its private name (blocking: for a thread).
+
+        The header, then the body up to its last whole line. Should that not be
+        written (a full disk), the body alone becomes the command file (it plays, with
+        no header). After a write error the CSV is cut after its last whole row too.
+        """
         txt: Path | None = None
-        if self.error is None:
-            try:
-                temporary = self.txt.with_name(f".{self.name}.txt.tmp")
-                with open(temporary, "w", encoding="ascii") as out, open(self.part) as body:
-                    out.write(self.header())
-                    while chunk := body.read(BUFFER_BYTES):
-                        out.write(chunk)
-                os.replace(temporary, self.txt)
-                self.part.unlink()
+        try:
+            self._assemble()
+            txt = self.txt
+        except OSError as exc:
+            self.error = self.error or f"write error: {exc.strerror or exc}"
+            self.files.discard(".txt")
+            with contextlib.suppress(OSError):
+                cut_to_line(self.part)
+                os.replace(self.part, self.txt)
                 txt = self.txt
-            except OSError as exc:
-                self.error = f"write error: {exc.strerror or exc}"
-                log.warning("recording %s: cannot write %s: %s", self.name, self.txt, self.error)
+        if self.error is not None:
+            with contextlib.suppress(OSError):
+                cut_to_line(self.csv)
         return Recorded(
             self.name,
             self.state.robot.name,
@@ -305,11 +295,17 @@ class Recorder(Observer):
             self.error,
         )
 
+    def _assemble(self) -> None:
+        join_body(self.files.create(".txt"), self.header(), self.part, BUFFER_BYTES)
+        self.part.unlink()
+
     def header(self) -> str:
         sources = ", ".join(self.sources) or "none"
         if self.more_sources:
             sources += f" and {self.more_sources} more"
         robot = self.state.robot.name
+        why = self.error or self.early
+        early = "" if why is None else f"# stopped early: {why}\n"
         return (
             f"# c2rviz recording {self.name}: play it back with c2rviz-play {self.name}.txt\n"
             f"# robot: {robot}\n"
@@ -319,4 +315,5 @@ class Recorder(Observer):
             f"# sources: {sources}\n"
             f"# frames: {self.name}.csv (time [s], joints [rad or m], tool pose x,y,z [m] "
             "roll,pitch,yaw [rad] in the base frame)\n"
+            f"{early}"
         )

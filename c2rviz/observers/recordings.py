@@ -1,89 +1,81 @@
-"""The recordings of a world: where they go, the one running, and the ``record`` errors.
+"""The recordings of a world: where they go, the ones running (one per robot), and their end.
 
-One recording at a time per world (the app makes one ``Recordings`` and hands it
-to the sessions); it records the robot of the source that started it, from every
-source. Stopping returns a future that is done when the files are complete (the
-command file is put together in a thread, then each exporter the app gave, such as
-the page ``NAME.html``, writes its file from the finished recording).
+Each robot has its own recording (``start(name, robot)``): NAME.txt and
+NAME.csv (``Recorder``) and the bag NAME/ (``BagRecorder``), from every source.
+``start(name, robot, every=True)`` records every robot of the world at once, as
+one recording: per robot NAME.ROBOT.txt and NAME.ROBOT.csv (NAME.txt and
+NAME.csv when the world has one robot), and one bag NAME/ holding every robot's
+topics. A recording is stopped for one of its robots (``stop``), which stops it
+whole; the session refuses a ``record stop`` for a robot not recorded.
+
+Stopping returns a future that is done when the files are complete and in
+place: in a thread the bag is ended, each command file put together, each
+exporter the app gave (the page NAME.html) run, and every file renamed from its
+private name (``record_files``) to its own. Two recordings of the same name
+finish one after the other, in the order they stopped, so ``record NAME
+overwrite`` racing a ``record stop`` of NAME loses neither: each is complete when
+its ``record stop`` is answered, and the later one holds the names. A name whose
+files are symbolic links is refused. ``close`` stops every recording and waits
+for every one still finishing (the program's exit).
 """
 
 from __future__ import annotations
 
 import asyncio
 import logging
-from collections.abc import Callable, Sequence
-from dataclasses import replace
+import re
+import shutil
+from collections.abc import Callable, Coroutine, Sequence
 from pathlib import Path
+from typing import Any
 
 from ..errors import C2rvizError
+from ..world.effects import Observer
 from ..world.state import RobotState
 from ..world.world import World
-from .recorder import Recorded, Recorder
+from .bag_recorder import BagRecorder
+from .record_errors import (
+    AlreadyRecording,
+    LinkedName,
+    NameInUse,
+    NotABagFolder,
+    NotRecording,
+    NotYourRecording,
+    RecordFolderError,
+    RecordingError,
+    RecordingExists,
+)
+from .record_files import RecordFiles, existing, is_bag_folder, links
+from .record_finish import Exporter, Recording, finish
+from .recorded import Recorded
+from .recorder import Recorder
 
 log = logging.getLogger("c2rviz.record")
 
 __all__ = [
     "DEFAULT_FOLDER",
     "AlreadyRecording",
+    "Exporter",
+    "LinkedName",
+    "NameInUse",
+    "NotABagFolder",
     "NotRecording",
+    "NotYourRecording",
     "RecordFolderError",
+    "Recording",
     "RecordingError",
     "RecordingExists",
-    "Exporter",
     "Recordings",
 ]
 
 DEFAULT_FOLDER = Path("recordings")
 """Where recordings go unless told (``--record-dir``, ini ``record_dir``)."""
 
-Exporter = Callable[[Recorded, RobotState], Path]
-"""Writes one more file from a finished recording (blocking, run in a thread) and returns
-its path, such as ``view.record_page.write_html``'s NAME.html."""
-
-
-class RecordingError(C2rvizError):
-    """A ``record`` command that cannot be done."""
-
-
-class RecordingExists(RecordingError):
-    """NAME.txt or NAME.csv is already in the folder (and ``overwrite`` was not said)."""
-
-    def __init__(self, name: str, folder: Path) -> None:
-        self.name = name
-        self.folder = folder
-        super().__init__(
-            f"record: {name} already exists in {folder}; choose another name or say "
-            f"'record {name} overwrite'"
-        )
-
-
-class AlreadyRecording(RecordingError):
-    """A recording runs already (one at a time)."""
-
-    def __init__(self, name: str, seconds: float) -> None:
-        self.name = name
-        self.seconds = seconds
-        super().__init__(f"record: {name} is being recorded ({seconds:.1f} s); 'record stop' first")
-
-
-class NotRecording(RecordingError):
-    """``record stop`` with no recording running."""
-
-    def __init__(self) -> None:
-        super().__init__("record: nothing is being recorded")
-
-
-class RecordFolderError(RecordingError):
-    """The recording folder cannot be made or written."""
-
-    def __init__(self, folder: Path, why: str) -> None:
-        self.folder = folder
-        self.why = why
-        super().__init__(f"record: cannot record into {folder}: {why}")
+_FILE_PART = re.compile(r"[^A-Za-z0-9_.-]")
 
 
 class Recordings:
-    """The recordings of one world: the folder, the one running, the last one finished."""
+    """The recordings of one world: the folder, the running ones, the last one finished."""
 
     def __init__(
         self,
@@ -91,6 +83,7 @@ class Recordings:
         folder: Path = DEFAULT_FOLDER,
         tell: Callable[[str], None] | None = None,
         exporters: Sequence[Exporter] = (),
+        bag: bool = True,
     ) -> None:
         """Set up.
 
@@ -99,83 +92,207 @@ class Recordings:
             folder: Where recordings go (made when needed).
             tell: Tells every watcher an event (``record-stopped NAME: WHY``).
             exporters: What else is written from a finished recording (in order).
+            bag: Write the bag NAME/ too.
         """
         self.world = world
         self.folder = folder
         self.tell = tell
         self.exporters = tuple(exporters)
-        self.current: Recorder | None = None
+        self.bag = bag
+        self.running: dict[str, Recording] = {}
+        """The recording of each robot being recorded."""
         self.last: Recorded | None = None
+        self._finishing: dict[str, asyncio.Future[list[Recorded]]] = {}  # by stem
+        self._in_flight: set[asyncio.Future[list[Recorded]]] = set()
 
-    def start(self, name: str, robot: str, overwrite: bool = False) -> Recorder:
-        """Begin recording ``robot`` as ``name``.
+    def recorder(self, robot: str | None = None) -> Recorder | None:
+        """The recorder of ``robot`` (the world's default robot for None), if recorded."""
+        name = self.world.default if robot is None else robot
+        recording = self.running.get(name)
+        return None if recording is None else recording.recorders[name]
+
+    @property
+    def current(self) -> Recorder | None:
+        """The default robot's recorder (a world of one robot has only that one)."""
+        return self.recorder()
+
+    # Starting.
+
+    def start(
+        self, name: str, robot: str, overwrite: bool = False, every: bool = False
+    ) -> Recording:
+        """Begin recording ``robot`` (``every``: every robot of the world) as ``name``.
 
         Raises:
-            AlreadyRecording, RecordingExists, RecordFolderError.
+            AlreadyRecording, NameInUse, RecordingExists, LinkedName, RecordFolderError.
         """
-        if self.current is not None:
-            raise AlreadyRecording(self.current.name, self.current.seconds)
+        robots = list(self.world.robots) if every else [robot]
+        for each in robots:
+            if each in self.running:
+                now = self.running[each]
+                seconds = self.world.clock.now() - now.t0
+                raise AlreadyRecording(now.name, seconds, None if each == robot else each)
+        several = len(robots) > 1
+        stems = {r: f"{name}.{_FILE_PART.sub('_', r)}" if several else name for r in robots}
+        self._check_names(name, set(stems.values()) | {name}, overwrite)
+        t0 = self.world.clock.now()
+        bag_files = RecordFiles(self.folder, name)
+        recording = Recording(name, {}, None, bag_files, t0)
+        try:
+            if self.bag:
+                recording.bag = BagRecorder(
+                    self.world, robots, bag_files.bag_folder(), t0, self._bag_failed
+                )
+            for each in robots:
+                recorder = Recorder(
+                    self.world,
+                    each,
+                    stems[each],
+                    RecordFiles(self.folder, stems[each]),
+                    self._failed,
+                    t0=t0,
+                    bag=recording.bag,
+                )
+                recording.recorders[each] = recorder
+                if recording.bag is not None:
+                    recording.bag.peers.append(recorder)
+        except (OSError, C2rvizError) as exc:
+            self._abandon(recording)
+            why = exc.strerror or str(exc) if isinstance(exc, OSError) else str(exc)
+            raise RecordFolderError(self.folder, why) from None
+        observers: list[Observer] = [*recording.recorders.values()]
+        if recording.bag is not None:
+            observers.append(recording.bag)
+        self.world.add_observers(observers)
+        for each in robots:
+            self.running[each] = recording
+        return recording
+
+    def _check_names(self, name: str, stems: set[str], overwrite: bool) -> None:
         folder = self.folder
         try:
             folder.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise RecordFolderError(folder, exc.strerror or str(exc)) from None
+        for other in {id(r): r for r in self.running.values()}.values():
+            if other.stems & stems:
+                raise NameInUse(name, list(other.recorders))
+        for stem in sorted(stems):
+            linked = links(folder, stem)
+            if linked:
+                raise LinkedName(linked[0])
+        bag = folder / name
+        if bag.is_dir() and not is_bag_folder(bag, name):
+            raise NotABagFolder(bag)
         if not overwrite and any(
-            (folder / f"{name}{ext}").exists() for ext in (".txt", ".csv", ".html")
+            existing(folder, stem) or stem in self._finishing for stem in stems
         ):
             raise RecordingExists(name, folder)
-        try:
-            recorder = Recorder(self.world, robot, name, folder, self._failed)
-        except OSError as exc:
-            raise RecordFolderError(folder, exc.strerror or str(exc)) from None
-        self.world.add_observers([recorder])
-        self.current = recorder
-        return recorder
 
-    def stop(self, why: str) -> asyncio.Future[Recorded]:
-        """End the recording (``why``: who stopped it); the files are complete when the
-        returned future is done.
+    def _abandon(self, recording: Recording) -> None:
+        """A start that failed half-way: close and remove what it made."""
+        for recorder in recording.recorders.values():
+            recorder.stop()
+            recorder.files.discard(".txt.part", ".csv")
+        if recording.bag is not None:
+            recording.bag.close()
+        parent = recording.bag_files.bag_parent
+        if parent.is_dir() and not parent.is_symlink():
+            shutil.rmtree(parent, ignore_errors=True)
+
+    # Stopping.
+
+    def stop(self, robot: str, why: str) -> asyncio.Future[list[Recorded]]:
+        """End the recording of ``robot`` (``why``: who stopped it) and every robot's in it;
+        the files are complete and in place when the returned future is done.
 
         Raises:
-            NotRecording: none runs.
+            NotRecording: nothing is being recorded.
+            NotYourRecording: ``robot`` is not, but another robot is.
         """
-        recorder = self.current
-        if recorder is None:
-            raise NotRecording()
-        self._detach(recorder, why)
-        recorder.stop()
-        future = asyncio.ensure_future(
-            asyncio.to_thread(_finish, recorder, recorder.state, self.exporters)
-        )
-        future.add_done_callback(self._finished)
+        recording = self.running.get(robot)
+        if recording is None:
+            others = {id(r): r for r in self.running.values()}.values()
+            if not others:
+                raise NotRecording()
+            raise NotYourRecording(robot, [(r.name, ", ".join(r.recorders)) for r in others])
+        return self._end(recording, why)
+
+    def _end(self, recording: Recording, why: str) -> asyncio.Future[list[Recorded]]:
+        """Detach ``recording``, write its last frames, and finish it in a thread."""
+        if not any(self.running.get(r) is recording for r in recording.recorders):
+            done: asyncio.Future[list[Recorded]] = asyncio.get_running_loop().create_future()
+            done.set_result([])  # ended already (a write error and a stop at once)
+            return done
+        for robot in recording.recorders:
+            del self.running[robot]
+        parts = [*recording.recorders.values(), recording.bag]
+        for part in parts:
+            if part is not None and part in self.world.observers:
+                self.world.remove_observer(part)
+        for recorder in recording.recorders.values():
+            recorder.stop()
+        if recording.bag is not None:
+            recording.bag.stop()
+        if self.tell is not None:
+            self.tell(f"record-stopped {recording.name}: {why}")
+        before = {self._finishing[s] for s in recording.stems if s in self._finishing}
+        states = {r: self.world.state(r) for r in recording.recorders}
+        future = asyncio.ensure_future(self._finish_after(before, recording, states))
+        for stem in recording.stems:
+            self._finishing[stem] = future
+        self._in_flight.add(future)
+        future.add_done_callback(lambda done: self._finished(recording, done))
         return future
 
-    def _finished(self, future: asyncio.Future[Recorded]) -> None:
-        if not future.cancelled() and future.exception() is None:
-            self.last = future.result()
+    async def _finish_after(
+        self,
+        before: set[asyncio.Future[list[Recorded]]],
+        recording: Recording,
+        states: dict[str, RobotState],
+    ) -> list[Recorded]:
+        if before:  # the same name, stopped earlier: put in place first
+            await asyncio.wait(before)
+        return await asyncio.to_thread(finish, recording, states, self.exporters)
+
+    def _finished(self, recording: Recording, future: asyncio.Future[list[Recorded]]) -> None:
+        self._in_flight.discard(future)
+        for stem in recording.stems:
+            if self._finishing.get(stem) is future:
+                del self._finishing[stem]
+        if not future.cancelled() and future.exception() is None and future.result():
+            self.last = future.result()[-1]
+        elif not future.cancelled() and future.exception() is not None:
+            log.error("recording %s: finishing failed", recording.name, exc_info=future.exception())
 
     def _failed(self, recorder: Recorder, error: str) -> None:
+        self._failing(lambda r: recorder in r.recorders.values(), error)
+
+    def _bag_failed(self, bag: BagRecorder, error: str) -> None:
+        self._failing(lambda r: r.bag is bag, error)
+
+    def _failing(self, match: Callable[[Recording], bool], error: str) -> None:
         # Called from inside the world's fan-out: leave its list of observers alone now.
-        asyncio.get_running_loop().call_soon(self._detach, recorder, error)
-        self.last = recorder.finish()
+        for recording in {id(r): r for r in self.running.values()}.values():
+            if match(recording):
+                for recorder in recording.recorders.values():
+                    recorder.early = recorder.early or error
+                asyncio.get_running_loop().call_soon(self._end, recording, error)
+                return
 
-    def _detach(self, recorder: Recorder, why: str) -> None:
-        """The recording ends (once: a write error while closing says nothing more)."""
-        if self.current is not recorder:
-            return
-        self.current = None
-        if recorder in self.world.observers:
-            self.world.remove_observer(recorder)
-        if self.tell is not None:
-            self.tell(f"record-stopped {recorder.name}: {why}")
+    def close(self, why: str) -> Coroutine[Any, Any, list[Recorded]]:
+        """Stop every recording now; return a coroutine that waits for every one to be
+        finished, those stopped earlier too (the program's end), and gives what was
+        finished, in the order they stopped."""
+        for recording in list({id(r): r for r in self.running.values()}.values()):
+            self._end(recording, why)
+        return self._all_finished()
 
-
-def _finish(recorder: Recorder, state: RobotState, exporters: Sequence[Exporter]) -> Recorded:
-    """NAME.txt put together, then each exporter's file (blocking: for a thread)."""
-    recorded = recorder.finish()
-    for export in exporters:
-        try:
-            recorded = replace(recorded, html=export(recorded, state))
-        except Exception as exc:  # the txt and csv stand; the rest is a bonus
-            log.warning("recording %s: no page written: %s", recorded.name, exc)
-    return recorded
+    async def _all_finished(self) -> list[Recorded]:
+        finished: list[Recorded] = []
+        while self._in_flight:
+            waiting = list(self._in_flight)
+            for result in await asyncio.gather(*waiting, return_exceptions=True):
+                if isinstance(result, list):
+                    finished.extend(result)
+        return finished

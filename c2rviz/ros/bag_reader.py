@@ -158,11 +158,16 @@ class JointStateBag:
         return warnings
 
     def samples(
-        self, chain_names: Sequence[str], start_s: float = 0.0, duration_s: float | None = None
+        self,
+        chain_names: Sequence[str],
+        start_s: float = 0.0,
+        duration_s: float | None = None,
+        warnings: list[str] | None = None,
     ) -> Generator[tuple[float, tuple[float, ...]], None, None]:
         """Yield ``(t_s, positions)`` of the span, lazily: t [s from the bag's start],
-        the chain's positions [rad or m] in chain order. Raises as ``check`` does."""
-        return self._scan(chain_names, start_s, duration_s, [])
+        the chain's positions [rad or m] in chain order. Raises as ``check`` does, and
+        appends its warnings to ``warnings`` (if given) once the span is read."""
+        return self._scan(chain_names, start_s, duration_s, [] if warnings is None else warnings)
 
     # Reading.
 

@@ -12,6 +12,7 @@ bad command never moves the robot partly.
 from __future__ import annotations
 
 import asyncio
+import functools
 import math
 from collections.abc import Sequence
 
@@ -21,7 +22,7 @@ from ..collision.model import segment
 from ..collision.other_robots import first_hit_between
 from ..errors import C2rvizError, JointLimitError, PathCollides
 from ..protocol import replies
-from ..protocol.grammar import numbers_batch, parse_line
+from ..protocol.grammar import ForeignProtocol, numbers_batch, parse_line
 from ..protocol.registry import HANDLERS, Reply
 from ..robot.frames import pose_se3, se3_pose
 from ..tolerance import within_limit
@@ -150,17 +151,39 @@ class Session:
 
     def run(self, line: str) -> Reply | None:
         """Parse and run one line (None for a blank or comment line), noting it in the
-        world as accepted or refused."""
+        world as accepted or refused, and its reply once known (``World.replied``: a reply
+        that waits is handed back as a future that notes it when it comes)."""
+        world = self.world
         try:
             command = parse_line(line)
             if command is None:
                 return None
             reply = HANDLERS[command.__class__](self, command)
-        except C2rvizError:
-            self.world.note(self.source, line, False)
+        except C2rvizError as exc:
+            world.note(self.source, line, False)
+            if not isinstance(exc, ForeignProtocol):  # a door answers that one its own way
+                world.replied(self.source, line, replies.error(exc))
             raise
-        self.world.note(self.source, line, True)
-        return reply
+        world.note(self.source, line, True)
+        if isinstance(reply, str):
+            world.replied(self.source, line, reply)
+            return reply
+        later = asyncio.ensure_future(reply)
+        later.add_done_callback(functools.partial(self._replied, line))
+        return later
+
+    def _replied(self, line: str, later: asyncio.Future[str]) -> None:
+        """A reply that waited has come (one cancelled never reached anyone)."""
+        if later.cancelled():
+            return
+        error = later.exception()
+        if error is None:
+            text = later.result()
+        elif isinstance(error, C2rvizError):
+            text = replies.error(error)
+        else:
+            text = replies.error("internal error (see the server log)")
+        self.world.replied(self.source, line, text)
 
     def after(self, seconds: float, reply: str) -> asyncio.Future[str]:
         """A reply that comes ``seconds`` [s] from now (on the running loop).

@@ -230,9 +230,11 @@ class Connection(asyncio.Protocol):
         if not self.session.joints_run(texts):
             return start
         note = self.session.world.note
+        replied = self.session.world.replied
         source = self.session.source
         for line in run:
             note(source, line, True)
+            replied(source, line, replies.OK)
         out.extend([replies.OK] * len(run))
         return start + len(run)
 

@@ -50,6 +50,10 @@ class Observer:
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         """``source`` sent ``line``; ``accepted`` False if it was refused."""
 
+    def on_reply(self, source: str, line: str, reply: str) -> None:
+        """``source``'s ``line`` got ``reply`` (its text, errors too), once known: at once,
+        or when a reply that waits comes (a move's on arrival); not if it never came."""
+
     def on_tool(self, robot: str, tool: pin.SE3) -> None:
         """``robot``'s tool point is now ``tool`` (relative to its end-effector link)."""
 

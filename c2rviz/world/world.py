@@ -79,6 +79,7 @@ class World:
         self.observers: list[Observer] = [self.contacts]
         if scene is not None:
             self.observers.append(scene)
+        self._repliers = _repliers(self.observers)  # those that keep replies (recordings)
         self.travels = Travels(self._show, self._rested, self.clock, self.frame_s)
         for name, state in self.robots.items():
             self.travels.add(state, (limits or {}).get(name) or motion_limits(state.robot))
@@ -242,8 +243,20 @@ class World:
         for observer in self.observers:
             observer.on_command(source, line, accepted)
 
+    def replied(self, source: str, line: str, reply: str) -> None:
+        """``source``'s ``line`` got ``reply``; tell the observers (recordings keep it)."""
+        for observer in self._repliers:  # most lines: none, so this costs next to nothing
+            observer.on_reply(source, line, reply)
+
     def add_observers(self, observers: Iterable[Observer]) -> None:
         self.observers.extend(observers)
+        self._repliers = _repliers(self.observers)
 
     def remove_observer(self, observer: Observer) -> None:
         self.observers.remove(observer)
+        self._repliers = _repliers(self.observers)
+
+
+def _repliers(observers: Sequence[Observer]) -> list[Observer]:
+    """The observers that do something with ``on_reply``."""
+    return [o for o in observers if type(o).on_reply is not Observer.on_reply]

@@ -17,6 +17,7 @@ import re
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -64,7 +65,8 @@ def record_two_clients(server: ServerThread, connect, folder: Path) -> tuple[str
     final = boss.ask("where")
     reply = boss.ask("record stop")
     assert re.fullmatch(
-        r"ok recorded take: \d+ frames, \d+\.\d{3} s \(.*take\.txt, .*take\.csv, .*take\.html\)",
+        r"ok recorded take: \d+ frames, \d+\.\d{3} s "
+        r"\(.*take\.txt, .*take\.csv, .*take\.html, .*take\)",
         reply,
     )
     sources = [f"tcp 127.0.0.1:{c.sock.getsockname()[1]}" for c in (boss, mover, dropper)]
@@ -85,7 +87,12 @@ def test_a_recorded_session_replays_to_the_same_states(
     recorded_markers = markers(first)
     assert len(recorded_markers) == 4
     txt, table = tmp_path / "take.txt", tmp_path / "take.csv"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["take.csv", "take.html", "take.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "take",
+        "take.csv",
+        "take.html",
+        "take.txt",
+    ]
 
     # The command file: its header, then commands the player takes.
     text = txt.read_text()
@@ -184,7 +191,7 @@ def test_record_status_and_bad_names(server: ServerThread, connect, tmp_path: Pa
     )
     assert client.ask("record one overwrite").startswith("ok recording one")
     assert client.ask("record stop").startswith("ok recorded one: ")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["one.csv", "one.html", "one.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["one", "one.csv", "one.html", "one.txt"]
     assert not (tmp_path.parent / "x.txt").exists()
 
 
@@ -218,8 +225,24 @@ def test_a_write_error_stops_the_recording_and_the_server_goes_on(
     assert client.ask("record") == "ok not recording"
     assert client.ask("where") == "ok 0.099,0,0,0,0,0,0"
     assert client.ask("record stop") == "error: record: nothing is being recorded"
-    assert not (tmp_path / "broken.txt").exists()  # what was written stays in the part file
-    assert (tmp_path / ".broken.txt.part").exists()
+    # What was written is kept, each file ending with a whole line, in place.
+    deadline = time.monotonic() + 60
+    while (
+        time.monotonic() < deadline and server.call(lambda: server.services.recordings.last) is None
+    ):
+        time.sleep(0.05)
+    txt = tmp_path / "broken.txt"
+    script = player.load_script(txt)
+    assert script.problems == [] and script.robot == "motoman_sia20d"
+    assert "# stopped early: write error: " in txt.read_text()
+    rows = (tmp_path / "broken.csv").read_text()  # what was flushed before the disk went
+    assert rows == "" or rows.endswith("\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "broken",
+        "broken.csv",
+        "broken.html",
+        "broken.txt",
+    ]
 
 
 def test_watchers_hear_when_a_recording_stops(server: ServerThread, connect, tmp_path: Path):
