@@ -5,7 +5,7 @@ clock offers (``path_play``).
 """
 
 from .limits import MotionLimitError, MotionLimits, motion_limits
-from .line_play import LinePlay, ramp_limits
+from .line_play import LinePlay, brake_limits, ramp_limits
 from .path_play import PathPlay
 from .planner import Motion, MotionPlanError
 
@@ -16,6 +16,7 @@ __all__ = [
     "MotionLimits",
     "MotionPlanError",
     "PathPlay",
+    "brake_limits",
     "motion_limits",
     "ramp_limits",
 ]
