@@ -253,21 +253,11 @@ class CollisionModel:
         return geometry, data, names
 
     def _rebuild(self) -> None:
-        self._checks = self._build(set(self.self_pairs.checked), self.workcell.items())
+        self._checks = geometry, data, names = self._build(
+            set(self.self_pairs.checked), self.workcell.items()
+        )
         self._revision += 1
-
-    # --- for checkers of one's own -----------------------------------------------
-
-    @property
-    def revision(self) -> int:
-        """Counts the changes of what is checked (each object set or removed)."""
-        return self._revision
-
-    def check_geometry(self) -> CheckGeometry:
-        """What is checked now, for a checker of one's own (``batch_check``); it stays
-        valid (a change builds new checks, it never alters these)."""
-        geometry, data, names = self._checks
-        return CheckGeometry(
+        self._snapshot = CheckGeometry(  # one assignment: another thread reads it whole
             geometry,
             data,
             tuple(names),
@@ -275,6 +265,18 @@ class CollisionModel:
             tuple(self._link_of),
             self._revision,
         )
+
+    # --- for checkers of one's own -----------------------------------------------
+
+    @property
+    def revision(self) -> int:
+        """Counts the changes of what is checked (each object set or removed)."""
+        return self._snapshot.revision
+
+    def check_geometry(self) -> CheckGeometry:
+        """What is checked now, for a checker of one's own (``batch_check``); it stays
+        valid (a change builds new checks, it never alters these)."""
+        return self._snapshot
 
     def batch_check(
         self,

@@ -22,7 +22,14 @@ from typing import cast
 import numpy as np
 import pinocchio as pin
 
-from c2rviz.collision import CollisionModel, Pair, PlacedShape, placed_shapes
+from c2rviz.collision import (
+    BatchCheck,
+    CheckGeometry,
+    CollisionModel,
+    Pair,
+    PlacedShape,
+    placed_shapes,
+)
 
 from .edge_resolution import TOOL_MARGIN, EdgeResolution, Joints, coarse_first, edge_resolution
 
@@ -40,7 +47,10 @@ class ValidityChecker:
         robot: Its robot.
         resolution: How finely edges are checked.
         batch: The batched check underneath (its ``names`` are the pairs checked).
-        revision: The collision model's revision it was built at.
+        source: The collision model's checks it copied.
+        revision: Their revision.
+        others: The other robots' shapes it holds as obstacles, placed in the cell.
+        origin: Where this robot's root stands in the cell (None: at its origin).
     """
 
     def __init__(
@@ -52,6 +62,7 @@ class ValidityChecker:
         resolution: EdgeResolution | None = None,
         without: Collection[Pair] = (),
         only: Collection[Pair] | None = None,
+        source: CheckGeometry | None = None,
     ) -> None:
         """Snapshot ``collision``'s checks and add the other robots' shapes as fixed obstacles.
 
@@ -64,15 +75,41 @@ class ValidityChecker:
             resolution: Edge resolution (``edge_resolution(robot)`` if None).
             without: Pairs not checked (a guarded move may leave a contact).
             only: If given, the only pairs checked.
+            source: The model's checks to copy (``collision.check_geometry()`` if None).
         """
         robot = collision.robot
         self.collision = collision
         self.robot = robot
         self.resolution = resolution if resolution is not None else edge_resolution(robot)
-        self.revision = collision.revision
-        self.batch = collision.batch_check(others, origin=origin, without=without, only=only)
+        self.others = tuple(others)
+        self.origin = origin
+        source = source if source is not None else collision.check_geometry()
+        self.source = source
+        self.revision = source.revision
+        self.batch = BatchCheck(
+            robot,
+            source,
+            others,
+            origin=origin,
+            without=frozenset(without),
+            only=None if only is None else frozenset(only),
+        )
         self._model = robot.model
         self._model_data = robot.model.createData()
+
+    def variant(
+        self, *, without: Collection[Pair] = (), only: Collection[Pair] | None = None
+    ) -> ValidityChecker:
+        """The same checks (model, others, resolution), less ``without`` or only ``only``."""
+        return ValidityChecker(
+            self.collision,
+            self.others,
+            origin=self.origin,
+            resolution=self.resolution,
+            without=without,
+            only=only,
+            source=self.source,
+        )
 
     @property
     def checks(self) -> int:
