@@ -21,6 +21,7 @@ from __future__ import annotations
 import asyncio
 import copy
 import functools
+import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -33,9 +34,11 @@ from ..motion.path_play import PathPlay
 from ..planning import EdgeResolution, MoveChecker, MoveRequest, first_blocked
 from ..world.effects import Observer
 from ..world.world import World
-from .worker import Worker
+from .worker import Superseded, Worker
 
 __all__ = ["DT", "GuardWatch", "Run"]
+
+log = logging.getLogger("c2rviz")
 
 DT = 0.01  # [s] of the world's clock between two samples of a running move re-checked
 
@@ -168,8 +171,13 @@ class GuardWatch(Observer):
         return checker
 
     def _checked(self, robot: str, run: Run, cause: str, done: asyncio.Future[Hit | None]) -> None:
-        if done.cancelled() or done.exception() is not None:
-            return  # superseded by a newer re-check, or the program stops
+        if done.cancelled():
+            return  # the program stops
+        error = done.exception()
+        if error is not None:
+            if not isinstance(error, Superseded):  # (a newer re-check replaced it)
+                log.warning("re-checking %s's running guarded move failed: %r", robot, error)
+            return
         hit: Hit | None = done.result()
         if hit is None or self.current(robot) is not run:
             return
