@@ -37,9 +37,12 @@ from .ompl_planner import PlannedPath, plan_for
 from .path_check import first_blocked, path_points
 from .validity import ValidityChecker
 
-__all__ = ["PLAN_MODES", "CheckedMove", "MoveChecker", "MoveRequest"]
+__all__ = ["PLAN_MODES", "CheckedMove", "MoveChecker", "MoveRequest", "OtherAt"]
 
 PLAN_MODES = ("never", "blocked", "always")
+
+OtherAt = tuple[str, tuple[float, ...] | None, bytes]
+"""Another robot when a request was made: name, joints if still (else None), origin's bytes."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -50,7 +53,9 @@ class MoveRequest:
         collision: The robot's collision model.
         source: Its checks when the request was made (``check_geometry()``).
         others: The other robots' shapes where they stood, placed in the cell.
-        others_key: Says when ``others`` changed (their names, joints and places).
+        others_at: Each other robot: its name, its joints [rad or m] if it stood
+            still (None if it moved) and its place (the bytes of its origin), so the
+            caller can tell when ``others`` changed.
         origin: Where this robot's root stands in the cell.
         resolution: How finely edges are checked.
         start: Where the move starts, at rest [rad or m].
@@ -65,7 +70,7 @@ class MoveRequest:
     collision: CollisionModel
     source: CheckGeometry
     others: tuple[PlacedShape, ...]
-    others_key: Hashable
+    others_at: tuple[OtherAt, ...]
     origin: pin.SE3
     resolution: EdgeResolution
     start: tuple[float, ...]
@@ -107,7 +112,7 @@ class MoveChecker:
 
     def checker(self, request: MoveRequest) -> ValidityChecker:
         """The robot's checker for what ``request`` is checked against (built if needed)."""
-        key = (request.source.revision, request.others_key, request.resolution)
+        key = (request.source.revision, request.others_at, request.resolution)
         cached = self._cache.get(id(request.collision))
         if cached is not None and cached[0] == key and cached[1].collision is request.collision:
             return cached[1]

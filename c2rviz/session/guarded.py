@@ -133,7 +133,7 @@ def unchanged(session: GuardedSession, asked: MoveRequest, at_rest: bool) -> boo
         return False
     if at_rest and (session.travel.active or tuple(state.q) != asked.start):
         return False
-    for name, q, _ in asked.others_key:  # type: ignore[attr-defined]
+    for name, q, _ in asked.others_at:
         if q is not None and (world.moving(name) or tuple(world.robots[name].q) != q):
             return False
     return True

@@ -15,6 +15,7 @@ import numpy as np
 from ..collision.batch import PlacedShape
 from ..collision.other_robots import placed_shapes
 from ..planning import EdgeResolution, MoveRequest
+from ..planning.guarded_move import OtherAt
 from ..world.world import World
 
 __all__ = ["world_request"]
@@ -39,12 +40,12 @@ def world_request(
     state = world.state(robot)
     model = world.collision_model(robot)
     shapes: list[PlacedShape] = []
-    key = []
+    key: list[OtherAt] = []
     for name, other in world.robots.items():
         moving = world.moving(name)
         if name == robot or (moving and still_only):
             continue
-        q = world.now(name)
+        q = tuple(world.now(name))
         shapes += placed_shapes(name, world.collision_model(name), q, other.origin)
         key.append((name, None if moving else q, other.origin.homogeneous.tobytes()))
     return MoveRequest(
