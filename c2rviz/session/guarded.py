@@ -11,10 +11,11 @@ With ``guard on`` (or ``plan``) a joint-space move goes like this:
    thread (``planning.MoveChecker``): the goal alone for a move shown at once,
    else the straight joint-space path (``guard plan``: planned around when it
    is blocked; ``plan``: always planned, the direct edge first).
-3. Back on the loop the world may have changed meanwhile: the arm must rest where
-   the check started, the workcell be the one checked (its revision), and every
-   other robot that stood still stand where it stood; else the move is checked
-   again, up to ``TRIES`` times, and then refused (``WorldChanged``).
+3. Back on the loop the world may have changed meanwhile: the workcell must be the
+   one checked (its revision), and every other robot that stood still stand where
+   it stood; else the move is checked again, up to ``TRIES`` times, and then
+   refused (``WorldChanged``). If another command sent the arm elsewhere meanwhile,
+   this one is refused (``ArmMoved``): the newer command wins.
 4. The move is played as a ``TimedPath`` on the checked polyline (a straight move
    is a one-edge path) at the session's speed, and ``GuardWatch`` keeps
    re-checking it while it runs (a new object, another robot's move).
@@ -30,7 +31,7 @@ from typing import Protocol
 import numpy as np
 
 from ..collision.model import NoFreeConfiguration
-from ..errors import C2rvizError
+from ..errors import ArmMoved, C2rvizError
 from ..planning import (
     CheckedMove,
     EdgeResolution,
@@ -60,6 +61,7 @@ __all__ = [
 
 TRIES = 3  # checks of one move while the world keeps changing under it
 DRAWS = 1000  # random configurations a guarded rand draws at most
+_TAKEN = "another command moved the arm while this move was checked; nothing moved, send it again"
 
 
 class GuardedSession(Protocol):
@@ -174,10 +176,14 @@ async def checked_move(
         checked = await worker.run(
             functools.partial(checker.check, asked), key=("move", id(session))
         )
-        if not at_once and session.travel.active:
+        if not at_once:
+            if session.travel.active and not session.travel.stopping:
+                raise ArmMoved(_TAKEN)  # not our brake: another command took the arm
             rest = session.world.travels.rest(session.state)
             if rest is not None:
                 await rest
+            if tuple(session.state.q) != asked.start:
+                raise ArmMoved(_TAKEN)
         if unchanged(session, asked, at_rest=not at_once):
             return checked, at_once
     raise WorldChanged(TRIES)

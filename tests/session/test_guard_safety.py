@@ -284,3 +284,20 @@ def test_the_newest_of_one_sources_waiting_moves_wins(server: ServerThread):
     assert str(older) == "superseded by a newer command before it was checked"
     assert newer == "ok"
     np.testing.assert_allclose(server.q, [math.radians(20), 0, 0, 0, 0, 0, 0], atol=1e-12)
+
+
+def test_a_newer_command_that_moves_the_arm_during_a_check_wins(server: ServerThread, open_client):
+    mover = open_client("guard on", "motion on")
+    other = open_client()
+    blocker = Blocker(server)
+    try:
+        mover.send(f"j {REACH}\n")
+        wait_for_waiting(server, 1)
+        assert other.ask(f"j {OTHER}") == "ok"  # unguarded, shown at once
+    finally:
+        blocker.release()
+    assert mover.read_line() == (
+        "error: another command moved the arm while this move was checked; nothing moved, "
+        "send it again"
+    )
+    assert mover.ask("where") == f"ok {OTHER}"
