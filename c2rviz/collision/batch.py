@@ -133,6 +133,8 @@ class BatchCheck:
     def configurations(self, qs: np.ndarray | Sequence[Sequence[float]]) -> np.ndarray:
         """Pinocchio configurations (``nq`` x k) of chain values ``qs`` (k x n) [rad or m]."""
         qs = np.atleast_2d(np.asarray(qs, dtype=float))
+        if len(qs) == 1:  # the common case of a single check: the robot's own, quicker
+            return self.robot.configuration(cast(Sequence[float], qs[0]))[:, None]
         full = np.repeat(self._neutral[:, None], len(qs), axis=1)
         full[self._plain_q] = qs[:, self._plain].T
         for i, idx in self._turning:

@@ -136,7 +136,9 @@ class MoveChecker:
         """
         checker = self.checker(request)
         start = np.asarray(request.start, dtype=float)
-        allowed = frozenset(checker.batch.colliding(start))
+        allowed = (
+            frozenset() if checker.is_valid(start) else frozenset(checker.batch.colliding(start))
+        )
         revision = request.source.revision
         if request.plan == "always":
             return self._planned(checker, request, allowed)
