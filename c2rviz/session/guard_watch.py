@@ -34,7 +34,7 @@ from ..motion.path_play import PathPlay
 from ..planning import EdgeResolution, MoveChecker, MoveRequest, first_blocked
 from ..world.effects import Observer
 from ..world.world import World
-from .worker import Superseded, Worker
+from .worker import Superseded, Worker, WorkerBusy
 
 __all__ = ["DT", "GuardWatch", "Run"]
 
@@ -90,6 +90,7 @@ class GuardWatch(Observer):
         self.worker = worker
         self.request = request
         self.runs: dict[str, Run] = {}
+        self._rechecking: dict[str, str | None] = {}  # robot -> the cause of one more, if any
         self.stops = 0
         """Running moves stopped because the world changed under them."""
 
@@ -136,10 +137,18 @@ class GuardWatch(Observer):
 
     # The re-check.
 
-    def recheck(self, robot: str, cause: str) -> None:
-        """Check ``robot``'s running guarded move again, first on the worker."""
+    def recheck(self, robot: str, cause: str, urgent: bool = True) -> None:
+        """Check ``robot``'s running guarded move again, first on the worker (``urgent``).
+
+        While one re-check of the robot runs, more changes make one more after it, not
+        urgent: a robot streamed to new places at once cannot keep the worker from the
+        other clients' work.
+        """
         run = self.current(robot)
         if run is None:
+            return
+        if robot in self._rechecking:
+            self._rechecking[robot] = cause  # once more when this one is done
             return
         world = self.world
         state = world.state(robot)
@@ -159,9 +168,16 @@ class GuardWatch(Observer):
             moving,
         )
         checker = self._checker()
-        done = self.worker.run(
-            functools.partial(_first_hit, checker, snapshot), key=("watch", robot), urgent=True
-        )
+        self._rechecking[robot] = None
+        try:
+            done = self.worker.run(
+                functools.partial(_first_hit, checker, snapshot),
+                key=("watch", robot),
+                urgent=urgent,
+            )
+        except WorkerBusy:  # (only a follow-up, not urgent, can be refused)
+            done = asyncio.get_running_loop().create_future()
+            done.set_result(None)
         done.add_done_callback(functools.partial(self._checked, robot, run, cause))
 
     def _checker(self) -> MoveChecker:
@@ -171,8 +187,11 @@ class GuardWatch(Observer):
         return checker
 
     def _checked(self, robot: str, run: Run, cause: str, done: asyncio.Future[Hit | None]) -> None:
+        again = self._rechecking.pop(robot, None)
         if done.cancelled():
             return  # the program stops
+        if again is not None:
+            self.recheck(robot, again, urgent=False)
         error = done.exception()
         if error is not None:
             if not isinstance(error, Superseded):  # (a newer re-check replaced it)
