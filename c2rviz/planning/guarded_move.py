@@ -112,7 +112,13 @@ class MoveChecker:
 
     def checker(self, request: MoveRequest) -> ValidityChecker:
         """The robot's checker for what ``request`` is checked against (built if needed)."""
-        key = (request.source.revision, request.others_at, request.resolution)
+        placed = tuple((name, where.homogeneous.tobytes()) for name, _, where in request.others)
+        key = (
+            request.source.revision,
+            placed,
+            request.origin.homogeneous.tobytes(),
+            request.resolution,
+        )
         cached = self._cache.get(id(request.collision))
         if cached is not None and cached[0] == key and cached[1].collision is request.collision:
             return cached[1]

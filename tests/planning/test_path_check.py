@@ -6,8 +6,16 @@ import numpy as np
 import pinocchio as pin
 from planning_scenes import load
 
-from c2rviz.collision import CollisionModel
-from c2rviz.planning import ValidityChecker, first_blocked, path_points
+from c2rviz.collision import CollisionModel, placed_shapes
+from c2rviz.errors import PathCollides
+from c2rviz.planning import (
+    MoveChecker,
+    MoveRequest,
+    ValidityChecker,
+    edge_resolution,
+    first_blocked,
+    path_points,
+)
 
 
 def checker() -> ValidityChecker:
@@ -48,3 +56,35 @@ def test_a_contact_at_the_start_may_be_left_but_not_pushed_into_or_met_again() -
     through = path_points(valid, np.array([inside, deg(0, 60, 0, 0, 0, 0, 0), inside]))
     index, pair = first_blocked(valid, through, allowed)  # out and back in: blocked again
     assert pair in allowed and index > len(through) // 2
+
+
+def test_the_move_checker_follows_the_other_robots_where_they_are() -> None:
+    """Its kept checker is rebuilt when another robot stands elsewhere (moving or not)."""
+    robot = load("motoman_sia20d")
+    a, b = CollisionModel(robot), CollisionModel(robot)
+    here, there = (
+        pin.SE3(np.eye(3), np.array([0, -0.45, 0])),
+        pin.SE3(np.eye(3), np.array([0, 0.45, 0])),
+    )
+    towards_a = deg(-90, 60, 0, 0, 0, 0, 0)  # b's arm held out towards a, over a's head
+    goal = np.zeros(7)  # a upright
+    moves = MoveChecker()
+    answers = []
+    for q_b in (np.zeros(7), towards_a):
+        request = MoveRequest(
+            a,
+            a.check_geometry(),
+            tuple(placed_shapes("b", b, q_b, there)),
+            (("b", None, there.homogeneous.tobytes()),),  # b moving: same key either way
+            here,
+            edge_resolution(robot),
+            tuple(deg(0, 60, 0, 0, 0, 0, 0)),  # a held out along +x: free of b either way
+            (tuple(goal),),
+            target_only=True,
+        )
+        try:
+            moves.check(request)
+            answers.append("free")
+        except PathCollides as exc:
+            answers.append(exc.pair[1].split("/")[0])
+    assert answers == ["free", "b"]
