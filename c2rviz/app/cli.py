@@ -123,8 +123,37 @@ def build_parser() -> argparse.ArgumentParser:
     add("--speed", type=float, metavar="P", help="new connections' speed, %% of the limits (50)")
     add(
         "--guard",
-        choices=("off", "on"),
-        help="new connections refuse colliding targets and paths (default off)",
+        choices=("off", "on", "plan"),
+        help="new connections refuse colliding targets and paths (on), or plan joint-space "
+        "moves around what they would hit (plan); default off",
+    )
+    add(
+        "--plan-timeout",
+        dest="plan_timeout_s",
+        type=float,
+        metavar="S",
+        help="most time a plan searches (default 1 s; 0.001..60)",
+    )
+    add(
+        "--seed",
+        dest="plan_seed",
+        type=int,
+        metavar="N",
+        help="seed of the planner and of rand, so a run repeats (default: a fresh one)",
+    )
+    add(
+        "--plan-step",
+        dest="plan_step_deg",
+        type=float,
+        metavar="DEG",
+        help="most a joint turns between two checks of a path (default 1 degree; 0.01..10)",
+    )
+    add(
+        "--plan-tool-step",
+        dest="plan_tool_step_mm",
+        type=float,
+        metavar="MM",
+        help="most the tool travels between two checks of a path (default 5 mm; 0.1..100)",
     )
     add("--srdf", metavar="FILE", type=Path, help="SRDF whose disable_collisions are honoured")
     add("--max-objects", type=int, metavar="N", help="workcell objects per robot (default 100)")

@@ -12,6 +12,7 @@ is looked up in the catalogue (example-robot-data). Every bad value is a
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -150,6 +151,14 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "max_objects": ("max_objects", int, 0, 10_000),
     "max_viewers": ("max_viewers", int, 1, 1024),
     "rosbridge_port": ("rosbridge_port", int, 0, 65535),
+    "plan_timeout": ("plan_timeout_s", float, 0.001, 60),
+    "seed": ("plan_seed", int, 0, 2**31 - 2),
+    "plan_step": ("plan_step_deg", float, 0.01, 10),
+    "plan_tool_step": ("plan_tool_step_mm", float, 0.1, 100),
+}
+_TO_SI = {  # a setting given in handier units -> (SessionDefaults field, conversion)
+    "plan_step_deg": ("plan_step_rad", math.radians),
+    "plan_tool_step_mm": ("plan_tool_step_m", lambda mm: mm / 1000.0),
 }
 _TEXT_OPTIONS = (
     "host",
@@ -161,7 +170,7 @@ _TEXT_OPTIONS = (
     "viewer_token",
     "viewer_origins",
 )
-_CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on")}
+_CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on", "plan")}
 MOTION_FLAGS = ("max_velocity", "max_acceleration", "max_jerk")
 """Motion limits a flag may give every robot (over the ini's)."""
 _EXTRA_KEYS = ["tool", *MOTION_FLAGS]
@@ -183,7 +192,7 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
                 if text not in _CHOICES.get(key, (text,)):
                     raise ConfigError(f"[options] {key} = {text!r} is not one", _CHOICES[key])
                 if key == "guard":
-                    values[key] = text == "on"
+                    values[key], values["plan_around"] = text != "off", text == "plan"
                 elif key == "record_dir":
                     values[key] = path.parent / text
                 elif key == "viewer_origins":
@@ -291,8 +300,11 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
             flag = "--" + key.replace("viewer_", "viser_").replace("_", "-")
             raise ConfigError(f"{flag} {given[name]:g} is outside {low:g}..{high:g}")
     if "guard" in given:
-        given["guard"] = given["guard"] == "on"
+        given["guard"], given["plan_around"] = given["guard"] != "off", given["guard"] == "plan"
     values.update(given)
+    for key, (name, to_si) in _TO_SI.items():
+        if key in values:
+            values[name] = to_si(values.pop(key))
     if "record_dir" in values:
         values["record_dir"] = Path(values["record_dir"])
     for key in ("package_paths", "xacro_args", "viewer_origins"):

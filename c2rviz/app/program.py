@@ -14,6 +14,8 @@ import sys
 from collections.abc import Awaitable, Sequence
 from pathlib import Path
 
+import numpy as np
+
 from ..collision.geometry import read_srdf
 from ..errors import C2rvizError, ConfigError
 from ..observers.recorder import Recorded
@@ -119,6 +121,7 @@ async def serve(
         world,
         limits=settings.limits,
         defaults=settings.session,
+        rng=np.random.default_rng(settings.session.plan_seed),  # a seed repeats rand too
         record_dir=settings.record_dir,
         trail_points=settings.trail_points,
         exporters=(write_page,),

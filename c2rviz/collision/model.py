@@ -29,6 +29,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..robot.model import Robot
+from .batch import BatchCheck, CheckGeometry, PlacedShape
 from .geometry import (
     CollisionError,
     CollisionModelError,
@@ -154,6 +155,7 @@ class CollisionModel:
         self.warnings = tuple(notes)
         self.self_pairs = self._choose_pairs(skip, moving, samples, seed)
         self.workcell = Workcell(known, max_objects)
+        self._revision = 0
         self._rebuild()
 
     def _choose_pairs(
@@ -251,7 +253,51 @@ class CollisionModel:
         return geometry, data, names
 
     def _rebuild(self) -> None:
-        self._checks = self._build(set(self.self_pairs.checked), self.workcell.items())
+        self._checks = geometry, data, names = self._build(
+            set(self.self_pairs.checked), self.workcell.items()
+        )
+        self._revision += 1
+        self._snapshot = CheckGeometry(  # one assignment: another thread reads it whole
+            geometry,
+            data,
+            tuple(names),
+            tuple(self._moving_geoms),
+            tuple(self._link_of),
+            self._revision,
+        )
+
+    # --- for checkers of one's own -----------------------------------------------
+
+    @property
+    def revision(self) -> int:
+        """Counts the changes of what is checked (each object set or removed)."""
+        return self._snapshot.revision
+
+    def check_geometry(self) -> CheckGeometry:
+        """What is checked now, for a checker of one's own (``batch_check``); it stays
+        valid (a change builds new checks, it never alters these)."""
+        return self._snapshot
+
+    def batch_check(
+        self,
+        others: Sequence[PlacedShape] = (),
+        *,
+        origin: pin.SE3 | None = None,
+        without: Iterable[Pair] = (),
+        only: Iterable[Pair] | None = None,
+    ) -> BatchCheck:
+        """A fast batched check of this robot for one thread (``batch.BatchCheck``): its
+        pairs and objects now, the ``others`` (other robots' shapes placed in the cell,
+        this robot's root at ``origin``) as fixed obstacles, less ``without`` or only
+        ``only``."""
+        return BatchCheck(
+            self.robot,
+            self.check_geometry(),
+            others,
+            origin=origin,
+            without=frozenset(without),
+            only=None if only is None else frozenset(only),
+        )
 
     def _hits(
         self,
@@ -344,11 +390,11 @@ class CollisionModel:
     def link_shapes(self, q: Sequence[float]) -> list[tuple[str, Any, pin.SE3]]:
         """Every collision shape of the robot at chain values ``q``: its link, its coal
         geometry and its placement in the model's root frame (for checks against
-        another robot, ``between.py``)."""
+        another robot, ``other_robots.py``)."""
         geometry = self._geometry
-        data = geometry.createData()
+        data = geometry.createData()  # its own data: safe beside checks on another thread
         pin.updateGeometryPlacements(
-            self.model, self.data, geometry, data, self.robot.configuration(q)
+            self.model, self.model.createData(), geometry, data, self.robot.configuration(q)
         )
         return [
             (link, obj.geometry, data.oMg[k].copy())

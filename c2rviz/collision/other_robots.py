@@ -1,9 +1,15 @@
-"""Collisions between the robots of a world (a cell): one robot's path against the others.
+"""Collisions between the robots of a world (a cell): one robot against the others.
 
-Each robot's own ``CollisionModel`` checks it against itself and its objects; a
-guarded move of one robot of a cell is also checked here against every other
-robot as it stands now. Shapes are first compared by their bounding spheres
-(numpy, all pairs at once); only pairs whose spheres meet go to coal.
+Each robot's own ``CollisionModel`` checks it against itself and its objects;
+here a robot is checked against every other robot as it stands:
+``pairs_between`` (every touching pair now, for ``collisions``) and
+``first_hit_between`` (the first point of a path that touches). Shapes are
+first compared by their bounding spheres (numpy, all pairs at once); only pairs
+whose spheres meet go to coal. ``placed_shapes`` places a robot's shapes in the
+cell (for a ``BatchCheck`` that holds other robots as fixed obstacles).
+
+A pair between robots is ``(link, other/link)``: this robot's link, then the
+other robot's name and link (``collisions`` writes ``link_t~right/link_4``).
 """
 
 from __future__ import annotations
@@ -15,12 +21,44 @@ import coal
 import numpy as np
 import pinocchio as pin
 
+from .batch import PlacedShape
+from .geometry import Pair
 from .model import CollisionModel
 
-__all__ = ["OtherRobot", "first_hit_between"]
+__all__ = ["OtherRobot", "first_hit_between", "pairs_between", "placed_shapes"]
 
 OtherRobot = tuple[str, CollisionModel, Sequence[float], pin.SE3]
 """Another robot of the cell as it stands: name, collision model, joints [rad or m], origin."""
+
+
+def placed_shapes(
+    name: str, collision: CollisionModel, q: Sequence[float], origin: pin.SE3
+) -> list[PlacedShape]:
+    """Every collision shape of the robot ``name`` at ``q`` [rad or m], placed in the cell.
+
+    Args:
+        name: The robot's name in the cell; each shape is named ``name/link``.
+        collision: Its collision model.
+        q: Its chain values [rad or m].
+        origin: Placement of its model's root frame in the cell [m].
+    """
+    return [
+        (f"{name}/{link}", geometry, origin * placement)
+        for link, geometry, placement in collision.link_shapes(q)
+    ]
+
+
+def pairs_between(
+    model: CollisionModel, origin: pin.SE3, q: Sequence[float], others: Sequence[OtherRobot]
+) -> list[Pair]:
+    """Every pair (``link``, ``other/link``) in contact between a robot at ``q`` [rad or m]
+    (its root at ``origin``) and the ``others`` as they stand, sorted."""
+    placed = [shape for name, m, oq, o in others for shape in placed_shapes(name, m, oq, o)]
+    if not placed:
+        return []
+    mine = [(link, shape, origin * placement) for link, shape, placement in model.link_shapes(q)]
+    near = _near(mine, placed)
+    return sorted({(mine[i][0], placed[j][0]) for i, j in near if _collide(mine[i], placed[j])})
 
 
 def first_hit_between(
@@ -39,26 +77,28 @@ def first_hit_between(
         others: The other robots of the cell as they stand.
         path: The moving robot's chain values along its path [rad or m].
     """
-    placed: list[tuple[str, Any, pin.SE3]] = [
-        (f"{name}/{link}", geometry, other_origin * placement)
-        for name, other_model, q, other_origin in others
-        for link, geometry, placement in other_model.link_shapes(q)
-    ]
+    placed = [shape for name, m, oq, o in others for shape in placed_shapes(name, m, oq, o)]
     if not placed:
         return None
-    theirs = _spheres(placed)
     for index, q in enumerate(path):
         mine = [
             (link, shape, origin * placement) for link, shape, placement in model.link_shapes(q)
         ]
-        ours = _spheres(mine)
-        near = np.linalg.norm(ours[0][:, None, :] - theirs[0][None, :, :], axis=2) <= (
-            ours[1][:, None] + theirs[1][None, :]
-        )
-        for i, j in zip(*np.nonzero(near)):
+        for i, j in _near(mine, placed):
             if _collide(mine[i], placed[j]):
                 return index, (mine[i][0], placed[j][0])
     return None
+
+
+def _near(
+    mine: list[tuple[str, Any, pin.SE3]], theirs: list[tuple[str, Any, pin.SE3]]
+) -> list[tuple[int, int]]:
+    """The index pairs of shapes whose bounding spheres meet."""
+    ours, others = _spheres(mine), _spheres(theirs)
+    near = np.linalg.norm(ours[0][:, None, :] - others[0][None, :, :], axis=2) <= (
+        ours[1][:, None] + others[1][None, :]
+    )
+    return [(int(i), int(j)) for i, j in zip(*np.nonzero(near))]
 
 
 def _spheres(shapes: list[tuple[str, Any, pin.SE3]]) -> tuple[np.ndarray, np.ndarray]:

@@ -6,7 +6,7 @@ played on the clock offers (``path_play``).
 """
 
 from .limits import MotionLimitError, MotionLimits, motion_limits
-from .line_play import LinePlay, ramp_limits
+from .line_play import LinePlay, brake_limits, ramp_limits
 from .path_play import PathPlay
 from .planner import Motion, MotionPlanError
 from .trajectory import PlannedTrajectory, TrajectoryError, plan_trajectory
@@ -19,6 +19,7 @@ __all__ = [
     "MotionLimits",
     "MotionPlanError",
     "PathPlay",
+    "brake_limits",
     "PlannedTrajectory",
     "TrajectoryError",
     "TrajectoryPlay",

@@ -13,8 +13,11 @@ limit ``a`` (and jerk limit ``j``) from the ramp: ``du^2/dt^2 <= min(a / v)``,
 Between waypoints the joints still move linearly in ``u`` (their velocity
 changes at a waypoint, as the line's direction in joint space does).
 
-A stop brakes ``u`` to rest as fast as those limits allow: the arm slows down
-on the line and stops on it, short of the goal. Pure: times are the caller's.
+A stop brakes ``u`` to rest at the joints' full limits (``brake_limits``: a
+line timed at speed fraction ``f`` has ``|dq/du| <= f * v``, so ``u`` may
+decelerate at ``min(a / v) / f`` and jerk at ``min(j / v) / f**2``): the arm
+slows down on the line and stops on it, short of the goal. Pure: times are the
+caller's.
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ from ruckig import ControlInterface, InputParameter, Result, Ruckig, Trajectory
 from .limits import MotionLimits
 from .planner import MotionPlanError
 
-__all__ = ["LinePlay", "ramp_limits"]
+__all__ = ["LinePlay", "brake_limits", "ramp_limits"]
 
 
 def ramp_limits(limits: MotionLimits, fraction: float) -> tuple[float, float]:
@@ -36,6 +39,13 @@ def ramp_limits(limits: MotionLimits, fraction: float) -> tuple[float, float]:
     acceleration = float(np.min(np.asarray(limits.acceleration) / velocity))
     jerk = float(np.min(np.asarray(limits.jerk) / velocity))
     return acceleration * fraction, jerk * fraction**2
+
+
+def brake_limits(limits: MotionLimits, fraction: float) -> tuple[float, float]:
+    """The path-time acceleration and jerk [1/s, 1/s^2] a line timed at speed ``fraction``
+    may brake with: the joints' full acceleration and jerk (see the module)."""
+    acceleration, jerk = ramp_limits(limits, 1.0)
+    return acceleration / fraction, jerk / fraction**2
 
 
 class LinePlay:
@@ -54,6 +64,7 @@ class LinePlay:
         qs: np.ndarray,
         acceleration: float,
         jerk: float,
+        brake: tuple[float, float] | None = None,
     ) -> None:
         """Ease in at ``start`` and out at the last waypoint.
 
@@ -63,13 +74,21 @@ class LinePlay:
             qs: The waypoints [rad or m], one row each.
             acceleration: Most path-time acceleration [1/s] (``ramp_limits``).
             jerk: Most path-time jerk [1/s^2] (``ramp_limits``).
+            brake: Path-time acceleration and jerk a stop may use (``brake_limits``;
+                the ramp's when None).
         """
         self.start = start
         self.times = np.asarray(times, dtype=float)
         self.qs = np.asarray(qs, dtype=float)
         self._limits = (acceleration, jerk)
+        self._brake_limits = brake if brake is not None else self._limits
         self._origin = start  # the profile's time 0 on the caller's clock
         self._profile = self._plan(0.0, 0.0, 0.0, ControlInterface.Position)
+
+    @property
+    def joint_path(self) -> np.ndarray:
+        """The waypoints played [rad or m], one row each (the page draws the tool's line)."""
+        return self.qs
 
     @property
     def arrival(self) -> float:
@@ -93,17 +112,39 @@ class LinePlay:
         f = (u - u0) / (u1 - u0) if u1 > u0 else 1.0
         return tuple((self.qs[k - 1] + f * (self.qs[k] - self.qs[k - 1])).tolist())
 
+    def state(self, t: float) -> tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]:
+        """Position [rad or m], velocity [/s] and acceleration [/s^2] at the caller's ``t``
+        (the joints move linearly in ``u`` between waypoints)."""
+        u, rate, acceleration = self.path_time(t)
+        k = min(max(int(np.searchsorted(self.times, u, side="right")), 1), len(self.times) - 1)
+        span = self.times[k] - self.times[k - 1]
+        slope = (self.qs[k] - self.qs[k - 1]) / span if span > 0 else np.zeros(self.qs.shape[1])
+        if u >= self.times[-1]:
+            slope = np.zeros(self.qs.shape[1])
+        return (
+            self.sample(t),
+            tuple((slope * rate).tolist()),
+            tuple((slope * acceleration).tolist()),
+        )
+
     def brake(self, t: float) -> float:
         """From ``t`` on, slow down on the path to rest; return when the arm is at rest."""
         u, rate, acceleration = self.path_time(t)
-        self._profile = self._plan(u, rate, acceleration, ControlInterface.Velocity)
+        self._profile = self._plan(
+            u, rate, acceleration, ControlInterface.Velocity, self._brake_limits
+        )
         self._origin = t
         return self.arrival
 
     def _plan(
-        self, u: float, rate: float, acceleration: float, interface: ControlInterface
+        self,
+        u: float,
+        rate: float,
+        acceleration: float,
+        interface: ControlInterface,
+        limits: tuple[float, float] | None = None,
     ) -> Trajectory:
-        max_acceleration, max_jerk = self._limits
+        max_acceleration, max_jerk = self._limits if limits is None else limits
         params = InputParameter(1)
         params.control_interface = interface
         params.current_position = [u]

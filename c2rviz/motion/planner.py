@@ -18,10 +18,20 @@ times longer), and what the old plan could do from this state (stop before a
 limit, ramp its acceleration down before passing its velocity limit) the new
 plan can too. Once the arm is at rest the commanded fraction alone counts.
 
-Stop. Every joint brakes to rest as fast as the plan's limits allow, each on
-its own (ruckig's velocity interface, no synchronization): a synchronized brake
-slows the quicker joints' braking, and they coast past the target they were
-heading for. The tests check that a stop ends between start and target.
+Stop. The arm brakes at the joints' full limits, whatever the move's speed (a
+stop at 5 % speed would otherwise take 1/0.05**2 = 400 times the braking
+acceleration's time). A move that started from rest is a straight segment in
+joint space (phase synchronization, below): it brakes along that segment. Its
+path parameter ``s`` (``q = start + u * s``, ``max |u_i| = 1``) is braked by a
+one-joint ruckig profile whose limits are the tightest of the joints' along
+``u`` (``min v_i / |u_i|`` and likewise), so every joint stops at one common
+fraction of its travel and the arm stays on the path the guard checked
+(ruckig's own phase-synchronized brake falls back to time synchronization,
+off the line, when the limiting joint's profile scaled would break another
+joint's limits). Any other plan (a preemption blended from a moving state)
+brakes each joint on its own (no synchronization): a synchronized brake slows
+the quicker joints' braking, and they coast past the target they were heading
+for. The tests check that a stop ends between start and target.
 
 Position limits. ruckig's community edition ignores ``min_position`` and
 ``max_position`` (a Pro feature), so the planner keeps within the joint limits
@@ -60,11 +70,12 @@ from ruckig import (
 
 from ..errors import C2rvizError, JointCountError
 from .limits import MotionLimitError, MotionLimits, motion_limits
+from .line_brake import LineBrake, line_brake
 
 __all__ = ["Motion", "MotionLimitError", "MotionLimits", "MotionPlanError", "motion_limits"]
 
 State = tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]
-Plan = tuple[tuple[float, Trajectory], ...]  # (start time [s], trajectory), in order
+Plan = tuple[tuple[float, "Trajectory | LineBrake"], ...]  # (start time [s], plan), in order
 
 _TOLERANCE = 1e-6  # [rad or m] an overshoot up to this (rounding) is only clamped
 _TIGHTER = (1.0, 1 - 1e-12, 1 - 1e-9)  # acceleration/jerk limit factors ruckig is retried with
@@ -147,6 +158,7 @@ class Motion:
         self._speed = 1.0  # velocity fraction of the plan
         self._scale = 1.0  # acceleration (squared) and jerk (cubed) fraction of the plan
         self._overshoot = 0.0
+        self._line: tuple[np.ndarray, np.ndarray] | None = None  # a straight plan: (start, goal)
 
     # --- state ------------------------------------------------------------------
 
@@ -192,6 +204,21 @@ class Motion:
         self._end = t
         self._speed = self._scale = 1.0
         self._overshoot = 0.0
+        self._line = None
+
+    def take_over(self, state: State, t: float) -> None:
+        """The arm is at ``state`` (position [rad or m], velocity, acceleration) at ``t``
+        [s], moving along a path played elsewhere: from here it brakes, each joint at
+        its full limits, unless a move planned at ``t`` replaces that (then the move
+        blends from this state, as a preemption does)."""
+        q, v, a = (tuple(float(x) for x in values) for values in state)
+        if not any(v) and not any(a):
+            self.jump(q, t)
+            return
+        brake = self._brake(q, v, a, 1.0)
+        rest = np.clip(brake.at_time(brake.duration)[0], self._lower, self._upper)
+        self._set(((t, brake),), tuple(rest.tolist()), 1.0, 1.0)
+        self._line = None
 
     def move_to(self, target: Sequence[float], t: float, speed: float = 1.0) -> float:
         """Plan from the state at ``t`` [s] to rest at ``target``; return arrival [s].
@@ -209,7 +236,8 @@ class Motion:
         goal = self._check_target(target)
         speed = self._check_speed(speed)
         q, v, a = self.sample(t)
-        scale = max(speed, self._scale) if t < self._end else speed
+        moving = t < self._end
+        scale = max(speed, self._scale) if moving else speed
         trajectory = self._position(q, v, a, goal, speed, scale)
         plan: Plan = ((t, trajectory),)
         if self._overshoot_of(trajectory) > _TOLERANCE:
@@ -218,6 +246,7 @@ class Motion:
             move = self._position(rest, self._zeros, self._zeros, goal, speed, speed)
             plan = ((t, brake), (t + brake.duration, move))
         self._set(plan, goal, speed, scale)
+        self._line = None if moving else (np.array(q), np.array(goal))
         return self._end
 
     def follow(self, target: Sequence[float], t: float, speed: float = 1.0) -> None:
@@ -230,18 +259,35 @@ class Motion:
             self.move_to(target, t, speed)
 
     def stop(self, t: float) -> float:
-        """Decelerate to rest within the limits from time ``t`` [s]; return rest time [s].
+        """Decelerate to rest from time ``t`` [s] at the joints' full limits; return rest
+        time [s].
 
-        Each joint brakes as fast as the plan's limits allow. At rest already:
+        A move from rest brakes along its straight segment (every joint at one common
+        fraction); any other plan brakes each joint on its own. At rest already:
         nothing changes and the time it came to rest is returned.
         """
         if t >= self._end:
             return self._end
         q, v, a = self.sample(t)
-        brake = self._brake(q, v, a, self._scale)
-        rest = np.clip(brake.at_time(brake.duration)[0], self._lower, self._upper)
-        self._set(((t, brake),), tuple(rest.tolist()), self._speed, self._scale)
+        if self._line is not None:
+            brake = line_brake(self._line, (q, v, a), self.limits)
+            if brake is not None:
+                if brake.beyond:  # so near the end that braking would pass it: it stops first
+                    return self._end
+                self._set(((t, brake),), brake.rest, self._speed, 1.0)
+                return self._end  # still on the segment: a stop again brakes along it
+        joints = self._brake(q, v, a, 1.0)
+        rest = np.clip(joints.at_time(joints.duration)[0], self._lower, self._upper)
+        self._set(((t, joints),), tuple(rest.tolist()), self._speed, 1.0)
+        self._line = None
         return self._end
+
+    @property
+    def straight(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """The segment (start, goal) [rad or m] a move from rest travels along (and a stop
+        of it brakes along), or None for a plan that is not one (a preemption from a
+        moving state)."""
+        return self._line
 
     # --- planning ---------------------------------------------------------------
 
@@ -283,8 +329,10 @@ class Motion:
         inp.target_velocity = inp.target_acceleration = self._zeros
         return self._calculate(scale, scale)
 
-    def _overshoot_of(self, trajectory: Trajectory) -> float:
+    def _overshoot_of(self, trajectory: Trajectory | LineBrake) -> float:
         """How far [rad or m] ``trajectory`` passes a position limit (0: within)."""
+        if isinstance(trajectory, LineBrake):
+            return 0.0  # on a segment between two points within the limits
         profiles = trajectory.profiles[0]
         overshoot = 0.0
         for i, lower, upper in self._bounded:

@@ -284,14 +284,18 @@ class Recordings:
         """Stop every recording now; return a coroutine that waits for every one to be
         finished, those stopped earlier too (the program's end), and gives what was
         finished, in the order they stopped."""
+        ending = list(self._in_flight)  # stopped earlier, still being finished
         for recording in list({id(r): r for r in self.running.values()}.values()):
-            self._end(recording, why)
-        return self._all_finished()
+            ending.append(self._end(recording, why))
+        return self._all_finished(ending)
 
-    async def _all_finished(self) -> list[Recorded]:
+    async def _all_finished(self, ending: list[asyncio.Future[list[Recorded]]]) -> list[Recorded]:
+        """What ``ending`` (and any finish started meanwhile) gave, in the order they stopped;
+        a finish already done when this is awaited counts too."""
         finished: list[Recorded] = []
-        while self._in_flight:
-            waiting = list(self._in_flight)
+        awaited: set[asyncio.Future[list[Recorded]]] = set()
+        while waiting := [f for f in (*ending, *self._in_flight) if f not in awaited]:
+            awaited.update(waiting)
             for result in await asyncio.gather(*waiting, return_exceptions=True):
                 if isinstance(result, list):
                     finished.extend(result)

@@ -4,7 +4,10 @@
 workcell and the other robots of a cell, at the resolution of
 ``edge_resolution.py``; ``plan_for``/``plan_path`` (``ompl_planner.py``) plan
 with RRT-Connect and shorten the path; ``time_path`` (``timing.py``) turns the
-waypoints into a motion that stays on them. No asyncio and no world here: the
+waypoints into a motion that stays on them. The guard's path check
+(``path_check.py``: contacts at the start may be left), several IK answers of a
+pose to plan to (``ik_goals.py``), and a move checked or planned off the event
+loop (``guarded_move.py``) build on them. No asyncio and no world here: the
 caller owns the clock.
 """
 
@@ -20,16 +23,29 @@ from .errors import (
     BadPlanningSetting,
     GoalCollides,
     NoPathFound,
+    NoWayAround,
     OutOfLimits,
     PathCheckFailed,
     PlanningError,
     StartCollides,
 )
-from .ompl_planner import MAX_TIMEOUT_S, EdgeCheck, PlannedPath, plan_for, plan_path
+from .guarded_move import PLAN_MODES, CheckedMove, MoveChecker, MoveRequest
+from .ik_goals import goal_candidates
+from .ompl_planner import MAX_TIMEOUT_S, SEEDS, EdgeCheck, PlannedPath, plan_for, plan_path
+from .path_check import first_blocked, path_points
 from .timing import TimedPath, TimingFailed, time_path
 from .validity import PlacedShape, ValidityChecker, robot_shapes
 
 __all__ = [
+    "PLAN_MODES",
+    "SEEDS",
+    "CheckedMove",
+    "MoveChecker",
+    "MoveRequest",
+    "NoWayAround",
+    "first_blocked",
+    "goal_candidates",
+    "path_points",
     "MAX_STEP_M",
     "MAX_STEP_RAD",
     "MAX_TIMEOUT_S",

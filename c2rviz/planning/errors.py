@@ -16,6 +16,7 @@ __all__ = [
     "BadPlanningSetting",
     "GoalCollides",
     "NoPathFound",
+    "NoWayAround",
     "OutOfLimits",
     "PathCheckFailed",
     "PlanningError",
@@ -99,3 +100,12 @@ class PathCheckFailed(PlanningError):
     def __init__(self, edge: int) -> None:
         self.edge = edge
         super().__init__(f"the planned path's edge {edge} collides at the check resolution")
+
+
+class NoWayAround(PlanningError):
+    """A guarded move (``guard plan``) whose straight path is blocked and no plan goes round."""
+
+    def __init__(self, blocked: str, why: str) -> None:
+        self.blocked = blocked
+        self.why = why
+        super().__init__(f"{blocked}, and no way around it: {why}")

@@ -151,8 +151,16 @@ class TimedPath:
         self._goal = qs[-1].copy()
         self._starts = np.array([edge.t0 for edge in self._edges])
 
-    def _bounds(self, u: np.ndarray) -> tuple[float, float, float]:
-        f, limits = self.speed, self._limits
+    @property
+    def joint_path(self) -> np.ndarray:
+        """The polyline played: the waypoints [rad or m], one row each (the page draws
+        the tool's line through them)."""
+        return self.qs
+
+    def _bounds(self, u: np.ndarray, f: float | None = None) -> tuple[float, float, float]:
+        """Bounds of ``s`` along ``u`` at speed fraction ``f`` (the path's if None)."""
+        f = self.speed if f is None else f
+        limits = self._limits
         return (
             _limits_along(u, limits.velocity) * f,
             _limits_along(u, limits.acceleration) * f**2,
@@ -200,8 +208,9 @@ class TimedPath:
     def brake(self, t: float) -> float:
         """From ``t`` [s] on, slow down on the edge being played to rest; return when.
 
-        The stop is as quick as the edge's limits allow, and never passes the
-        edge's end (a stop of a rest-to-rest profile is at least as short as
+        The stop is as quick as the joints' full limits allow along the edge (not
+        the path's speed fraction's), and never passes the edge's end (a stop at
+        limits at least those of a rest-to-rest profile is at least as short as
         the rest of it); at rest already, nothing changes.
         """
         if t >= self._end or not self._edges:
@@ -210,7 +219,7 @@ class TimedPath:
         k = self._index(t)
         edge = self._edges[k]
         s, rate, acceleration = edge.at(t)
-        profile, result = _profile(s, rate, acceleration, math.nan, self._bounds(edge.u))
+        profile, result = _profile(s, rate, acceleration, math.nan, self._bounds(edge.u, 1.0))
         if result not in (Result.Working, Result.Finished):
             raise TimingFailed(k, f"braking ({result.name})")
         braked = _Edge(edge.t0, edge.q0, edge.u, edge.length, edge.profile, t, profile)

@@ -4,7 +4,7 @@ The app makes one ``Services`` for the program and passes it to every door and t
 the view; a test makes one around its own world. It holds the world, how sessions
 start and what a client may cost, the random source of ``rand``, the worker that
 runs CPU work off the event loop, and the observers the verbs drive: ``watch``
-streams, trails and recordings.
+streams, trails, recordings, and the guard's watch over running guarded moves.
 """
 
 from __future__ import annotations
@@ -19,6 +19,8 @@ from ..observers.recordings import DEFAULT_FOLDER, Exporter, Recordings
 from ..observers.trail import DEFAULT_TRAIL_POINTS, TrailKeeper
 from ..observers.watch import WatchHub
 from ..world.world import World
+from .guard_watch import GuardWatch
+from .move_requests import world_request
 from .settings import ServerLimits, SessionDefaults
 from .worker import Worker
 
@@ -41,6 +43,7 @@ class Services:
         trails: The trails (made here).
         recordings: The recordings (made here).
         worker: CPU work off the event loop (made here).
+        guards: The guarded moves running, re-checked when the world changes (made here).
     """
 
     world: World
@@ -54,6 +57,7 @@ class Services:
     trails: TrailKeeper = field(init=False)
     recordings: Recordings = field(init=False)
     worker: Worker = field(init=False)
+    guards: GuardWatch = field(init=False)
     _clients: dict[str, int] = field(init=False, default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -61,6 +65,14 @@ class Services:
         self.trails = TrailKeeper(self.world, self.trail_points)
         self.recordings = Recordings(self.world, self.record_dir, self.watch.event, self.exporters)
         self.worker = Worker()
+        self.guards = GuardWatch(
+            self.world,
+            self.worker,
+            lambda robot, resolution, start: world_request(
+                self.world, robot, resolution, start, [start], still_only=True
+            ),
+        )
+        self.world.add_observers([self.guards])
 
     def count_clients(self, door: str, count: int) -> None:
         """``door`` has ``count`` clients now; the world tells the total to its observers."""

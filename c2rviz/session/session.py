@@ -16,11 +16,11 @@ import functools
 import math
 from collections.abc import Sequence
 
+import numpy as np
 import pinocchio as pin
 
-from ..collision.model import segment
-from ..collision.other_robots import first_hit_between
 from ..errors import C2rvizError, JointLimitError, PathCollides
+from ..planning import EdgeResolution, MoveChecker, edge_resolution, first_blocked, path_points
 from ..protocol import replies
 from ..protocol.grammar import ForeignProtocol, numbers_batch, parse_line
 from ..protocol.registry import HANDLERS, Reply
@@ -28,6 +28,7 @@ from ..robot.frames import pose_se3, se3_pose
 from ..tolerance import within_limit
 from ..world.moves import Travel
 from ..world.state import RobotState
+from .guarded import guarded_go, request
 from .services import Services
 from .units import UnitTable
 
@@ -44,7 +45,12 @@ class Session:
         motion: ``off``, ``on`` or ``follow`` (``protocol.verbs.motion.MOTION_MODES``).
         speed: Moves at this % of the joints' limits.
         guard: Refuse commands whose target or path collides.
+        plan_around: With the guard, plan joint-space moves around what their straight
+            path would hit (``guard plan``).
         lspeed: ``movel``'s tool speed [m/s].
+        plan_timeout_s: Most time a plan searches [s].
+        plan_seed: The planner's seed (None: a fresh one each plan).
+        last_plan: The waypoints of the last path ``plan`` found [rad or m], if any.
         hangup: Set by a handler to ``"bye"`` or ``"quit"``: the connection closes
             after this reply (and for ``quit`` stops the program).
     """
@@ -64,7 +70,12 @@ class Session:
         self.motion = defaults.motion
         self.speed = defaults.speed
         self.guard = defaults.guard
+        self.plan_around = defaults.guard and defaults.plan_around
         self.lspeed = defaults.lspeed
+        self.plan_timeout_s = defaults.plan_timeout_s
+        self.plan_seed = defaults.plan_seed
+        self.last_plan: np.ndarray | None = None
+        self._steps = (defaults.plan_step_rad, defaults.plan_tool_step_m)
         self.select(robot)
 
     def select(self, name: str | None) -> None:
@@ -79,12 +90,41 @@ class Session:
         self.n = self.robot.n  # Robot.n is a property; this is read per command
         self._tables = (UnitTable.build(self.robot, False), UnitTable.build(self.robot, True))
         self.table = self._tables[self.degrees]
+        self.last_plan = None
+        self._resolution: EdgeResolution | None = None
+
+    @property
+    def resolution(self) -> EdgeResolution:
+        """How finely this session's guarded paths and plans are checked."""
+        if self._resolution is None:
+            step_rad, tool_m = self._steps
+            self._resolution = edge_resolution(self.robot, step_rad, max_tool_step_m=tool_m)
+        return self._resolution
+
+    @property
+    def steps(self) -> tuple[float, float | None]:
+        """The resolution's revolute step [rad] and tool step [m] (None: no tool bound)."""
+        return self._steps
+
+    def set_steps(self, step_rad: float, tool_step_m: float | None) -> None:
+        """Check paths at these steps from now on.
+
+        Raises:
+            BadPlanningSetting: a step that is NaN, <= 0 or too large (names the range).
+        """
+        edge_resolution(self.robot, step_rad, max_tool_step_m=tool_step_m)  # checks them
+        self._steps = (step_rad, tool_step_m)
+        self._resolution = None
 
     def go(self, q: Sequence[float]) -> Reply:
         """Send this session's robot to ``q`` [rad or m, checked]: at once (``motion off``),
-        or travelling (``on``: the reply comes on arrival; ``follow``: ``ok`` now)."""
+        or travelling (``on``: the reply comes on arrival; ``follow``: ``ok`` now).
+
+        With the guard, the move is checked (or planned around, ``guard plan``) off the
+        event loop and played on the checked path (``guarded.guarded_go``): the reply
+        is then always awaitable."""
         if self.guard:
-            self.check_path(q)
+            return guarded_go(self, q)
         if self.motion == "off":
             self.world.set_q(q, self.state.name, self.source)
             return replies.OK
@@ -96,22 +136,25 @@ class Session:
     def check_path(self, q: Sequence[float], path: Sequence[Sequence[float]] = ()) -> None:
         """Refuse ``q`` if it collides, or if any point of the way there does (``path``,
         else the straight joint-space segment from where the arm is now): with itself,
-        its objects, and the other robots of the world as they stand.
+        its objects, and the other robots of the world as they stand. Contacts where
+        the arm is now may be left, not pushed into (``planning.first_blocked``).
+
+        This checks on the event loop; moves sent through ``go`` are checked off it.
 
         Raises:
             PathCollides: naming the pair and how far along the move.
         """
-        model = self.world.collision_model(self.state.name)
         at_target = self.motion == "off" and not path
+        start = self.now()
+        asked = request(self, start, [q])
+        checker = MoveChecker().checker(asked)
+        allowed = checker.batch.colliding(start)
         if at_target:
-            points: Sequence[Sequence[float]] = [q]
+            points = np.array([q], dtype=float)
         else:
-            points = path or segment(self.robot, self.now(), q)
-        found = model.first_collision(points)
-        if found is None and len(self.world.robots) > 1:
-            found = first_hit_between(
-                model, self.state.origin, self.world.others(self.state.name), points
-            )
+            waypoints = np.array(path if path else [start, q], dtype=float)
+            points = path_points(checker, waypoints)
+        found = first_blocked(checker, points, allowed)
         if found is not None:
             index, (first, second) = found
             raise PathCollides(first, second, index / max(len(points) - 1, 1), at_target)

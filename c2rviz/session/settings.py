@@ -7,6 +7,7 @@ command). Both come from ``cmdinterpreter.ini`` and the flags (``app.config``).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 __all__ = ["ServerLimits", "SessionDefaults"]
@@ -40,3 +41,14 @@ class SessionDefaults:
     """Refuse commands whose target or path collides."""
     lspeed: float = 0.25
     """``movel``'s tool speed [m/s] (as UR's movel)."""
+    plan_around: bool = False
+    """With the guard: plan around what a joint-space move's straight path would hit
+    (``guard plan``) instead of refusing it."""
+    plan_timeout_s: float = 1.0
+    """Most time a plan searches [s] (``plan``, ``guard plan``)."""
+    plan_seed: int | None = None
+    """The planner's seed, so a run repeats (None: a fresh one each plan)."""
+    plan_step_rad: float = math.radians(1.0)
+    """Most a revolute joint moves between two checks of a path [rad] (5 mm prismatic)."""
+    plan_tool_step_m: float | None = 0.005
+    """Most the tool travels between two checks of a path [m]; None: no bound."""

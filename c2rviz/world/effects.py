@@ -44,6 +44,10 @@ class Observer:
     def on_stopped(self, robot: str) -> None:
         """A move of ``robot`` came to rest short of its target, after a ``stop``."""
 
+    def on_motion(self, robot: str, t: float) -> None:
+        """``robot``'s commanded motion changed at clock time ``t`` [s]: a move started,
+        was stopped, or was cut short by a command that put the arm somewhere at once."""
+
     def on_clients(self, count: int) -> None:
         """``count`` TCP clients are connected."""
 

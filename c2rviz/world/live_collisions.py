@@ -7,7 +7,9 @@ every published pose marks the robot for a check, run at most once per frame
 on the asyncio loop: a flood of ``joints`` lines costs one check per frame, not
 one per line. A change of the colliding pairs reaches the observers as
 ``on_collisions(robot, pairs)`` (the page turns links red, a watch stream says
-``event collision ...``).
+``event collision ...``). In a cell, a robot's pairs include those with the other
+robots as they are shown (``link_t~right/link_4``: this robot's link, then the
+other robot's name and link), and a robot's move re-checks every robot.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Sequence
 
 from ..collision.model import CollisionModel, Pair
+from ..collision.other_robots import pairs_between
 from ..collision.workcell import MAX_OBJECTS
 from .clock import Clock, Timer
 from .effects import Observer
@@ -91,7 +94,10 @@ class Contacts(Observer):
             self._timer = None
 
     def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
-        if robot in self.models:
+        if len(self.states) > 1:  # its pairs with the other robots change too
+            for name in self.models:
+                self.changed(name)
+        elif robot in self.models:
             self.changed(robot)
 
     def _due(self) -> None:
@@ -101,7 +107,17 @@ class Contacts(Observer):
     def _check(self, robots: Iterable[str]) -> None:
         for robot in robots:
             self._dirty.discard(robot)
-            pairs = self.models[robot].colliding(self.states[robot].q)
+            state = self.states[robot]
+            pairs = self.models[robot].colliding(state.q)
+            if len(self.states) > 1:
+                others = [
+                    (name, self.model(name), other.q, other.origin)
+                    for name, other in self.states.items()
+                    if name != robot
+                ]
+                pairs = sorted(
+                    pairs + pairs_between(self.models[robot], state.origin, state.q, others)
+                )
             if pairs != self.pairs[robot]:
                 self.pairs[robot] = pairs
                 self.tell(robot, pairs)

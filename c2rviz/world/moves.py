@@ -62,6 +62,7 @@ class Travels:
         rested: Callable[[RobotState, bool], None],
         clock: Clock,
         frame_s: float,
+        planned: Callable[[RobotState, float], None] | None = None,
     ) -> None:
         """Set up.
 
@@ -72,11 +73,14 @@ class Travels:
                 instant command cut short.
             clock: The world's clock.
             frame_s: Time between two samples of a moving arm [s].
+            planned: ``planned(state, t)``: the robot's motion changed at ``t`` (a move
+                started, a stop, a preemption).
         """
         self.publish = publish
         self.rested = rested
         self.clock = clock
         self.frame_s = frame_s
+        self.planned = planned
         self.by_robot: dict[str, Travel] = {}
         self._timer: Timer | None = None
 
@@ -93,6 +97,7 @@ class Travels:
         travel.synced = False
         travel.path = None
         _settle(travel.rests, replies.OK)
+        self._planned(travel)
 
     def go(
         self, state: RobotState, q: Sequence[float], speed: float, source: str, wait: bool
@@ -106,8 +111,12 @@ class Travels:
         travel = self.by_robot[state.name]
         self._interrupt(travel, f"preempted by {source}")
         t = self.clock.now()
-        if travel.path is not None:  # leaving a path: from where it is, at rest (see README)
-            travel.motion.jump(travel.path.sample(t), t)
+        if travel.path is not None:  # leaving a path: from its state if it tells it, else at rest
+            state_at = getattr(travel.path, "state", None)
+            if travel.active and callable(state_at):
+                travel.motion.take_over(state_at(t), t)
+            else:
+                travel.motion.jump(travel.path.sample(t), t)
             travel.path = None
         elif not travel.synced:
             travel.motion.jump(state.q, t)
@@ -118,6 +127,7 @@ class Travels:
             travel.motion.follow(q, t, speed)
         state.target = travel.motion.target
         self._run(travel)
+        self._planned(travel)
         if not wait:
             return None
         arrival: asyncio.Future[str] = asyncio.get_running_loop().create_future()
@@ -141,25 +151,32 @@ class Travels:
         state.target = path.sample(path.arrival)
         travel.active = True
         self._run(travel)
+        self._planned(travel)
         if not wait:
             return None
         arrival: asyncio.Future[str] = asyncio.get_running_loop().create_future()
         travel.arrivals.append(arrival)
         return arrival
 
-    def stop(self, state: RobotState, source: str) -> asyncio.Future[str] | None:
-        """Decelerate to rest; return the reply that comes at rest (None: at rest now)."""
+    def stop(
+        self, state: RobotState, source: str, why: str | None = None
+    ) -> asyncio.Future[str] | None:
+        """Decelerate to rest at the joints' full limits, on the path where there is one
+        (a path played, a straight move from rest); return the reply that comes at rest
+        (None: at rest now). The move's waiters hear ``why`` (default: stopped by
+        ``source``)."""
         travel = self.by_robot[state.name]
         if not travel.active:
             return None
-        self._interrupt(travel, f"motion stopped by {source}")
+        self._interrupt(travel, why or f"motion stopped by {source}")
         travel.stopping = True
         if travel.path is not None:  # a path brakes on the path
             travel.path.brake(self.clock.now())
             state.target = travel.path.sample(travel.path.arrival)
-            return self.rest(state)
-        travel.motion.stop(self.clock.now())
-        state.target = travel.motion.target
+        else:
+            travel.motion.stop(self.clock.now())
+            state.target = travel.motion.target
+        self._planned(travel)
         return self.rest(state)
 
     def rest(self, state: RobotState) -> asyncio.Future[str] | None:
@@ -193,6 +210,10 @@ class Travels:
         if self._timer is not None:
             self._timer.cancel()
             self._timer = None
+
+    def _planned(self, travel: Travel) -> None:
+        if self.planned is not None:
+            self.planned(travel.state, self.clock.now())
 
     # The frame timer.
 

@@ -80,7 +80,7 @@ class World:
         if scene is not None:
             self.observers.append(scene)
         self._repliers = _repliers(self.observers)  # those that keep replies (recordings)
-        self.travels = Travels(self._show, self._rested, self.clock, self.frame_s)
+        self.travels = Travels(self._show, self._rested, self.clock, self.frame_s, self._planned)
         for name, state in self.robots.items():
             self.travels.add(state, (limits or {}).get(name) or motion_limits(state.robot))
 
@@ -151,6 +151,11 @@ class World:
                 observer.on_stopped(state.name)
             else:
                 observer.on_arrived(state.name)
+
+    def _planned(self, state: RobotState, t: float) -> None:
+        """The robot's motion changed at ``t``: tell every observer."""
+        for observer in self.observers:
+            observer.on_motion(state.name, t)
 
     def ee_pose(self, robot: str | None = None) -> pin.SE3:
         """End-effector placement in the base frame, as the arm is now."""

@@ -21,6 +21,7 @@ from watch_support import read_until
 
 from c2rviz.app.cell import load_cell
 from c2rviz.app.cli import main
+from c2rviz.collision import first_hit_between
 from c2rviz.errors import ConfigError
 from c2rviz.session import Services
 from c2rviz.transports.tcp_server import CommandServer
@@ -552,3 +553,80 @@ def test_port_gives_a_cell_its_first_port(tmp_path: Path):
     proc, ports = serve_until_ports(["--cell", "twoarms", "--port", str(base)], ROOT, 2)
     assert ports == {"left": base, "right": base + 1}
     stop(proc, base)
+
+
+@pytest.fixture
+def twins() -> Iterator[CellThread]:
+    """Two motomans 0.9 m apart along y, each on its own port."""
+    made = CellThread(
+        {"a": "motoman_sia20d", "b": "motoman_sia20d"},
+        {"a": se3(0, -0.45, 0, 0, 0, 0), "b": se3(0, 0.45, 0, 0, 0, 0)},
+    )
+    yield made
+    made.stop()
+
+
+def test_collisions_report_the_pairs_between_robots(twins: CellThread) -> None:
+    """Each robot names its own link, then the other robot's: ``link_b~b/link_s``."""
+    a, b = twins.client("a"), twins.client("b")
+    try:
+        for line in ("degrees", "j 90,90,0,0,0,0,0"):  # unguarded: a's arm into b
+            assert a.ask(line) == "ok"
+        mine = a.ask("collisions")
+        assert re.fullmatch(r"ok (link_\w+~b/\w+,?)+", mine), mine
+        theirs = b.ask("collisions")
+        assert re.fullmatch(r"ok (\w+~a/link_\w+,?)+", theirs), theirs
+        assert {p.split("~")[0] for p in mine[3:].split(",")} == {
+            p.split("~")[1][2:] for p in theirs[3:].split(",")
+        }
+        assert a.ask("home") == "ok"
+        assert a.ask("collisions") == "ok none" and b.ask("collisions") == "ok none"
+    finally:
+        a.close()
+        b.close()
+
+
+def test_plan_goes_around_the_other_robot(twins: CellThread) -> None:
+    a, b = twins.client("a"), twins.client("b")
+    try:
+        for line in ("degrees", "guard on", "j 0,90,0,0,0,0,0", "motion follow", "speed 100"):
+            assert a.ask(line) == "ok"
+        reply = a.ask("j 180,90,0,0,0,0,0")  # the straight way swings through b
+        assert re.fullmatch(r"error: link_\w+ would hit b/\w+ at \d+% of the move", reply)
+        reply = a.ask("plan joints 180,90,0,0,0,0,0")
+        assert re.fullmatch(r"ok \d+ waypoints \d+\.\d+ rad \d+\.\d+ s", reply), reply
+        play = twins.call(lambda: twins.world.travel("a").path)
+        model, other = twins.call(
+            lambda: (twins.world.collision_model("a"), twins.world.others("a"))
+        )
+        times = np.arange(play.start, play.arrival, 0.005)
+        path = [play.sample(t) for t in times]
+        assert first_hit_between(model, twins.world.state("a").origin, other, path) is None
+        assert a.ask("wait") == "ok" and a.ask("where") == "ok 180,90,0,0,0,0,0"
+        assert b.ask("collisions") == "ok none"
+    finally:
+        a.close()
+        b.close()
+
+
+def test_another_robots_move_stops_a_guarded_move_in_its_way(twins: CellThread) -> None:
+    """Issue 23.3 in a cell: b is put where a's running guarded move would end."""
+    a, b, watcher = twins.client("a"), twins.client("b"), twins.client("a")
+    try:
+        for line in ("degrees", "j -90,90,0,0,0,0,0", "guard on", "motion on", "speed 10"):
+            assert a.ask(line) == "ok"
+        assert b.ask("degrees") == "ok" and watcher.ask("degrees") == "ok"
+        a.send("j 0,90,0,0,0,0,0\n")
+        for _ in range(100_000):  # until a has left its start
+            if float(watcher.ask("where")[3:].split(",")[0]) > -89.9:
+                break
+        assert b.ask("j -60,90,0,0,0,0,0") == "ok"  # unguarded: at once, into a's way ahead
+        reply = a.read_line()
+        assert re.fullmatch(r"error: stopped: link_\w+ would hit b/\w+ \(b moved\)", reply), reply
+        assert a.ask("collisions") == "ok none"
+        reply = a.ask("j 0,90,0,0,0,0,0")
+        assert re.fullmatch(r"error: link_\w+ would hit b/\w+ at \d+% of the move", reply), reply
+    finally:
+        a.close()
+        b.close()
+        watcher.close()

@@ -174,7 +174,8 @@ def test_colliding_agrees_with_coal_distances(name: str) -> None:
     model = CollisionModel(robot)
     model.set_object("crate", "box", (0.3, 0.3, 0.3), at(0.5, 0.2, 0.6))
     model.set_object("ball", "sphere", (0.15,), at(-0.4, 0.0, 0.9))
-    geometry, data, names = model._checks
+    checks = model.check_geometry()
+    geometry, names = checks.geometry, checks.names
     reference = pin.GeometryData(geometry)
     rng = np.random.default_rng(3)
     compared = 0

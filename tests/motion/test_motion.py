@@ -339,6 +339,29 @@ def test_stop_comes_to_rest_between_start_and_target(name: str, when: float) -> 
     assert motion.stop(rest_time + 1) == rest_time  # at rest: nothing to do
 
 
+@pytest.mark.parametrize("speed", [1.0, 0.2, 0.05])
+@pytest.mark.parametrize("name", ALL)
+def test_a_stop_brakes_along_the_straight_move_at_the_full_limits(name: str, speed: float) -> None:
+    """Issue 23.2: every joint stops at one common fraction of its travel (the arm stays
+    on the segment the guard checked), and at the joints' full limits: quickly at 5 %."""
+    limits = motion_limits(robot_named(name))
+    start, target = far_pair(limits)
+    motion = Motion(limits, start)
+    switch = 0.3 * motion.move_to(target, 0.0, speed)
+    assert motion.straight is not None
+    before = trace(motion, 0.0, switch)
+    rest_time = motion.stop(switch)
+    after = trace(motion, switch, rest_time + 0.01, 1e-3)
+    assert_within(before + after, limits, 1.0)
+    travel = np.subtract(target, start)
+    moved = np.abs(travel) > 1e-9
+    for q in after.q:
+        fractions = (np.asarray(q) - start)[moved] / travel[moved]
+        assert np.ptp(fractions) < 1e-9, "a joint left the segment"
+    assert 0 < fractions[0] < 1
+    assert rest_time - switch < 1.5  # the full limits, not speed**2 of them
+
+
 @pytest.mark.parametrize("name", ALL)
 def test_follow_a_fast_sine_lags_within_limits(name: str) -> None:
     limits = motion_limits(robot_named(name))
@@ -465,7 +488,7 @@ def test_any_move_respects_the_limits_and_arrives(scenario: Scenario) -> None:
     switch = preempt_at * arrival
     tr = trace(motion, 0.0, switch, step)
     if stop:
-        arrival, final, fastest = motion.stop(switch), None, speed
+        arrival, final, fastest = motion.stop(switch), None, 1.0  # a stop: the full limits
         low, high = np.minimum(start, target), np.maximum(start, target)
         rest = np.array(motion.target)
         assert np.all((rest >= low - POS_TOL) & (rest <= high + POS_TOL)), "stopped past target"

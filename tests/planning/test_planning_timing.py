@@ -87,8 +87,22 @@ def test_brake_stops_on_the_edge_being_played(fraction: float) -> None:
     along = np.dot(stop - a, b - a) / np.dot(b - a, b - a)
     assert -1e-12 <= along <= 1 + 1e-12
     assert np.linalg.norm(stop - (a + along * (b - a))) < 1e-9
-    assert_within_limits(path, limits, 0.7)
+    assert_within_limits(path, limits, 1.0)  # a brake may use the joints' full limits
     assert path.brake(rest + 1.0) == rest  # at rest: nothing changes
+
+
+def test_a_brake_uses_the_full_limits_whatever_the_speed() -> None:
+    """Issue 23.2: a stop at 5 % speed is as quick as the joints allow, not 400 times slower."""
+    limits = motion_limits(load("kuka_lwr"))
+    waypoints = random_polyline(limits, 2, seed=4)
+    rests = []
+    for speed in (1.0, 0.05):
+        path = time_path(waypoints, limits, start=0.0, speed=speed)
+        when = 0.5 * path.duration
+        state = path.state(when)
+        rests.append(path.brake(when) - when)
+        assert np.allclose(path.state(when)[1], state[1])
+    assert rests[1] < rests[0]  # the slow path, moving slower, stops sooner
 
 
 def test_one_waypoint_or_repeated_corners_take_no_time() -> None:

@@ -20,6 +20,7 @@ from c2rviz.protocol.verbs.joints import Home, Joints, Move, Rand, Units
 from c2rviz.protocol.verbs.markers import Clear, Color, Mark, MarkerShape
 from c2rviz.protocol.verbs.motion import MotionMode, Speed, Status, Stop, Target, Wait
 from c2rviz.protocol.verbs.observe import Trail, Unwatch, Watch
+from c2rviz.protocol.verbs.planning import Plan
 from c2rviz.protocol.verbs.queries import Help, Limits, Names, Pose, Version, Where
 from c2rviz.protocol.verbs.record import Record
 from c2rviz.protocol.verbs.workcell import Collisions, Guard, ObjectEdit, Objects
@@ -78,6 +79,16 @@ GOOD = [
     ("collisions", Collisions(), "collisions"),
     ("guard", Guard(None), "guard-ask"),
     ("guard ON", Guard(True), "guard-on"),
+    ("guard off", Guard(False), "guard-off"),
+    ("guard Plan", Guard(True, plan=True), "guard-plan"),
+    ("plan", Plan("show"), "plan-show"),
+    ("plan joints 1,2,-3", Plan("joints", (1.0, 2.0, -3.0)), "plan-joints"),
+    ("PLAN Pose 0.5,0,1.2,0,90,0", Plan("pose", (0.5, 0, 1.2, 0, 90, 0)), "plan-pose"),
+    ("plan pose 0.5,0,1.2", Plan("pose", (0.5, 0.0, 1.2)), "plan-point"),
+    ("plan timeout", Plan("timeout"), "plan-timeout-ask"),
+    ("plan timeout 0.25", Plan("timeout", (0.25,)), "plan-timeout"),
+    ("plan resolution", Plan("resolution"), "plan-resolution-ask"),
+    ("plan resolution 0.5,0.002", Plan("resolution", (0.5, 0.002)), "plan-resolution"),
     ("color 0,0.5,1", Color((0.0, 0.5, 1.0)), "color"),
     ("rgb 0,255,51", Color((0.0, 1.0, 0.2)), "rgb"),
     ("marker CUBE", MarkerShape("cube"), "marker"),
@@ -216,6 +227,15 @@ BAD = [
     ("record stop overwrite", BadArguments, "'stop' takes no option", "record-stop-option"),
     ("record a b c d", BadArguments, "takes at most 3 arguments, got 4", "record-four"),
     ("record a all all", BadArguments, "'all' given twice", "record-all-twice"),
+    ("guard maybe", BadArguments, "'maybe' is not on, off or plan", "guard-bad"),
+    ("plan around", BadArguments, "'around' is not one of joints, pose, timeout", "plan-what"),
+    ("plan joints", BadArguments, "plan: joints needs values", "plan-joints-none"),
+    ("plan joints 1 2", BadArguments, "joints takes one list of values", "plan-two-words"),
+    ("plan joints 1,nan", BadArguments, "bad number 'nan'", "plan-nan"),
+    ("plan pose 1,2,3,4", BadArguments, "x,y,z or x,y,z,roll,pitch,yaw, not 4", "plan-pose-4"),
+    ("plan timeout 1,2", BadArguments, "timeout takes one number of seconds", "plan-timeout-2"),
+    ("plan timeout inf", BadArguments, "bad number 'inf'", "plan-timeout-inf"),
+    ("plan resolution 1", BadArguments, "a joint step and a tool step", "plan-resolution-1"),
     ("degree 1", BadArguments, "(usage: degrees)", "alias-usage"),
     ("jump 1", UnknownCommand, "unknown command 'jump' (try 'help')", "unknown-verb"),
     ("jonts 1,2", UnknownCommand, "unknown command 'jonts' (did you mean 'joints'?)", "typo"),

@@ -137,7 +137,7 @@ def test_rand_under_guard_draws_only_free_configurations(server: ServerThread, c
         ("object all sphere 1 0,0,0", "'all' is not an object name"),
         ("object t sphere 1", "sphere takes a size and a pose"),
         ("object t box 1,1 0,0,0,0,0,0", "needs 3 values, got 2"),
-        ("guard maybe", "'maybe' is neither on nor off"),
+        ("guard maybe", "'maybe' is not on, off or plan"),
     ],
     ids=[
         "negative",

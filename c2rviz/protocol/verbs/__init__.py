@@ -7,6 +7,7 @@ Importing this package registers every verb in ``registry.VERBS``, in the order
 # isort: off
 from . import joints, markers, queries, connection  # the seed's verbs
 from . import cartesian, cell, motion, observe, record, workcell
+from . import planning
 # isort: on
 
 __all__ = [
@@ -17,6 +18,7 @@ __all__ = [
     "markers",
     "motion",
     "observe",
+    "planning",
     "queries",
     "record",
     "workcell",

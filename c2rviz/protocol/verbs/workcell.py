@@ -98,22 +98,25 @@ class Collisions:
 
 @verb(
     "guard",
-    "[on|off]",
+    "[on|off|plan]",
     "with `guard on` this connection's commands whose target, or any point of a move's path, "
     "collides are refused (`error: link_t would hit table at 40% of the move`); `rand` "
-    "draws a free configuration; alone, reply it",
+    "draws a free configuration; `guard plan`: joint-space moves go around what their "
+    "straight path would hit instead (docs/planning.md); alone, reply it",
 )
 @dataclass(frozen=True, slots=True)
 class Guard:
-    """Set (or, with None, ask) whether this connection's commands are guarded."""
+    """Set (or, with None, ask) whether this connection's commands are guarded, and
+    (``plan``) whether joint-space moves are planned around what they would hit."""
 
     on: bool | None
+    plan: bool = False
 
     @staticmethod
     def parse(verb: str, words: list[str]) -> Guard:
         if not words:
             return Guard(None)
         word = one_word(verb, words).lower()
-        if word not in ("on", "off"):
-            raise BadArguments(verb, f"{shown(word)} is neither on nor off", usage(verb))
-        return Guard(word == "on")
+        if word not in ("on", "off", "plan"):
+            raise BadArguments(verb, f"{shown(word)} is not on, off or plan", usage(verb))
+        return Guard(word != "off", word == "plan")

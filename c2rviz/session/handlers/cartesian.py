@@ -15,11 +15,12 @@ import numpy as np
 from ...errors import ArmMoved, UnknownMarker
 from ...ik.line import plan_line
 from ...ik.target import PointTarget, Target
-from ...motion.line_play import LinePlay, ramp_limits
+from ...motion.line_play import LinePlay, brake_limits, ramp_limits
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
 from ...protocol.verbs.cartesian import Ik, LinearSpeed, MoveL, MoveTo, PoseValues, Tool
 from ...robot.frames import in_base, wxyz_se3
+from ..guarded import checked_move
 
 if TYPE_CHECKING:
     from ..session import Session
@@ -70,16 +71,20 @@ async def movel(session: Session, command: MoveL) -> str:
     if state.q != start or session.travel.active:
         raise ArmMoved("the arm moved while the line was planned: send movel again")
     qs = np.array([waypoint.q for waypoint in line.waypoints])
-    if session.guard:
-        session.check_path(line.waypoints[-1].q, path=[waypoint.q for waypoint in line.waypoints])
+    allowed: frozenset[tuple[str, str]] = frozenset()
+    if session.guard:  # the whole line, off the loop
+        checked, _ = await checked_move(session, [qs[-1]], path_from=qs)
+        allowed = checked.allowed
     if session.motion == "off":
         session.world.set_q(line.waypoints[-1].q, state.name, session.source)
         return replies.OK
     fraction, limits = session.speed / 100.0, session.travel.motion.limits
     times = line.timestamps(session.lspeed, [v * fraction for v in limits.velocity])
     ramp = ramp_limits(limits, fraction)
-    play = LinePlay(world.clock.now(), times, qs, *ramp)
+    play = LinePlay(world.clock.now(), times, qs, *ramp, brake=brake_limits(limits, fraction))
     arrival = world.travels.play(state, play, session.source, session.motion == "on")
+    if session.guard:
+        session.services.guards.watch(state.name, play, allowed, session.source, session.resolution)
     return replies.OK if arrival is None else await arrival
 
 

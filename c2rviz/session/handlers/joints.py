@@ -8,6 +8,7 @@ from ...errors import JointCountError, JointIndexError
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
 from ...protocol.verbs.joints import Home, Joints, Move, Rand, Units
+from ..guarded import guarded_rand
 
 if TYPE_CHECKING:
     from ..session import Session
@@ -17,10 +18,9 @@ __all__: list[str] = []
 
 @handler(Rand)
 def rand(session: Session, command: Rand) -> Reply:
-    rng = session.services.rng
-    if session.guard:  # a configuration that collides with nothing
-        return session.go(session.world.collision_model(session.state.name).random_free(rng))
-    return session.go(session.robot.random(rng))
+    if session.guard:  # a configuration that collides with nothing, drawn off the loop
+        return guarded_rand(session)
+    return session.go(session.robot.random(session.services.rng))
 
 
 @handler(Home)

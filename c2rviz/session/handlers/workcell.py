@@ -45,8 +45,12 @@ def collisions(session: Session, command: Collisions) -> str:
 @handler(Guard)
 def guard(session: Session, command: Guard) -> str:
     if command.on is None:
-        return replies.ok("on" if session.guard else "off")
+        if not session.guard:
+            return replies.ok("off")
+        return replies.ok("plan" if session.plan_around else "on")
     if command.on:
-        session.world.collision_model(session.state.name)  # built now, not mid-command
+        for name in session.world.robots:  # built now, not mid-command (a cell counts all)
+            session.world.collision_model(name)
     session.guard = command.on
+    session.plan_around = command.plan
     return replies.OK

@@ -1,0 +1,195 @@
+"""A move checked, or planned around obstacles, off the event loop: ``MoveChecker``.
+
+The session takes a snapshot of what a move is checked against on the event loop
+(``MoveRequest``: the robot's collision checks as they are, the other robots'
+shapes where they stand, the start and the goal) and hands it to the worker's
+thread, where ``MoveChecker.check`` answers with the path the arm may take
+(``CheckedMove``) or refuses:
+
+- ``target_only`` (a move shown at once): the goal alone is checked;
+- otherwise the path (the straight joint-space segment, or the polyline given)
+  at the checker's resolution, first point first (``path_check.first_blocked``:
+  contacts at the start may be left, not pushed into);
+- ``plan="blocked"`` (``guard plan``): a blocked straight path is planned around;
+  ``plan="always"`` (``plan``): every goal is planned (the direct edge first),
+  trying the goals given in order (several IK answers of a pose) until one plans.
+
+The checkers are kept between jobs (one per robot, rebuilt when its workcell, the
+other robots or the resolution change), so a stream of guarded commands costs a
+check each, not a checker each.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Hashable
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from c2rviz.collision import CheckGeometry, CollisionModel, Pair, PlacedShape
+from c2rviz.errors import PathCollides
+
+from .edge_resolution import EdgeResolution
+from .errors import GoalCollides, NoPathFound, NoWayAround, PlanningError
+from .ompl_planner import PlannedPath, plan_for
+from .path_check import first_blocked, path_points
+from .validity import ValidityChecker
+
+__all__ = ["PLAN_MODES", "CheckedMove", "MoveChecker", "MoveRequest", "OtherAt"]
+
+PLAN_MODES = ("never", "blocked", "always")
+
+OtherAt = tuple[str, tuple[float, ...] | None, bytes]
+"""Another robot when a request was made: name, joints if still (else None), origin's bytes."""
+
+
+@dataclass(frozen=True, eq=False)
+class MoveRequest:
+    """A move to check off the event loop, and what it is checked against.
+
+    Attributes:
+        collision: The robot's collision model.
+        source: Its checks when the request was made (``check_geometry()``).
+        others: The other robots' shapes where they stood, placed in the cell.
+        others_at: Each other robot: its name, its joints [rad or m] if it stood
+            still (None if it moved) and its place (the bytes of its origin), so the
+            caller can tell when ``others`` changed.
+        origin: Where this robot's root stands in the cell.
+        resolution: How finely edges are checked.
+        start: Where the move starts, at rest [rad or m].
+        goals: Where it may end, in order of preference [rad or m].
+        path: A polyline to check instead of the straight segment (rows, start first).
+        target_only: Check the first goal alone (a move shown at once).
+        plan: ``never``, ``blocked`` (plan around a blocked straight path) or ``always``.
+        timeout_s: Most time a plan may search [s].
+        seed: The planner's seed (None: a fresh one).
+    """
+
+    collision: CollisionModel
+    source: CheckGeometry
+    others: tuple[PlacedShape, ...]
+    others_at: tuple[OtherAt, ...]
+    origin: pin.SE3
+    resolution: EdgeResolution
+    start: tuple[float, ...]
+    goals: tuple[tuple[float, ...], ...]
+    path: np.ndarray | None = None
+    target_only: bool = False
+    plan: str = "never"
+    timeout_s: float = 1.0
+    seed: int | None = None
+
+
+@dataclass(frozen=True)
+class CheckedMove:
+    """The path a checked move may take.
+
+    Attributes:
+        waypoints: Its corners, start and goal included, one row each [rad or m].
+        planned: The planner's answer when it was planned (None: straight, or given).
+        allowed: Pairs in contact at the start that the move may leave.
+        revision: The workcell's revision it was checked against.
+    """
+
+    waypoints: np.ndarray
+    planned: PlannedPath | None
+    allowed: frozenset[Pair]
+    revision: int
+
+    @property
+    def goal(self) -> tuple[float, ...]:
+        """Where the move ends [rad or m]."""
+        return tuple(float(x) for x in self.waypoints[-1])
+
+
+class MoveChecker:
+    """Checks and plans moves on one thread, keeping a checker per robot."""
+
+    def __init__(self) -> None:
+        self._cache: dict[int, tuple[Hashable, ValidityChecker]] = {}
+
+    def checker(self, request: MoveRequest) -> ValidityChecker:
+        """The robot's checker for what ``request`` is checked against (built if needed)."""
+        placed = tuple((name, where.homogeneous.tobytes()) for name, _, where in request.others)
+        key = (
+            request.source.revision,
+            placed,
+            request.origin.homogeneous.tobytes(),
+            request.resolution,
+        )
+        cached = self._cache.get(id(request.collision))
+        if cached is not None and cached[0] == key and cached[1].collision is request.collision:
+            return cached[1]
+        checker = ValidityChecker(
+            request.collision,
+            request.others,
+            origin=request.origin,
+            resolution=request.resolution,
+            source=request.source,
+        )
+        self._cache[id(request.collision)] = (key, checker)
+        return checker
+
+    def check(self, request: MoveRequest) -> CheckedMove:
+        """The path ``request``'s move may take (see the module).
+
+        Raises:
+            PathCollides: the goal or the path collides (naming the pair and where).
+            NoWayAround: blocked, and no plan around it (``plan="blocked"``).
+            PlanningError: ``plan="always"`` found no path (an end collides, none in time).
+        """
+        checker = self.checker(request)
+        start = np.asarray(request.start, dtype=float)
+        allowed = (
+            frozenset() if checker.is_valid(start) else frozenset(checker.batch.colliding(start))
+        )
+        revision = request.source.revision
+        if request.plan == "always":
+            return self._planned(checker, request, allowed)
+        goal = np.asarray(request.goals[0], dtype=float)
+        if request.target_only:
+            blocked = first_blocked(checker, goal[None, :], allowed)
+            if blocked is not None:
+                raise PathCollides(*blocked[1], 1.0, True)
+            return CheckedMove(np.array([start, goal]), None, allowed, revision)
+        waypoints = request.path if request.path is not None else np.array([start, goal])
+        points = path_points(checker, waypoints)
+        blocked = first_blocked(checker, points, allowed)
+        if blocked is None:
+            return CheckedMove(np.asarray(waypoints, dtype=float), None, allowed, revision)
+        index, pair = blocked
+        collides = PathCollides(*pair, index / max(len(points) - 1, 1), False)
+        if request.plan != "blocked" or request.path is not None:
+            raise collides
+        try:
+            return self._planned(checker, request, allowed)
+        except PlanningError as exc:
+            raise NoWayAround(str(collides), str(exc)) from exc
+
+    def _planned(
+        self, checker: ValidityChecker, request: MoveRequest, allowed: frozenset[Pair]
+    ) -> CheckedMove:
+        """A plan to the first of ``request.goals`` that plans within the time limit."""
+        began = time.perf_counter()
+        states, searched = 0, False
+        collided: GoalCollides | None = None
+        for goal in request.goals:
+            left = request.timeout_s - (time.perf_counter() - began)
+            if left <= 0:
+                break
+            try:
+                path = plan_for(
+                    checker, request.start, goal, timeout_s=max(left, 1e-3), seed=request.seed
+                )
+            except GoalCollides as exc:
+                collided = collided or exc
+                continue
+            except NoPathFound as exc:
+                states, searched = states + exc.states, True
+                continue
+            return CheckedMove(path.waypoints, path, allowed, request.source.revision)
+        if collided is not None and not searched:
+            raise collided
+        raise NoPathFound(request.timeout_s, states)
