@@ -51,8 +51,8 @@ class RobotEntry:
     ini: Path | None = None
     """The file the section was read from."""
     extras: tuple[tuple[str, str], ...] = ()
-    """``tool``, ``max_velocity``, ``max_acceleration``, ``max_jerk`` as written (see
-    ``furnish``, which checks them)."""
+    """``tool``, ``gripper``, ``max_velocity``, ``max_acceleration``, ``max_jerk`` as written
+    (see ``furnish``, which checks them)."""
 
     def check_package_paths(self) -> None:
         """Raise ConfigError, naming ``[section] package_path``, for an entry that is no folder."""
@@ -152,7 +152,7 @@ _TEXT_OPTIONS = (
 _CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on")}
 MOTION_FLAGS = ("max_velocity", "max_acceleration", "max_jerk")
 """Motion limits a flag may give every robot (over the ini's)."""
-_EXTRA_KEYS = ["tool", *MOTION_FLAGS]
+_EXTRA_KEYS = ["tool", "gripper", *MOTION_FLAGS]
 ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args", *_EXTRA_KEYS]
 _MEMBER_PLACE_KEYS = ("origin", "port")  # a cell member's, beside its robot keys (cell.py)
 _LIMIT_FIELDS = {f for f in ServerLimits.__dataclass_fields__}

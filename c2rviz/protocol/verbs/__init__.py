@@ -7,12 +7,14 @@ Importing this package registers every verb in ``registry.VERBS``, in the order
 # isort: off
 from . import joints, markers, queries, connection  # the seed's verbs
 from . import cartesian, cell, motion, observe, record, workcell
+from . import gripper
 # isort: on
 
 __all__ = [
     "cartesian",
     "cell",
     "connection",
+    "gripper",
     "joints",
     "markers",
     "motion",

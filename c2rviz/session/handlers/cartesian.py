@@ -8,13 +8,14 @@ wait for them while every other client is served.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
 
 from ...errors import ArmMoved, UnknownMarker
-from ...ik.line import plan_line
+from ...ik.line import StraightLine, plan_line
 from ...motion.line_play import LinePlay, ramp_limits
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
@@ -24,7 +25,7 @@ from ...robot.frames import in_base, wxyz_se3
 if TYPE_CHECKING:
     from ..session import Session
 
-__all__: list[str] = []
+__all__ = ["StraightPlan", "play_straight", "plan_straight", "solve"]
 
 
 @handler(Tool)
@@ -49,7 +50,7 @@ async def moveto(session: Session, command: MoveTo) -> str:
             raise UnknownMarker(index, len(markers))
         marker = markers[index - 1]
         target = in_base(session.state.base, wxyz_se3(marker.position, marker.wxyz))
-        q = await _solve_se3(session, target)
+        q = await solve(session, target)
     else:
         q = await _solve(session, command.pose)
     return await _reply(session.go(q))
@@ -57,28 +58,57 @@ async def moveto(session: Session, command: MoveTo) -> str:
 
 @handler(MoveL)
 async def movel(session: Session, command: MoveL) -> str:
-    state, world = session.state, session.world
-    if session.travel.active:
+    plan = await plan_straight(session, session.pose_se3(command.pose))
+    return await _reply(play_straight(session, plan))
+
+
+@dataclass(frozen=True)
+class StraightPlan:
+    """A straight tool line planned from the arm at rest at ``start`` [rad or m]."""
+
+    start: tuple[float, ...]
+    waypoints: list[tuple[float, ...]]
+    line: StraightLine
+
+
+async def plan_straight(
+    session: Session, goal: pin.SE3, start: Sequence[float] | None = None
+) -> StraightPlan:
+    """Plan the tool's straight line from where the arm rests (or from ``start`` [rad or
+    m], the end of a line planned before) to ``goal`` (base frame, SI), checked by the
+    guard when it is on; nothing moves yet (``play_straight`` moves).
+
+    Raises:
+        ArmMoved: the arm moves (or moved while the line was planned).
+        C2rvizError: the line leaves the reach, or (guarded) collides.
+    """
+    state = session.state
+    if start is None and session.travel.active:
         raise ArmMoved("movel starts from rest: send wait (or stop) first")
-    start = state.q
-    goal, tool_offset = session.pose_se3(command.pose), state.tool
+    first, tool_offset = tuple(state.q if start is None else start), state.tool
     worker = session.services.worker
     solver = worker.ik_solver(state)
-    line = await worker.run(lambda: plan_line(solver, start, goal, tool_offset))
-    if state.q != start or session.travel.active:
+    line = await worker.run(lambda: plan_line(solver, first, goal, tool_offset))
+    if start is None and (state.q != first or session.travel.active):
         raise ArmMoved("the arm moved while the line was planned: send movel again")
-    qs = np.array([waypoint.q for waypoint in line.waypoints])
+    waypoints = [waypoint.q for waypoint in line.waypoints]
     if session.guard:
-        session.check_path(line.waypoints[-1].q, path=[waypoint.q for waypoint in line.waypoints])
+        session.check_path(waypoints[-1], path=waypoints)
+    return StraightPlan(first, waypoints, line)
+
+
+def play_straight(session: Session, plan: StraightPlan) -> Reply:
+    """Move along a planned line as ``motion`` says (at once, or travelling at ``lspeed``)."""
+    state, world = session.state, session.world
     if session.motion == "off":
-        session.world.set_q(line.waypoints[-1].q, state.name, session.source)
+        world.set_q(plan.waypoints[-1], state.name, session.source)
         return replies.OK
     fraction, limits = session.speed / 100.0, session.travel.motion.limits
-    times = line.timestamps(session.lspeed, [v * fraction for v in limits.velocity])
+    times = plan.line.timestamps(session.lspeed, [v * fraction for v in limits.velocity])
     ramp = ramp_limits(limits, fraction)
-    play = LinePlay(world.clock.now(), times, qs, *ramp)
+    play = LinePlay(world.clock.now(), times, np.array(plan.waypoints), *ramp)
     arrival = world.travels.play(state, play, session.source, session.motion == "on")
-    return replies.OK if arrival is None else await arrival
+    return replies.OK if arrival is None else arrival
 
 
 @handler(LinearSpeed)
@@ -90,14 +120,22 @@ def lspeed(session: Session, command: LinearSpeed) -> str:
 
 
 async def _solve(session: Session, pose: PoseValues) -> Sequence[float]:
-    return await _solve_se3(session, session.pose_se3(pose))
+    return await solve(session, session.pose_se3(pose))
 
 
-async def _solve_se3(session: Session, target: pin.SE3) -> Sequence[float]:
+async def solve(
+    session: Session, target: pin.SE3, seed: Sequence[float] | None = None
+) -> Sequence[float]:
+    """The joints [rad or m] that put the tool point at ``target`` (base frame, SI), from
+    ``seed`` (default: the arm's joints now), on the worker's thread.
+
+    Raises:
+        C2rvizError: the pose is out of reach (naming how far).
+    """
     state, worker = session.state, session.services.worker
-    seed, tool_offset = session.now(), state.tool
+    first, tool_offset = (session.now() if seed is None else seed), state.tool
     solver = worker.ik_solver(state)
-    return await worker.run(lambda: solver.solve(target, seed, tool_offset))
+    return await worker.run(lambda: solver.solve(target, first, tool_offset))
 
 
 async def _reply(reply: Reply) -> str:
