@@ -67,6 +67,14 @@ def build_parser() -> argparse.ArgumentParser:
     add("--host", help="address for the command server (default 127.0.0.1)")
     add("--port", type=int, help="command port (default 31000; 0 picks a free one)")
     add(
+        "--crcl-port",
+        type=int,
+        metavar="PORT",
+        help="port for NIST's CRCL (XML commands, docs/crcl.md; default 64444, a cell's "
+        "robots this one and the next; 0 picks free ones)",
+    )
+    add("--no-crcl", dest="crcl", action="store_const", const=False, help="no CRCL door")
+    add(
         "--viser-host",
         dest="viewer_host",
         metavar="HOST",

@@ -121,6 +121,11 @@ class Settings:
     """``--robot`` was given."""
     urdf_flag: bool = False
     """``--urdf`` was given (the robot is then named by its model unless ``--robot`` is)."""
+    crcl: bool = True
+    """Open the CRCL door (``--no-crcl``: not)."""
+    crcl_port: int | None = None
+    """The CRCL port (``--crcl-port``, ini ``crcl_port``; a cell's robots take it and the
+    next ones); None: the default, 64444, which another program may hold."""
 
 
 # ini key -> (Settings or ServerLimits field, type, lowest allowed, highest allowed)
@@ -138,6 +143,7 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "trail_points": ("trail_points", int, 16, 10_000_000),
     "max_objects": ("max_objects", int, 0, 10_000),
     "max_viewers": ("max_viewers", int, 1, 1024),
+    "crcl_port": ("crcl_port", int, 0, 65535),
 }
 _TEXT_OPTIONS = (
     "host",
