@@ -7,7 +7,7 @@ does; motions are ``motions``' jobs). The rules:
 - **Canon**: before ``InitCanon`` and after ``EndCanon`` every command but InitCanon
   and GetStatus is ``CRCL_Error``.
 - **States**: a command is ``CRCL_Working`` while it runs and then ``CRCL_Done``, or
-  ``CRCL_Error`` with a ``StateDescription`` naming it (``MoveTo (CommandID 3): ...``)
+  ``CRCL_Error`` with a ``StateDescription`` naming it (``MoveToType (CommandID 3): ...``)
   and why; before any command the status is ``CRCL_Ready`` (CommandID 0). A document
   whose own CommandID cannot be read is reported under CommandID 0.
 - **Reporting**: every change of a command's state is pushed at once as a compact
@@ -84,7 +84,7 @@ class Report:
 
     command_id: int
     what: str
-    """``MoveTo (CommandID 3)``."""
+    """``MoveToType (CommandID 3)``, as the codec's errors name a command."""
     state: str = WORKING
     description: str | None = None
     program_file: str | None = None
@@ -158,7 +158,7 @@ class Controller:
             return
         report = Report(
             command.command_id,
-            f"{command.XSI_TYPE.removesuffix('Type')} (CommandID {command.command_id})",
+            f"{command.XSI_TYPE} (CommandID {command.command_id})",
             program_file=instance.program_file,
             program_index=instance.program_index,
             program_length=instance.program_length,
@@ -173,7 +173,7 @@ class Controller:
             description = self._actions[command.__class__](self, report, command)
         except C2rvizError as error:
             self.note(report.what, False)
-            self.finish(report, ERROR, f"{report.what}: {error}")
+            self.finish(report, ERROR, str(error))
             return
         self.note(report.what, True)
         if report.state == WORKING and not self._runs(report):
@@ -185,7 +185,7 @@ class Controller:
         report = Report(command_id, error.command_type or "document")
         self.latest = report
         self.note(f"refused: {error.description}", False)
-        self.finish(report, ERROR, error.description)
+        self.finish(report, ERROR, error.description, named=True)
 
     # lanes and jobs
 
@@ -233,14 +233,14 @@ class Controller:
             if job.successor is not None and own:
                 self.finish(report, DONE, f"stopped short: taken over by {job.successor.what}")
             else:
-                self.finish(report, ERROR, f"{report.what}: stopped short: {interrupted.why}")
+                self.finish(report, ERROR, f"stopped short: {interrupted.why}")
         except C2rvizError as error:
-            self.finish(report, ERROR, f"{report.what}: {error}")
+            self.finish(report, ERROR, str(error))
         except asyncio.CancelledError:
             raise
         except Exception:  # a bug costs this command, never the server
             log.exception("internal error running %s", report.what)
-            self.finish(report, ERROR, f"{report.what}: internal error (see the server log)")
+            self.finish(report, ERROR, "internal error (see the server log)")
         else:
             self.finish(report, DONE)
 
@@ -249,12 +249,15 @@ class Controller:
 
     # statuses out
 
-    def finish(self, report: Report, state: str, description: str | None = None) -> None:
-        """``report``'s command ends in ``state``: say so (once)."""
+    def finish(
+        self, report: Report, state: str, why: str | None = None, named: bool = False
+    ) -> None:
+        """``report``'s command ends in ``state``: say so (once), with ``why`` after the
+        command's name (``named``: ``why`` names it already)."""
         if report.state != WORKING and report.state != READY:
             return
         report.state = state
-        report.description = description
+        report.description = why if why is None or named else f"{report.what}: {why}"
         self._push(report)
 
     def _push(self, report: Report) -> None:

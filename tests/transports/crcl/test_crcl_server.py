@@ -71,14 +71,14 @@ def test_ready_then_a_session_init_move_status_end(crcl_server, crcl_connect) ->
     assert client.run(command("EndCanon", 3), 3).command_status.state == DONE
     after = client.run(move_to(4, OTHER), 4).command_status
     assert after.state == ERROR
-    assert after.description == "MoveTo (CommandID 4): after EndCanon: send InitCanon first"
+    assert after.description == "MoveToType (CommandID 4): after EndCanon: send InitCanon first"
 
 
 def test_nothing_but_init_canon_and_get_status_before_init(crcl_server, crcl_connect) -> None:
     client = crcl_connect(crcl_server)
     refused = client.run(move_to(7, REACH), 7).command_status
     assert refused.state == ERROR
-    assert refused.description == "MoveTo (CommandID 7): before InitCanon: send InitCanon first"
+    assert refused.description == "MoveToType (CommandID 7): before InitCanon: send InitCanon first"
     assert client.states(7) == [ERROR]
     assert client.run(command("Message", 8, "<Message>hi</Message>"), 8).command_status.state == (
         ERROR
@@ -163,7 +163,9 @@ def test_a_new_move_takes_over_and_the_old_is_reported(crcl_server, crcl_connect
     assert client.until(3).command_status.state == DONE
     old = [s.command_status for s in client.seen if s.command_status.command_id == 2]
     assert [s.state for s in old] == [WORKING, DONE]
-    assert old[-1].description == "stopped short: taken over by MoveTo (CommandID 3)"
+    assert old[-1].description == (
+        "MoveToType (CommandID 2): stopped short: taken over by MoveToType (CommandID 3)"
+    )
     np.testing.assert_allclose(tool_point(crcl_server), OTHER, atol=1e-6)
 
 
@@ -202,7 +204,7 @@ def test_stop_from_the_text_port_is_an_error_naming_it(crcl_server, crcl_connect
     assert text.ask("stop") == "ok"
     stopped = client.until(2).command_status
     assert stopped.state == ERROR
-    assert stopped.description.startswith("ActuateJoints (CommandID 2): stopped short: motion ")
+    assert stopped.description.startswith("ActuateJointsType (CommandID 2): stopped short: motion ")
     assert "stopped by tcp 127.0.0.1:" in stopped.description
 
 
@@ -222,7 +224,7 @@ def test_unreachable_and_colliding_moves_move_nothing(crcl_server, crcl_connect,
     client = started(crcl_connect(crcl_server))
     frames = crcl_server.call(lambda: len(crcl_server.scene.joints))
     far = client.run(move_to(2, (3.0, 0.0, 0.0)), 2).command_status
-    assert far.state == ERROR and "MoveTo (CommandID 2): pose unreachable" in far.description
+    assert far.state == ERROR and "MoveToType (CommandID 2): pose unreachable" in far.description
     text = connect(crcl_server)
     assert text.ask("object table box 0.2,0.2,0.2 0.5,0,0.8,0,0,0") == "ok"
     hit = client.run(move_to(3, REACH), 3).command_status
@@ -236,8 +238,8 @@ def test_message_shows_in_the_last_commands(crcl_server, crcl_connect) -> None:
     client = started(crcl_connect(crcl_server))
     assert client.run(command("Message", 2, "<Message>hello cell</Message>"), 2)
     lines = crcl_server.call(lambda: list(crcl_server.scene.commands))
-    assert "Message (CommandID 2): hello cell" in lines
-    assert "InitCanon (CommandID 1)" in lines
+    assert "MessageType (CommandID 2): hello cell" in lines
+    assert "InitCanonType (CommandID 1)" in lines
 
 
 def test_dwell_works_then_is_done(crcl_server, crcl_connect) -> None:
