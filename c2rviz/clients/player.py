@@ -34,6 +34,7 @@ from typing import TextIO
 from ..errors import C2rvizError
 from ..protocol.verbs.connection import Bye, Quit, Sleep
 from ..protocol.verbs.motion import MOTION_MODES, MotionMode
+from . import crcl_program
 from .client import (
     Client,
     ConnectionLost,
@@ -203,6 +204,8 @@ def _fail(problems: Sequence[str], name: str, err: TextIO) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``c2rviz-play``; returns the exit status."""
     args = build_parser().parse_args(argv)
+    if crcl_program.is_crcl_program(args.file):  # a CRCLProgram: run over the CRCL port
+        return crcl_program.main(argv)
     out, err = sys.stdout, sys.stderr
     if args.loop < 0 or args.window < 1:
         print("c2rviz-play: --loop must be >= 0 and --window >= 1", file=err)
