@@ -41,15 +41,9 @@ from ...session.session import Session
 from .commands import Command, GetStatus, InitCanon
 from .documents import parse_instance
 from .errors import CrclError
-from .reports import (
-    ConnectionSettings,
-    gripper_status,
-    joint_statuses,
-    pose_status,
-    settings_status,
-)
+from .reports import ConnectionSettings, StatusParts
 from .scalars import xml_safe_text
-from .status import CommandStatus, CrclStatus, write_status
+from .status import CommandStatus, CrclStatus
 
 __all__ = [
     "ARM",
@@ -133,6 +127,7 @@ class Controller:
         session.motion = "on"  # a command is Working until its motion arrives
         session.guard = True  # a colliding target or path is refused, never driven into
         self.settings = ConnectionSettings()
+        self.parts = StatusParts(session, self.settings)
         self.canon = False
         self.ended = False
         """An EndCanon came (so a command now is "after EndCanon")."""
@@ -172,9 +167,11 @@ class Controller:
                 raise Refused(f"{state}: send InitCanon first")
             description = self._actions[command.__class__](self, report, command)
         except C2rvizError as error:
+            self.settings.revision += 1  # an action may have set something before it refused
             self.note(report.what, False)
             self.finish(report, ERROR, str(error))
             return
+        self.settings.revision += 1
         self.note(report.what, True)
         if report.state == WORKING and not self._runs(report):
             self.finish(report, DONE, description)
@@ -267,7 +264,7 @@ class Controller:
         if self._closed:
             return
         try:
-            self._send(write_status(self.status(report, full)))
+            self._send(self.parts.write(self.status(report, full)))
         except C2rvizError:  # a value a status cannot carry (a bug): say it in the log
             log.exception("cannot write a status for %s", report.what)
 
@@ -286,27 +283,22 @@ class Controller:
             program_index=report.program_index,
             program_length=report.program_length,
         )
-        session, settings = self.session, self.settings
-        parts = settings.status_report
+        parts, asked = self.parts, self.settings.status_report
         if not full:
             return CrclStatus(
                 command_status=command,
-                joint_statuses=joint_statuses(session, settings, configured_only=True),
-                pose_status=pose_status(session, settings),
+                joint_statuses=parts.joints(configured_only=True),
+                pose_status=parts.pose(),
             )
         return CrclStatus(
             command_status=command,
-            joint_statuses=joint_statuses(session, settings)
-            if parts is None or parts.report_joint_statuses
+            joint_statuses=parts.joints() if asked is None or asked.report_joint_statuses else None,
+            pose_status=parts.pose() if asked is None or asked.report_pose_status else None,
+            gripper_status=parts.gripper()
+            if asked is None or asked.report_gripper_status
             else None,
-            pose_status=pose_status(session, settings)
-            if parts is None or parts.report_pose_status
-            else None,
-            gripper_status=gripper_status(session, settings)
-            if parts is None or parts.report_gripper_status
-            else None,
-            settings_status=settings_status(session, settings)
-            if parts is None or parts.report_settings_status
+            settings_status=parts.settings_status()
+            if asked is None or asked.report_settings_status
             else None,
         )
 

@@ -10,11 +10,14 @@ at this instant (mid-move too): ``pose_status`` (the tool point in the base fram
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TypeVar
 
 from ...session.session import Session
+from .binding import Nested, record_fields, write_record
 from .commands import ConfigureJointReport, ConfigureStatusReport
+from .documents import ROOT_ATTRIBUTES, XML_DECLARATION
 from .primitives import (
     JointPositionsTolerances,
     ParameterSetting,
@@ -29,6 +32,7 @@ from .primitives import (
     TransSpeedRelative,
 )
 from .status import (
+    CrclStatus,
     JointLimit,
     JointStatus,
     JointStatuses,
@@ -38,8 +42,11 @@ from .status import (
 )
 from .units import angle_factor, length_factor, matrix_to_pose
 
+_STATUS_PARTS = record_fields(CrclStatus)  # the status's elements, in the schema's order
+
 __all__ = [
     "ConnectionSettings",
+    "StatusParts",
     "gripper_status",
     "joint_statuses",
     "pose_status",
@@ -81,6 +88,8 @@ class ConnectionSettings:
     joint_reports: dict[int, ConfigureJointReport] | None = None
     status_report: ConfigureStatusReport | None = None
     gripper_enabled: bool = True
+    revision: int = 0
+    """Bumped by every command that may have changed a setting (what statuses cache by)."""
 
     @property
     def length(self) -> float:
@@ -201,3 +210,79 @@ def settings_status(session: Session, settings: ConnectionSettings) -> SettingsS
 
 def _kind(value: object, cls: type[T]) -> T | None:
     return value if isinstance(value, cls) else None
+
+
+class StatusParts:
+    """A connection's status parts, each built again only when what it shows changed:
+    the arm at rest (or the gripper) stands where it stood, the settings did not move.
+    A ``GetStatus`` while nothing moves then costs its parse and its writing."""
+
+    def __init__(self, session: Session, settings: ConnectionSettings) -> None:
+        self.session = session
+        self.settings = settings
+        self._memo: dict[str, tuple[object, object]] = {}
+        self._texts: dict[str, tuple[object, str]] = {}
+
+    def _memo_of(self, name: str, key: object, build: Callable[[], T]) -> T:
+        held = self._memo.get(name)
+        if key is not None and held is not None and held[0] == key:
+            return held[1]  # type: ignore[return-value]
+        value = build()
+        self._memo[name] = (key, value)
+        return value
+
+    def _at_rest(self) -> object:
+        """What the arm's parts depend on while it rests (None: it moves)."""
+        session = self.session
+        if session.travel.active:
+            return None
+        return (session.state.q, id(session.state.tool), self.settings.revision)
+
+    def pose(self) -> PoseStatus:
+        return self._memo_of(
+            "pose", self._at_rest(), lambda: pose_status(self.session, self.settings)
+        )
+
+    def joints(self, configured_only: bool = False) -> JointStatuses | None:
+        return self._memo_of(
+            f"joints {configured_only}",
+            self._at_rest(),
+            lambda: joint_statuses(self.session, self.settings, configured_only),
+        )
+
+    def gripper(self) -> ParallelGripperStatus | None:
+        session = self.session
+        moving = session.world.grips.moving(session.state)
+        key = None if moving else (session.state.opening, self.settings.revision)
+        return self._memo_of("gripper", key, lambda: gripper_status(session, self.settings))
+
+    def settings_status(self) -> SettingsStatus:
+        session = self.session
+        key = (
+            self.settings.revision,
+            session.speed,
+            session.lspeed,
+            session.state.opening_target,
+        )
+        return self._memo_of("settings", key, lambda: settings_status(session, self.settings))
+
+    def write(self, status: CrclStatus) -> bytes:
+        """``status.write_status(status)``, with each part that has not changed (the
+        same record as last time) written from the text kept of it."""
+        out = [XML_DECLARATION, f"<CRCLStatus{ROOT_ATTRIBUTES}>"]
+        for part in _STATUS_PARTS:
+            value = getattr(status, part.name)
+            if value is None:
+                continue
+            held = self._texts.get(part.name)
+            if held is not None and held[0] is value:
+                out.append(held[1])
+                continue
+            piece: list[str] = []
+            assert isinstance(part.codec, Nested)
+            write_record(value, part.tag, piece, part.codec)
+            text = "".join(piece)
+            self._texts[part.name] = (value, text)
+            out.append(text)
+        out.append("</CRCLStatus>")
+        return "".join(out).encode()
