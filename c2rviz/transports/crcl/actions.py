@@ -100,7 +100,18 @@ def _init_canon(ctl: Controller, report: Report, command: InitCanon) -> None:
 @_action(EndCanon)
 def _end_canon(ctl: Controller, report: Report, command: EndCanon) -> None:
     ctl.canon, ctl.ended = False, True
-    ctl.start(ARM, report, halt, takes=(GRIPPER, DWELL))
+    _halt(ctl, report, (GRIPPER, DWELL))
+
+
+def _halt(ctl: Controller, report: Report, takes: tuple[str, ...]) -> None:
+    """Stop what this connection runs in ``ARM`` and ``takes``, and the arm and fingers
+    (done at once if nothing moves)."""
+    session = ctl.session
+    if session.travel.active or session.world.grips.moving(session.state):
+        ctl.start(ARM, report, halt, takes=takes)
+    else:
+        for lane in (ARM, *takes):
+            ctl.take_over(lane, report)
 
 
 @_action(SetLengthUnits)
@@ -177,7 +188,7 @@ def _actuate(ctl: Controller, report: Report, command: ActuateJoints) -> None:
 
 @_action(StopMotion)
 def _stop(ctl: Controller, report: Report, command: StopMotion) -> None:
-    ctl.start(ARM, report, halt, takes=(GRIPPER,))
+    _halt(ctl, report, (GRIPPER,))
 
 
 @_action(Dwell)

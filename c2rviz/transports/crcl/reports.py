@@ -21,6 +21,8 @@ from .documents import ROOT_ATTRIBUTES, XML_DECLARATION
 from .primitives import (
     JointPositionsTolerances,
     ParameterSetting,
+    Point,
+    Pose,
     PoseTolerance,
     RotAccelAbsolute,
     RotAccelRelative,
@@ -30,6 +32,7 @@ from .primitives import (
     TransAccelRelative,
     TransSpeedAbsolute,
     TransSpeedRelative,
+    Vector,
 )
 from .status import (
     CrclStatus,
@@ -47,6 +50,7 @@ _STATUS_PARTS = record_fields(CrclStatus)  # the status's elements, in the schem
 __all__ = [
     "ConnectionSettings",
     "StatusParts",
+    "tidy",
     "gripper_status",
     "joint_statuses",
     "pose_status",
@@ -107,11 +111,26 @@ class ConnectionSettings:
         return [length if p else angle for p in prismatic]
 
 
+def tidy(value: float) -> float:
+    """``value`` to 12 significant digits, and 0 within 1e-12 of it: forward kinematics
+    leaves noise such as ``0.499999999999986`` or ``1.0e-14`` where 0.5 and 0 are meant,
+    far below what IK resolves (1e-9) or a robot shows."""
+    return 0.0 if abs(value) < 1e-12 else float(f"{value:.12g}")
+
+
 def pose_status(session: Session, settings: ConnectionSettings) -> PoseStatus:
     """The tool point's pose in the base frame, in the connection's length unit."""
     state = session.state
     placement = state.robot.ee_pose(session.now()) * state.tool
-    return PoseStatus(pose=matrix_to_pose(placement.homogeneous, settings.length_unit))
+    pose = matrix_to_pose(placement.homogeneous, settings.length_unit)
+    p, x, z = pose.point, pose.x_axis, pose.z_axis
+    return PoseStatus(
+        pose=Pose(
+            Point(tidy(p.x), tidy(p.y), tidy(p.z)),
+            Vector(tidy(x.i), tidy(x.j), tidy(x.k)),
+            Vector(tidy(z.i), tidy(z.j), tidy(z.k)),
+        )
+    )
 
 
 def joint_statuses(
@@ -139,8 +158,8 @@ def joint_statuses(
         statuses.append(
             JointStatus(
                 joint_number=number,
-                position=value / factors[index] if position else None,
-                velocity=v if speed else None,
+                position=tidy(value / factors[index]) if position else None,
+                velocity=tidy(v) if speed else None,
             )
         )
     return JointStatuses(tuple(statuses)) if statuses else None
@@ -164,7 +183,7 @@ def gripper_status(session: Session, settings: ConnectionSettings) -> ParallelGr
         return None
     opening = session.world.grips.now(state)
     return ParallelGripperStatus(
-        gripper_name=gripper.name, separation=gripper.separation(opening) / settings.length
+        gripper_name=gripper.name, separation=tidy(gripper.separation(opening) / settings.length)
     )
 
 

@@ -122,3 +122,17 @@ def test_no_server_is_exit_1(tmp_path, capsys) -> None:
     argv = [str(write(tmp_path, GOOD)), "--port", str(port), "--timeout", "0.2"]
     assert player.main(argv) == 1
     assert "no c2rviz CRCL door at 127.0.0.1:" in capsys.readouterr().err
+
+
+def test_the_bundled_pick_and_place_plays_all_done(start_crcl, capsys) -> None:
+    """commands/crcl_fanuc_pick.xml: the fanuc picks with its gripper and places."""
+    server = start_crcl("fanuc_lrmate200id")
+    assert play(server, Path("crcl_fanuc_pick.xml")) == 0, capsys.readouterr()
+    out = capsys.readouterr().out
+    assert "[ 5/13] SetEndEffectorType (CommandID 6): done" in out
+    assert out.splitlines()[-1].startswith("crcl_fanuc_pick.xml: 14 CRCL commands, all done")
+    tool = server.call(lambda: server.world.ee_pose().translation.copy())
+    np.testing.assert_allclose(tool, (0.4, 0.2, 0.4), atol=1e-6)
+    assert server.opening() == 1.0
+    openings = [o for o, _ in server.call(lambda: list(server.scene.openings))]
+    assert 0.3 in openings  # closed on the part between
