@@ -32,15 +32,26 @@ from __future__ import annotations
 import asyncio
 import logging
 from collections.abc import Awaitable, Callable
-from dataclasses import dataclass
-from typing import Final
+from typing import Any, Final
 
 from ...errors import C2rvizError, MotionInterrupted
 from ...protocol.registry import Reply
 from ...session.session import Session
-from .commands import Command, GetStatus, InitCanon
+from .commands import GetStatus, InitCanon
 from .documents import parse_instance
 from .errors import CrclError
+from .jobs import (
+    ARM,
+    DONE,
+    DWELL,
+    ERROR,
+    GRIPPER,
+    READY,
+    WORKING,
+    Job,
+    Refused,
+    Report,
+)
 from .reports import ConnectionSettings, StatusParts
 from .scalars import xml_safe_text
 from .status import CommandStatus, CrclStatus
@@ -54,58 +65,38 @@ __all__ = [
     "READY",
     "WORKING",
     "Controller",
+    "Action",
     "Job",
     "Refused",
     "Report",
-]
+    "registrar",
+]  # the lanes, states and records are ``jobs``'; here for the actions and motions
 
 log = logging.getLogger("c2rviz.crcl")
 
-DONE, ERROR, WORKING, READY = "CRCL_Done", "CRCL_Error", "CRCL_Working", "CRCL_Ready"
-ARM, GRIPPER, DWELL = "arm", "gripper", "dwell"
-"""The lanes: each runs one command at a time; a new one takes over."""
 MAX_DESCRIPTION: Final = 400
 """Longest StateDescription [characters]; a longer one is cut (a status stays compact)."""
 
 
-class Refused(C2rvizError):
-    """A command c2rviz will not carry out; the message says why."""
-
-
-@dataclass(eq=False)
-class Report:
-    """A command as its statuses report it."""
-
-    command_id: int
-    what: str
-    """``MoveToType (CommandID 3)``, as the codec's errors name a command."""
-    state: str = WORKING
-    description: str | None = None
-    program_file: str | None = None
-    program_index: int | None = None
-    program_length: int | None = None
-
-
-@dataclass(eq=False)
-class Job:
-    """A command running in a lane: its task, whether its motion began, who took over."""
-
-    report: Report
-    lane: str
-    task: asyncio.Task[None] | None = None
-    moving: bool = False
-    successor: Report | None = None
-    under_way: Job | None = None
-    """This connection's job of the lane still moving when this one started (its motion
-    is this one's to brake or blend from), until this one moves."""
-
-    @property
-    def over(self) -> bool:
-        return self.report.state != WORKING
-
-
 JobBody = Callable[["Controller", Job], Awaitable[None]]
-Action = Callable[["Controller", Report, Command], "str | None"]
+"""``body(controller, job)``: what a job does (``motions``)."""
+Action = Callable[["Controller", Report, Any], "str | None"]
+"""``action(controller, report, command)``: do the command (see ``actions``); return the
+``StateDescription`` of its CRCL_Done (None: none), or raise to refuse it."""
+
+
+def registrar(table: dict[type, Action]) -> Callable[..., Callable[[Action], Action]]:
+    """A decorator that enters an action in ``table`` for the command types it names."""
+
+    def named(*types: type) -> Callable[[Action], Action]:
+        def register(action: Action) -> Action:
+            for kind in types:
+                table[kind] = action
+            return action
+
+        return register
+
+    return named
 
 
 class Controller:
