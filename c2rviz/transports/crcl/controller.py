@@ -75,7 +75,10 @@ __all__ = [
 log = logging.getLogger("c2rviz.crcl")
 
 MAX_DESCRIPTION: Final = 400
-"""Longest StateDescription [characters]; a longer one is cut (a status stays compact)."""
+"""Longest StateDescription of a full status [characters]; a longer one is cut."""
+PUSHED_DESCRIPTION: Final = 240
+"""Longest StateDescription of a pushed status, and of a ``ProgramFile`` echoed
+[characters]: a compact status stays under 1 KiB, one per ``recv(1024)``."""
 
 
 JobBody = Callable[["Controller", Job], Awaitable[None]]
@@ -264,13 +267,16 @@ class Controller:
         self._status_id += 1
         description = report.description
         if description is not None:
-            description = xml_safe_text(description)[:MAX_DESCRIPTION]
+            description = xml_safe_text(description)[
+                : MAX_DESCRIPTION if full else PUSHED_DESCRIPTION
+            ]
+        program_file = report.program_file
         command = CommandStatus(
             command_id=report.command_id,
             status_id=self._status_id,
             state=report.state,
             description=description,
-            program_file=report.program_file,
+            program_file=program_file[:PUSHED_DESCRIPTION] if program_file else program_file,
             program_index=report.program_index,
             program_length=report.program_length,
         )

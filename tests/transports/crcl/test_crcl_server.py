@@ -353,3 +353,19 @@ def test_pose_to_matrix_is_what_a_move_reaches(crcl_server, crcl_connect) -> Non
     back = move_to(5, (p.x, p.y, p.z), x_axis=(x.i, x.j, x.k), z_axis=(z.i, z.j, z.k))
     assert client.run(back, 5).command_status.state == DONE
     assert crcl_server.call(lambda: crcl_server.world.ee_pose()).isApprox(placement, 1e-6)
+
+
+def test_a_pushed_status_stays_under_1_kib(crcl_server, crcl_connect) -> None:
+    """A client reading one status per recv(1024) gets whole ones: long texts are cut."""
+    client = crcl_connect(crcl_server)
+    doc = (
+        '<?xml version="1.0" encoding="UTF-8"?>\n'
+        '<CRCLCommandInstance xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance">\n'
+        '  <CRCLCommand xsi:type="MoveToType"><CommandID>1</CommandID>'
+        "<MoveStraight>false</MoveStraight>" + pose("EndPosition", (3.0, 0.0, 0.0)) + "\n"
+        "  </CRCLCommand>\n  <ProgramFile>" + "p" * 3000 + "</ProgramFile>\n"
+        "</CRCLCommandInstance>"
+    ).encode()
+    refused = client.run(doc, 1).command_status
+    assert refused.state == ERROR and refused.program_file == "p" * 240
+    assert len(client.raw[-1]) < 1024
