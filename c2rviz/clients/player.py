@@ -34,7 +34,6 @@ from typing import TextIO
 from ..errors import C2rvizError
 from ..protocol.verbs.connection import Bye, Quit, Sleep
 from ..protocol.verbs.motion import MOTION_MODES, MotionMode
-from . import crcl_program
 from .client import (
     Client,
     ConnectionLost,
@@ -204,7 +203,9 @@ def _fail(problems: Sequence[str], name: str, err: TextIO) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``c2rviz-play``; returns the exit status."""
     args = build_parser().parse_args(argv)
-    if crcl_program.is_crcl_program(args.file):  # a CRCLProgram: run over the CRCL port
+    if args.file.lower().endswith(".xml"):  # a CRCLProgram: over the CRCL port
+        from . import crcl_program  # the CRCL codec (lxml, numpy): loaded only for one
+
         return crcl_program.main(argv)
     out, err = sys.stdout, sys.stderr
     if args.loop < 0 or args.window < 1:
