@@ -22,6 +22,7 @@ __all__ = [
     "LineError",
     "LineTooLong",
     "MotionInterrupted",
+    "NoGripper",
     "PathCollides",
     "RobotError",
     "UnknownCommand",
@@ -179,3 +180,14 @@ class UnknownMarker(C2rvizError):
         self.count = count
         have = f"markers 1..{count}" if count else "no markers"
         super().__init__(f"no marker {index}: this robot has {have} (1 is the oldest)")
+
+
+class NoGripper(C2rvizError):
+    """A gripper command for a robot that has no gripper."""
+
+    def __init__(self, robot: str) -> None:
+        self.robot = robot
+        super().__init__(
+            f"no gripper: {robot} has none (a gripper is finger joints in its URDF, or the "
+            "ini's gripper = JOINT:CLOSED:OPEN ...)"
+        )

@@ -72,6 +72,14 @@ def build_parser() -> argparse.ArgumentParser:
         "robot's, the others at the next ports",
     )
     add(
+        "--crcl-port",
+        type=int,
+        metavar="PORT",
+        help="port for NIST's CRCL (XML commands, docs/crcl.md; default 64444, a cell's "
+        "robots this one and the next; 0 picks free ones)",
+    )
+    add("--no-crcl", dest="crcl", action="store_const", const=False, help="no CRCL door")
+    add(
         "--viser-host",
         dest="viewer_host",
         metavar="HOST",

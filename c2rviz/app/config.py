@@ -54,8 +54,8 @@ class RobotEntry:
     ini: Path | None = None
     """The file the section was read from."""
     extras: tuple[tuple[str, str], ...] = ()
-    """``tool``, ``max_velocity``, ``max_acceleration``, ``max_jerk`` as written (see
-    ``furnish``, which checks them)."""
+    """``tool``, ``gripper``, ``max_velocity``, ``max_acceleration``, ``max_jerk`` as written
+    (see ``furnish``, which checks them)."""
 
     def check_package_paths(self) -> None:
         """Raise ConfigError, naming ``[section] package_path``, for an entry that is no folder."""
@@ -133,6 +133,11 @@ class Settings:
     """``--port`` was given (a cell's members then take it as their base port)."""
     urdf_flag: bool = False
     """``--urdf`` was given (the robot is then named by its model unless ``--robot`` is)."""
+    crcl: bool = True
+    """Open the CRCL door (``--no-crcl``: not)."""
+    crcl_port: int | None = None
+    """The CRCL port (``--crcl-port``, ini ``crcl_port``; a cell's robots take it and the
+    next ones); None: the default, 64444, which another program may hold."""
 
 
 # ini key -> (Settings or ServerLimits field, type, lowest allowed, highest allowed)
@@ -155,6 +160,7 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "seed": ("plan_seed", int, 0, 2**31 - 2),
     "plan_step": ("plan_step_deg", float, 0.01, 10),
     "plan_tool_step": ("plan_tool_step_mm", float, 0.1, 100),
+    "crcl_port": ("crcl_port", int, 0, 65535),
 }
 _TO_SI = {  # a setting given in handier units -> (SessionDefaults field, conversion)
     "plan_step_deg": ("plan_step_rad", math.radians),
@@ -173,7 +179,7 @@ _TEXT_OPTIONS = (
 _CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on", "plan")}
 MOTION_FLAGS = ("max_velocity", "max_acceleration", "max_jerk")
 """Motion limits a flag may give every robot (over the ini's)."""
-_EXTRA_KEYS = ["tool", *MOTION_FLAGS]
+_EXTRA_KEYS = ["tool", "gripper", *MOTION_FLAGS]
 ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args", *_EXTRA_KEYS]
 _MEMBER_PLACE_KEYS = ("origin", "port")  # a cell member's, beside its robot keys (cell.py)
 _LIMIT_FIELDS = {f for f in ServerLimits.__dataclass_fields__}

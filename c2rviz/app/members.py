@@ -19,7 +19,7 @@ from ..robot.model import Robot
 from ..world.world import World
 from .cell import load_cell
 from .config import Settings
-from .robot_options import IniObject, ini_objects, limits_from, tool_from
+from .robot_options import IniObject, gripper_from, ini_objects, limits_from, tool_from
 
 __all__ = ["Member", "furnish", "members"]
 
@@ -123,6 +123,7 @@ def _member(
     first: bool,
 ) -> Member:
     objects = tuple(ini_objects(ini, name, first)) if ini is not None else ()
+    robot.gripper = gripper_from(section, given, robot)
     return Member(
         name,
         robot,

@@ -26,6 +26,7 @@ from ..world.clock import Clock
 from ..world.effects import NullScene, Scene
 from ..world.state import RobotState
 from ..world.world import World
+from . import crcl_door  # noqa: F401 (its opener joins doors.OPENERS)
 from .config import Settings, replaced_bundled
 from .doors import close_doors, open_doors
 from .members import Member, furnish

@@ -1,8 +1,11 @@
 """What the ini adds to each robot of the world: its tool, motion limits and workcell.
 
-A robot section may set ``tool = x,y,z,roll,pitch,yaw`` (m, deg) and
+A robot section may set ``tool = x,y,z,roll,pitch,yaw`` (m, deg),
 ``max_velocity``, ``max_acceleration``, ``max_jerk`` (one number for every
-joint, or one per joint, comma-separated; rad or m per s, s², s³). Workcell
+joint, or one per joint, comma-separated; rad or m per s, s², s³) and
+``gripper = JOINT:CLOSED:OPEN ...`` (finger joints off the chain, each with its
+closed and open value, m or deg; ``none``: no gripper, even if the URDF has
+finger joints). Workcell
 objects come from ``[objects]`` (the first robot's) and ``[objects:NAME]`` (robot
 NAME's, for a cell), one per line, placed in that robot's base frame::
 
@@ -27,9 +30,10 @@ import pinocchio as pin
 
 from ..errors import C2rvizError, ConfigError
 from ..motion.planner import MotionLimits, motion_limits
+from ..robot.gripper import Gripper, make_gripper
 from ..robot.model import Robot
 
-__all__ = ["IniObject", "ini_objects", "limits_from", "pose_from", "tool_from"]
+__all__ = ["IniObject", "gripper_from", "ini_objects", "limits_from", "pose_from", "tool_from"]
 
 IniObject = tuple[str, str, list[float], pin.SE3, "tuple[float, ...] | None", "Path | None"]
 """name, shape, size, placement in the base frame, rgba (None: default), mesh file."""
@@ -49,6 +53,45 @@ def tool_from(section: str, extras: Mapping[str, str]) -> pin.SE3 | None:
     """The section's ``tool``, if it sets one."""
     text = extras.get("tool")
     return None if text is None else pose_from(f"[{section}] tool", text)
+
+
+def gripper_from(section: str, extras: Mapping[str, str], robot: Robot) -> Gripper | None:
+    """The robot's gripper: the section's ``gripper`` if it sets one, else the URDF's.
+
+    Raises:
+        ConfigError: a malformed entry, or a joint that cannot be a finger.
+    """
+    text = extras.get("gripper")
+    if text is None:
+        return robot.gripper
+    if text.strip().lower() == "none":
+        return None
+    where = f"[{section}] gripper"
+    joints: list[tuple[str, float, float]] = []
+    for entry in text.split():
+        name, _, values = entry.partition(":")
+        numbers = _numbers(where, values.replace(":", ",")) if values else []
+        if not name or len(numbers) != 2:
+            raise ConfigError(
+                f"{where} = {text!r}: {entry!r} must be JOINT:CLOSED:OPEN (m, or deg for a "
+                "revolute joint), e.g. finger_joint:0:0.04; or none"
+            )
+        if name in robot.joint_names:
+            raise ConfigError(f"{where}: {name!r} is a joint of the chain, not a finger")
+        prismatic = _prismatic(robot, name)
+        scale = 1.0 if prismatic else math.pi / 180.0
+        joints.append((name, numbers[0] * scale, numbers[1] * scale))
+    try:
+        return make_gripper(robot.model, joints, robot.neutral)
+    except C2rvizError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
+
+
+def _prismatic(robot: Robot, joint: str) -> bool:
+    names = list(robot.model.names)
+    return joint in names and robot.model.joints[names.index(joint)].shortname().startswith(
+        "JointModelP"
+    )
 
 
 def limits_from(section: str, extras: Mapping[str, str], robot: Robot) -> MotionLimits:

@@ -212,6 +212,10 @@ def _fail(problems: Sequence[str], name: str, err: TextIO) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of ``c2rviz-play``; returns the exit status."""
     args = build_parser().parse_args(argv)
+    if args.file.lower().endswith(".xml"):  # a CRCLProgram: over the CRCL port
+        from . import crcl_program  # the CRCL codec (lxml, numpy): loaded only for one
+
+        return crcl_program.main(argv)
     out, err = sys.stdout, sys.stderr
     if is_bag(args.file):
         return play_bag(args, out, err)

@@ -19,6 +19,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import RobotError
+from .gripper import Gripper, find_fingers
 from .sources import RobotSource, load_source
 
 __all__ = ["CONTINUOUS_LIMIT", "ChainJoint", "Robot"]
@@ -119,6 +120,9 @@ class Robot:
         """Chain values of ``home``: 0, or the nearest limit where 0 is outside [rad or m]."""
         self._simple_q = all(joint.nq == 1 for joint in self.joints)
         self._idx_q = np.array([joint.idx_q for joint in self.joints], dtype=int)
+        self.gripper: Gripper | None = find_fingers(model, self._chain_ids, self.neutral)
+        """Its gripper: finger joints below the chain (``gripper.find_fingers``), or the
+        ini's (``gripper.make_gripper``); None: it has none."""
         pin.framesForwardKinematics(model, self.data, self.neutral)
         self.base_placement = self.data.oMf[self.base_frame].copy()
 
@@ -179,6 +183,7 @@ class Robot:
                 )
             path.append(joint)
             joint = model.parents[joint]
+        self._chain_ids = list(reversed(path))
         chain = []
         for j in reversed(path):
             jm = model.joints[j]
@@ -223,13 +228,16 @@ class Robot:
                     q[jm.idx_q] = min(max(q[jm.idx_q], lower), upper)
         return q
 
-    def configuration(self, q: Sequence[float]) -> np.ndarray:
+    def configuration(self, q: Sequence[float], opening: float | None = None) -> np.ndarray:
         """Pinocchio's full configuration for chain values ``q`` [rad or m].
 
         Joints off the chain stay at their neutral value (0, or the nearest limit
-        when 0 is outside them); mimic joints follow their leader.
+        when 0 is outside them), but for the gripper's fingers at ``opening`` (0
+        closed .. 1 open) when one is given; mimic joints follow their leader.
         """
         full = self.neutral.copy()
+        if opening is not None and self.gripper is not None:
+            self.gripper.apply(full, opening)
         if self._simple_q:
             full[self._idx_q] = q
         else:

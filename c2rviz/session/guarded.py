@@ -190,13 +190,15 @@ async def checked_move(
 
 
 def play_checked(
-    session: GuardedSession, checked: CheckedMove
+    session: GuardedSession, checked: CheckedMove, speed: float | None = None
 ) -> tuple[TimedPath, asyncio.Future[str] | None]:
-    """Play ``checked`` from rest on the world's clock at the session's speed (watched
-    while it runs); the path played, and the reply on arrival (``motion on``) or None."""
+    """Play ``checked`` from rest on the world's clock at ``speed`` % (default the
+    session's; watched while it runs); the path played, and the reply on arrival (``motion
+    on``) or None."""
     world, state = session.world, session.state
     limits = world.motion_limits(state.name)
-    play = time_path(checked.waypoints, limits, world.clock.now(), session.speed / 100.0)
+    percent = session.speed if speed is None else speed
+    play = time_path(checked.waypoints, limits, world.clock.now(), percent / 100.0)
     arrival = world.travels.play(state, play, session.source, wait=session.motion == "on")
     session.services.guards.watch(
         state.name, play, checked.allowed, session.source, session.resolution
@@ -204,21 +206,22 @@ def play_checked(
     return play, arrival
 
 
-async def guarded_go(session: GuardedSession, q: Sequence[float]) -> str:
+async def guarded_go(session: GuardedSession, q: Sequence[float], speed: float) -> str:
     """``Session.go`` under the guard (see the module): ``ok`` when shown, started
-    (``follow``) or arrived (``on``)."""
+    (``follow``) or arrived (``on``); ``speed`` is the session's [%] when the move was
+    asked (a door may change it for one move: it is read now, not once checked)."""
     plan = "blocked" if session.plan_around else "never"
     checked, at_once = await checked_move(session, [q], plan=plan)
     if at_once:
         session.world.set_q(checked.goal, session.state.name, session.source)
         return replies.OK
-    _, arrival = play_checked(session, checked)
+    _, arrival = play_checked(session, checked, speed)
     return replies.OK if arrival is None else await arrival
 
 
 async def guarded_rand(session: GuardedSession) -> str:
     """``rand`` under the guard: a configuration free of everything, drawn off the loop."""
-    rng, worker = session.services.rng, session.services.worker
+    rng, worker, speed = session.services.rng, session.services.worker, session.speed
     checker = checker_of(worker)
     asked = request(session, session.now(), [session.now()], target_only=True)
     name = session.state.robot.name
@@ -230,4 +233,4 @@ async def guarded_rand(session: GuardedSession) -> str:
         return found
 
     q = await worker.run(draw, key=("move", id(session)))
-    return await guarded_go(session, q)
+    return await guarded_go(session, q, speed)

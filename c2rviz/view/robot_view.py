@@ -123,14 +123,15 @@ class RobotView:
         self.sent_q: tuple[float, ...] | None = None
         self.sent_target: tuple[float, ...] | None = None
 
-    def draw(self, q: tuple[float, ...]) -> pin.SE3:
-        """Pose every link frame for chain values ``q`` [rad or m].
+    def draw(self, q: tuple[float, ...], opening: float | None = None) -> pin.SE3:
+        """Pose every link frame for chain values ``q`` [rad or m], the gripper's fingers
+        at ``opening`` (0 closed .. 1 open; None: where the model's neutral puts them).
 
         Returns:
             The end effector's placement in the base frame.
         """
         data = self._data
-        self._pose(self._frames, q)
+        self._pose(self._frames, q, opening)
         self.sent_q = q
         return self.robot.base_placement.actInv(data.oMf[self.robot.ee_frame])
 
@@ -185,9 +186,11 @@ class RobotView:
         pin.framesForwardKinematics(self.robot.model, self._data, self.robot.neutral)
         return max((float(np.linalg.norm(f.translation)) for f in self._data.oMf), default=1.0)
 
-    def _pose(self, frames: list[tuple[int, Any]], q: tuple[float, ...]) -> None:
+    def _pose(
+        self, frames: list[tuple[int, Any]], q: tuple[float, ...], opening: float | None = None
+    ) -> None:
         model, data = self.robot.model, self._data
-        pin.forwardKinematics(model, data, self.robot.configuration(q))
+        pin.forwardKinematics(model, data, self.robot.configuration(q, opening))
         pin.updateFramePlacements(model, data)
         for frame_id, handle in frames:
             placement = data.oMf[frame_id]

@@ -182,6 +182,10 @@ class ViserScene(Scene):
         self._dirty.add(robot)
         self.scheduler.request()
 
+    def on_gripper(self, robot: str, opening: float, t: float) -> None:
+        self._dirty.add(robot)
+        self.scheduler.request()
+
     def on_marker(self, robot: str, marker: Marker) -> None:
         self.markers.add(robot, marker)
         self.scheduler.request()
@@ -274,7 +278,7 @@ class ViserScene(Scene):
                 if state is None:
                     continue
                 view, panel = self.views[name], self.panels[name]
-                panel.show_pose(view.draw(state.q))
+                panel.show_pose(view.draw(state.q, state.opening))
                 moving = world.moving(name)
                 view.show_target(state.target if moving else None)
                 panel.show_joints(state.target, busy)

@@ -48,6 +48,9 @@ class Observer:
         """``robot``'s commanded motion changed at clock time ``t`` [s]: a move started,
         was stopped, or was cut short by a command that put the arm somewhere at once."""
 
+    def on_gripper(self, robot: str, opening: float, t: float) -> None:
+        """``robot``'s gripper is now at ``opening`` (0 closed .. 1 open), at time ``t`` [s]."""
+
     def on_clients(self, count: int) -> None:
         """``count`` TCP clients are connected."""
 
@@ -100,10 +103,15 @@ class RecordingScene(Scene):
     refused: list[str] = field(default_factory=list)
     objects: dict[str, list[str]] = field(default_factory=dict)
     collisions: list[tuple[str, list[tuple[str, str]]]] = field(default_factory=list)
+    openings: list[tuple[float, float]] = field(default_factory=list)
+    """Each gripper opening published and its clock time [s]."""
 
     def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
         self.joints.append(tuple(q))
         self.times.append(t)
+
+    def on_gripper(self, robot: str, opening: float, t: float) -> None:
+        self.openings.append((opening, t))
 
     def on_marker(self, robot: str, marker: Marker) -> None:
         self.markers.append(marker)

@@ -52,6 +52,8 @@ class RobotState:
         origin: Where its model's root stands in the world (the cell) frame.
         port: The command port that drives it by default (None: not known here).
         tool: The tool point (TCP) relative to the end-effector link.
+        opening: Its gripper's opening shown now, 0 closed .. 1 open (0 without one).
+        opening_target: The opening it was last commanded to.
     """
 
     name: str
@@ -62,10 +64,16 @@ class RobotState:
     origin: pin.SE3 = field(default_factory=pin.SE3.Identity)
     port: int | None = None
     tool: pin.SE3 = field(default_factory=pin.SE3.Identity)
+    opening: float = 0.0
+    opening_target: float = 0.0
 
     def __post_init__(self) -> None:
         if not self.q:
             self.q = self.target = self.robot.home
+        gripper = self.robot.gripper
+        if gripper is not None:  # where its fingers stand in the model's neutral pose
+            at_rest = [float(self.robot.neutral[i]) for i in gripper.idx_q]
+            self.opening = self.opening_target = gripper.opening_of(at_rest)
 
     @property
     def base(self) -> pin.SE3:

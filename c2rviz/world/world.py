@@ -24,6 +24,7 @@ from ..robot.frames import se3_wxyz
 from ..robot.model import Robot
 from .clock import Clock
 from .effects import Observer
+from .grips import Grips
 from .live_collisions import Contacts
 from .moves import Travel, Travels
 from .state import Marker, RobotState
@@ -83,6 +84,8 @@ class World:
         self.travels = Travels(self._show, self._rested, self.clock, self.frame_s, self._planned)
         for name, state in self.robots.items():
             self.travels.add(state, (limits or {}).get(name) or motion_limits(state.robot))
+        self.grips = Grips(self._show_opening, self.clock, self.frame_s)
+        """The grippers' moves (a robot's ``robot.gripper``; checked by the session)."""
 
     def state(self, name: str | None = None) -> RobotState:
         """The robot called ``name`` (the default robot for None)."""
@@ -143,6 +146,12 @@ class World:
         state.q = q
         for observer in self.observers:
             observer.on_joints(state.name, q, t)
+
+    def _show_opening(self, state: RobotState, opening: float, t: float) -> None:
+        """The robot's gripper is seen at ``opening`` at time ``t``: tell every observer."""
+        state.opening = opening
+        for observer in self.observers:
+            observer.on_gripper(state.name, opening, t)
 
     def _rested(self, state: RobotState, stopped: bool) -> None:
         """A move came to rest (after a stop: ``stopped``): tell every observer."""
@@ -207,6 +216,7 @@ class World:
     def close(self) -> None:
         """The program stops: no more frames, checks or solves."""
         self.travels.stop_all()
+        self.grips.stop_all()
         self.contacts.stop()
 
     # The workcell and collisions.

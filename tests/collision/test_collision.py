@@ -128,8 +128,11 @@ def test_the_pairs_left_unchecked_are_these(name: str) -> None:
     sets = [pairs.checked, pairs.adjacent, pairs.srdf, pairs.rigid, pairs.at_home, pairs.always]
     assert sum(len(s) for s in sets) == len(list(combinations(links, 2)))
     assert set().union(*sets) == set(combinations(links, 2))
-    # a serial arm: each link is adjacent to the next one only
-    assert len(pairs.adjacent) == robot.n
+    # a serial arm: each link is adjacent to the next one only; a gripper's hand (the
+    # fanuc's) to the flange and to each finger besides
+    on_gripper = {pair for pair in pairs.adjacent if "gripper_hand" in pair}
+    assert len(on_gripper) == (3 if robot.gripper is not None else 0)
+    assert len(pairs.adjacent) - len(on_gripper) == robot.n
 
 
 def test_a_pair_touching_in_nearly_every_sample_is_not_checked() -> None:

@@ -16,6 +16,7 @@ from c2rviz.protocol.grammar import ForeignProtocol, parse_line
 from c2rviz.protocol.verbs.cartesian import Ik, LinearSpeed, MoveL, MoveTo, Tool
 from c2rviz.protocol.verbs.cell import RobotChoice, RobotsList
 from c2rviz.protocol.verbs.connection import Bye, Quit, Sleep
+from c2rviz.protocol.verbs.gripper import Grip
 from c2rviz.protocol.verbs.joints import Home, Joints, Move, Rand, Units
 from c2rviz.protocol.verbs.markers import Clear, Color, Mark, MarkerShape
 from c2rviz.protocol.verbs.motion import MotionMode, Speed, Status, Stop, Target, Wait
@@ -130,6 +131,10 @@ GOOD = [
     ("sleep 1e9", Sleep(1e9), "sleep-long-checked-by-server"),
     ("bye", Bye(), "bye"),
     ("quit", Quit(), "quit"),
+    ("grip", Grip(None), "grip-ask"),
+    ("grip 0", Grip(0.0), "grip-closed"),
+    ("GRIP 1", Grip(1.0), "grip-open"),
+    ("grip .25", Grip(0.25), "grip-quarter"),
 ]
 
 
@@ -201,6 +206,10 @@ BAD = [
     ("sleep -1", BadArguments, "seconds must be >= 0, got -1", "sleep-negative"),
     ("sleep nan", BadArguments, "bad number 'nan'", "sleep-nan"),
     ("sleep 1,2", BadArguments, "sleep: needs 1 values, got 2", "sleep-two"),
+    ("grip 1.5", BadArguments, "grip: 1.5 is outside 0..1 (usage: grip [S])", "grip-over"),
+    ("grip -0.1", BadArguments, "grip: -0.1 is outside 0..1", "grip-negative"),
+    ("grip nan", BadArguments, "bad number 'nan'", "grip-nan"),
+    ("grip 0.5 1", BadArguments, "grip: takes 1 argument, got 2", "grip-two"),
     ("home 1", BadArguments, "home: takes no arguments", "home-arg"),
     ("limits some", BadArguments, "limits: unknown argument 'some'", "limits-other"),
     ("motion fast", BadArguments, "unknown mode 'fast'; choose off, on or follow", "motion-fast"),

@@ -43,7 +43,7 @@ ROBOTS = {
     },
     "fanuc_lrmate200id": {
         "robot_name": "fanuc_lrmate200id",
-        "nq": 6,
+        "nq": 8,  # the arm's 6, and its gripper's two fingers (ours, not FANUC's)
         "eelink": "link_6",
         "ee_at_zero": (0.465, 0.0, 0.695),
         # Effort is not among the published figures; the URDF leaves it 0 (unspecified).
@@ -64,6 +64,12 @@ ROBOTS = {
              (3.1415926535, -1.570796327, 0), None, None),
             ("base_link-base", "fixed", "base_link", "base", (0, 0, 0.330), (0, 0, 0),
              None, None),
+            ("link_6-gripper_hand", "fixed", "link_6", "gripper_hand", (0, 0, 0), (0, 0, 0),
+             None, None),
+            ("gripper_finger_left_joint", "prismatic", "gripper_hand", "gripper_finger_left",
+             (0.04, 0.001, 0), (0, 0, 0), (0, 1, 0), (0, 0.03, 0.1, 0)),
+            ("gripper_finger_right_joint", "prismatic", "gripper_hand", "gripper_finger_right",
+             (0.04, -0.001, 0), (0, 0, 0), (0, -1, 0), (0, 0.03, 0.1, 0)),
         ],
     },
     "kuka_lwr": {

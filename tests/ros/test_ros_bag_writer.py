@@ -190,9 +190,16 @@ def test_a_cell_namespaces_topics_and_prefixes_frames(tmp_path: Path) -> None:
         ("left/link_t", "left/tool0"),
     } <= pairs
     frames = {x.child_frame_id for _, tf in by_topic["/tf"] for x in tf.transforms}
-    assert frames == {
-        f"left/{n}" for n in ("link_s", "link_l", "link_e", "link_u", "link_r", "link_b", "link_t")
-    } | {f"right/link_{k}" for k in range(1, 7)}
+    fingers = {f"right/gripper_finger_{side}" for side in ("left", "right")}  # its gripper's
+    assert (
+        frames
+        == {
+            f"left/{n}"
+            for n in ("link_s", "link_l", "link_e", "link_u", "link_r", "link_b", "link_t")
+        }
+        | {f"right/link_{k}" for k in range(1, 7)}
+        | fingers
+    )
 
 
 def test_an_empty_bag_is_still_a_bag(tmp_path: Path) -> None:

@@ -105,6 +105,22 @@ def test_urdf_link_frames_are_pinocchio_body_frames(name: str) -> None:
             np.testing.assert_allclose(got, expected, atol=1e-6, err_msg=link)
 
 
+def test_the_fingers_are_drawn_at_the_gripper_opening(harness: Callable[..., Harness]) -> None:
+    h = harness("fanuc_lrmate200id", hz=1000.0)
+    robot = h.robot
+    for opening in (1.0, 0.25):
+        h.call(lambda o=opening: h.world.grips.set(h.world.state(), o, "test"))
+        h.run(0.005)
+        data = robot.model.createData()
+        pin.framesForwardKinematics(robot.model, data, robot.configuration(robot.home, opening))
+        for link in ("gripper_finger_left", "gripper_finger_right"):
+            expected = data.oMf[robot.model.getFrameId(link, pin.BODY)].translation
+            got = h.scene.link_frames[link].position
+            np.testing.assert_allclose(got, expected, atol=1e-9, err_msg=link)
+    left, right = (h.scene.link_frames[f"gripper_finger_{s}"].position for s in ("left", "right"))
+    assert np.linalg.norm(left - right) == pytest.approx(0.002 + 0.25 * 0.06)
+
+
 def test_a_flood_is_coalesced_and_the_last_pose_wins(harness: Callable[..., Harness]) -> None:
     h = harness(hz=100.0)
     h.run(0.05)

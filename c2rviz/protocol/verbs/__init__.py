@@ -8,12 +8,14 @@ Importing this package registers every verb in ``registry.VERBS``, in the order
 from . import joints, markers, queries, connection  # the seed's verbs
 from . import cartesian, cell, motion, observe, record, workcell
 from . import planning
+from . import gripper
 # isort: on
 
 __all__ = [
     "cartesian",
     "cell",
     "connection",
+    "gripper",
     "joints",
     "markers",
     "motion",

@@ -8,12 +8,13 @@ wait for them while every other client is served.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ...errors import ArmMoved, UnknownMarker
-from ...ik.line import plan_line
+from ...ik.line import StraightLine, plan_line
 from ...ik.target import PointTarget, Target
 from ...motion.line_play import LinePlay, brake_limits, ramp_limits
 from ...protocol import replies
@@ -25,7 +26,7 @@ from ..guarded import checked_move
 if TYPE_CHECKING:
     from ..session import Session
 
-__all__: list[str] = []
+__all__ = ["StraightPlan", "play_straight", "plan_straight", "solve"]
 
 
 @handler(Tool)
@@ -39,7 +40,7 @@ def tool(session: Session, command: Tool) -> str:
 @handler(Ik)
 async def ik(session: Session, command: Ik) -> str:
     target = _target(session, command.pose)
-    return replies.ok(replies.numbers(session.from_si(await _solve(session, target))))
+    return replies.ok(replies.numbers(session.from_si(await solve(session, target))))
 
 
 @handler(MoveTo)
@@ -50,42 +51,76 @@ async def moveto(session: Session, command: MoveTo) -> str:
         if not 0 < index <= len(markers):
             raise UnknownMarker(index, len(markers))
         marker = markers[index - 1]
-        q = await _solve(
-            session, in_base(session.state.base, wxyz_se3(marker.position, marker.wxyz))
-        )
+        target = in_base(session.state.base, wxyz_se3(marker.position, marker.wxyz))
+        q = await solve(session, target)
     else:
-        q = await _solve(session, _target(session, command.pose))
+        q = await solve(session, _target(session, command.pose))
     return await _reply(session.go(q))
 
 
 @handler(MoveL)
 async def movel(session: Session, command: MoveL) -> str:
-    state, world = session.state, session.world
-    if session.travel.active:
+    plan = await plan_straight(session, _target(session, command.pose))
+    return await _reply(play_straight(session, plan))
+
+
+@dataclass(frozen=True)
+class StraightPlan:
+    """A straight tool line planned from the arm at rest at ``start`` [rad or m]."""
+
+    start: tuple[float, ...]
+    waypoints: list[tuple[float, ...]]
+    line: StraightLine
+    allowed: frozenset[tuple[str, str]] = frozenset()
+    """Pairs touching at the start that the line may leave (the guard's)."""
+
+
+async def plan_straight(
+    session: Session, goal: Target, start: Sequence[float] | None = None
+) -> StraightPlan:
+    """Plan the tool's straight line from where the arm rests (or from ``start`` [rad or
+    m], the end of a line planned before) to ``goal`` (base frame, SI; a point alone leaves
+    the orientation free), checked off the loop by the guard when it is on; nothing moves
+    yet (``play_straight`` moves).
+
+    Raises:
+        ArmMoved: the arm moves (or moved while the line was planned).
+        C2rvizError: the line leaves the reach, or (guarded) collides.
+    """
+    state = session.state
+    if start is None and session.travel.active:
         raise ArmMoved("movel starts from rest: send wait (or stop) first")
-    start = state.q
-    goal, tool_offset = _target(session, command.pose), state.tool
+    first, tool_offset = tuple(state.q if start is None else start), state.tool
     worker = session.services.worker
     solver = worker.ik_solver(state)
-    line = await worker.run(lambda: plan_line(solver, start, goal, tool_offset))
-    if state.q != start or session.travel.active:
+    line = await worker.run(lambda: plan_line(solver, first, goal, tool_offset))
+    if start is None and (state.q != first or session.travel.active):
         raise ArmMoved("the arm moved while the line was planned: send movel again")
-    qs = np.array([waypoint.q for waypoint in line.waypoints])
+    waypoints = [waypoint.q for waypoint in line.waypoints]
     allowed: frozenset[tuple[str, str]] = frozenset()
     if session.guard:  # the whole line, off the loop
-        checked, _ = await checked_move(session, [qs[-1]], path_from=qs)
+        checked, _ = await checked_move(session, [waypoints[-1]], path_from=np.array(waypoints))
         allowed = checked.allowed
+    return StraightPlan(first, waypoints, line, allowed)
+
+
+def play_straight(session: Session, plan: StraightPlan) -> Reply:
+    """Move along a planned line as ``motion`` says (at once, or travelling at ``lspeed``)."""
+    state, world = session.state, session.world
     if session.motion == "off":
-        session.world.set_q(line.waypoints[-1].q, state.name, session.source)
+        world.set_q(plan.waypoints[-1], state.name, session.source)
         return replies.OK
     fraction, limits = session.speed / 100.0, session.travel.motion.limits
-    times = line.timestamps(session.lspeed, [v * fraction for v in limits.velocity])
+    times = plan.line.timestamps(session.lspeed, [v * fraction for v in limits.velocity])
     ramp = ramp_limits(limits, fraction)
-    play = LinePlay(world.clock.now(), times, qs, *ramp, brake=brake_limits(limits, fraction))
+    brake = brake_limits(limits, fraction)
+    play = LinePlay(world.clock.now(), times, np.array(plan.waypoints), *ramp, brake=brake)
     arrival = world.travels.play(state, play, session.source, session.motion == "on")
     if session.guard:
-        session.services.guards.watch(state.name, play, allowed, session.source, session.resolution)
-    return replies.OK if arrival is None else await arrival
+        session.services.guards.watch(
+            state.name, play, plan.allowed, session.source, session.resolution
+        )
+    return replies.OK if arrival is None else arrival
 
 
 @handler(LinearSpeed)
@@ -101,11 +136,20 @@ def _target(session: Session, pose: PoseValues) -> Target:
     return PointTarget.at(pose) if len(pose) == 3 else session.pose_se3(pose)
 
 
-async def _solve(session: Session, target: Target) -> Sequence[float]:
+async def solve(
+    session: Session, target: Target, seed: Sequence[float] | None = None
+) -> Sequence[float]:
+    """The joints [rad or m] that put the tool point at ``target`` (base frame, SI; a point
+    alone: any orientation), from
+    ``seed`` (default: the arm's joints now), on the worker's thread.
+
+    Raises:
+        C2rvizError: the pose is out of reach (naming how far).
+    """
     state, worker = session.state, session.services.worker
-    seed, tool_offset = session.now(), state.tool
+    first, tool_offset = (session.now() if seed is None else seed), state.tool
     solver = worker.ik_solver(state)
-    return await worker.run(lambda: solver.solve(target, seed, tool_offset))
+    return await worker.run(lambda: solver.solve(target, first, tool_offset))
 
 
 async def _reply(reply: Reply) -> str:

@@ -1,0 +1,29 @@
+"""What the gripper verb does: the fingers to an opening, travelling as ``motion`` says."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from ...errors import NoGripper
+from ...protocol import replies
+from ...protocol.registry import Reply, handler
+from ...protocol.verbs.gripper import Grip
+
+if TYPE_CHECKING:
+    from ..session import Session
+
+__all__: list[str] = []
+
+
+@handler(Grip)
+def grip(session: Session, command: Grip) -> Reply:
+    state, grips = session.state, session.world.grips
+    if state.robot.gripper is None:
+        raise NoGripper(state.name)
+    if command.opening is None:
+        return replies.ok(replies.numbers([grips.now(state)]))
+    if session.motion == "off":
+        grips.set(state, command.opening, session.source)
+        return replies.OK
+    arrival = grips.go(state, command.opening, session.source, wait=session.motion == "on")
+    return replies.OK if arrival is None else arrival

@@ -1,0 +1,312 @@
+"""One CRCL connection as a controller sees it: canon state, command states, statuses.
+
+A ``Controller`` takes the connection's documents in order (``receive``) and runs
+each command through the connection's ``Session`` (``actions`` says what each type
+does; motions are ``motions``' jobs). The rules:
+
+- **Canon**: before ``InitCanon`` and after ``EndCanon`` every command but InitCanon
+  and GetStatus is ``CRCL_Error``.
+- **States**: a command is ``CRCL_Working`` while it runs and then ``CRCL_Done``, or
+  ``CRCL_Error`` with a ``StateDescription`` naming it (``MoveToType (CommandID 3): ...``)
+  and why; before any command the status is ``CRCL_Ready`` (CommandID 0). A document
+  whose own CommandID cannot be read is reported under CommandID 0.
+- **Reporting**: every change of a command's state is pushed at once as a compact
+  status (``CommandStatus`` and ``PoseStatus``, and ``JointStatuses`` once
+  ``ConfigureJointReports`` asked for them); ``GetStatus`` answers a full one about
+  the latest command received (GetStatus aside). ``StatusID`` increases with every
+  status of the connection.
+- **Takeover**: the arm, the gripper and Dwell each run one command at a time. A new
+  one of the same kind takes over the one Working: a move blends from the arm's
+  motion (or, for a straight line, brakes to rest first) and ``StopMotion`` brakes;
+  the old command is then reported ``CRCL_Done`` "taken over by ..." (at once if it
+  had not started moving, else when the new motion starts: a refused new command
+  leaves the old one running and reported as usual). A move stopped or preempted by
+  another door (its ``stop``, the page) is ``CRCL_Error`` naming who.
+
+Values in and out are in the connection's units; the session sees SI, its angles in
+the connection's angle unit (so its limit errors speak it).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+from collections.abc import Awaitable, Callable
+from typing import Any, Final
+
+from ...errors import C2rvizError, MotionInterrupted
+from ...protocol.registry import Reply
+from ...session.session import Session
+from .commands import GetStatus, InitCanon
+from .documents import parse_instance
+from .errors import CrclError
+from .jobs import (
+    ARM,
+    DONE,
+    DWELL,
+    ERROR,
+    GRIPPER,
+    READY,
+    WORKING,
+    Job,
+    Refused,
+    Report,
+)
+from .reports import ConnectionSettings, StatusParts
+from .scalars import xml_safe_text
+from .status import CommandStatus, CrclStatus
+
+__all__ = [
+    "ARM",
+    "DONE",
+    "DWELL",
+    "ERROR",
+    "GRIPPER",
+    "READY",
+    "WORKING",
+    "Controller",
+    "Action",
+    "Job",
+    "Refused",
+    "Report",
+    "registrar",
+]  # the lanes, states and records are ``jobs``'; here for the actions and motions
+
+log = logging.getLogger("c2rviz.crcl")
+
+MAX_DESCRIPTION: Final = 400
+"""Longest StateDescription of a full status [characters]; a longer one is cut."""
+PUSHED_DESCRIPTION: Final = 240
+"""Longest StateDescription of a pushed status, and of a ``ProgramFile`` echoed
+[characters]: a compact status stays under 1 KiB, one per ``recv(1024)``."""
+
+
+JobBody = Callable[["Controller", Job], Awaitable[None]]
+"""``body(controller, job)``: what a job does (``motions``)."""
+Action = Callable[["Controller", Report, Any], "str | None"]
+"""``action(controller, report, command)``: do the command (see ``actions``); return the
+``StateDescription`` of its CRCL_Done (None: none), or raise to refuse it."""
+
+
+def registrar(table: dict[type, Action]) -> Callable[..., Callable[[Action], Action]]:
+    """A decorator that enters an action in ``table`` for the command types it names."""
+
+    def named(*types: type) -> Callable[[Action], Action]:
+        def register(action: Action) -> Action:
+            for kind in types:
+                table[kind] = action
+            return action
+
+        return register
+
+    return named
+
+
+class Controller:
+    """See the module docstring.
+
+    Args:
+        session: The connection's session (its motion is set ``on``, its guard on).
+        send: Writes one status document to the client.
+        actions: What each command type does (``actions.ACTIONS``).
+    """
+
+    def __init__(
+        self,
+        session: Session,
+        send: Callable[[bytes], None],
+        actions: dict[type, Action],
+    ) -> None:
+        self.session = session
+        session.motion = "on"  # a command is Working until its motion arrives
+        session.guard = True  # a colliding target or path is refused, never driven into
+        self.settings = ConnectionSettings()
+        self.parts = StatusParts(session, self.settings)
+        self.canon = False
+        self.ended = False
+        """An EndCanon came (so a command now is "after EndCanon")."""
+        self.latest = Report(0, "no command yet", READY)
+        self.lanes: dict[str, Job] = {}
+        self._send = send
+        self._actions = actions
+        self._status_id = 0
+        self._closed = False
+
+    # documents in
+
+    def receive(self, doc: bytes) -> None:
+        """Run one command document (its motion, if any, goes on in a task)."""
+        try:
+            instance = parse_instance(doc)
+        except CrclError as error:
+            self.refuse_document(error)
+            return
+        command = instance.command
+        if isinstance(command, GetStatus):
+            self._send_status(self.latest, full=True)
+            return
+        report = Report(
+            command.command_id,
+            f"{command.XSI_TYPE} (CommandID {command.command_id})",
+            program_file=instance.program_file,
+            program_index=instance.program_index,
+            program_length=instance.program_length,
+        )
+        self.latest = report
+        try:
+            if command.guards:
+                raise Refused("guards need sensors, and c2rviz simulates none")
+            if not self.canon and not isinstance(command, InitCanon):
+                state = "after EndCanon" if self.ended else "before InitCanon"
+                raise Refused(f"{state}: send InitCanon first")
+            description = self._actions[command.__class__](self, report, command)
+        except C2rvizError as error:
+            self.settings.revision += 1  # an action may have set something before it refused
+            self.note(report.what, False)
+            self.finish(report, ERROR, str(error))
+            return
+        self.settings.revision += 1
+        self.note(report.what, True)
+        if report.state == WORKING and not self._runs(report):
+            self.finish(report, DONE, description)
+
+    def refuse_document(self, error: CrclError) -> None:
+        """A document (or bytes) refused before it was a command: report it as an error."""
+        command_id = error.command_id if error.command_id is not None else 0
+        report = Report(command_id, error.command_type or "document")
+        self.latest = report
+        self.note(f"refused: {error.description}", False)
+        self.finish(report, ERROR, error.description, named=True)
+
+    # lanes and jobs
+
+    def start(self, lane: str, report: Report, body: JobBody, takes: tuple[str, ...] = ()) -> None:
+        """Run ``body`` as the command of ``lane`` (and of ``takes``: lanes it stops too),
+        taking over the command Working there."""
+        job = Job(report, lane)
+        old = self.lanes.get(lane)
+        if old is not None:
+            under_way = old if old.moving else old.under_way
+            job.under_way = under_way if under_way is not None and not under_way.over else None
+        for name in (lane, *takes):
+            self.take_over(name, report)
+        self.lanes[lane] = job
+        self._push(report)
+        job.task = asyncio.get_running_loop().create_task(self._run(job, body))
+
+    def take_over(self, lane: str, successor: Report) -> None:
+        """``successor`` takes ``lane`` over: its job is reported now if it has not moved
+        (and given up), else when the successor's motion interrupts it."""
+        old = self.lanes.get(lane)
+        if old is None or old.over:
+            return
+        old.successor = successor
+        if not old.moving:
+            if old.task is not None:
+                old.task.cancel()
+            before = "" if lane == DWELL else " before it moved"
+            self.finish(old.report, DONE, f"taken over by {successor.what}{before}")
+
+    @staticmethod
+    async def moving(job: Job, reply: Reply) -> None:
+        """``job``'s motion has begun (``reply``: the session's, ``ok`` on arrival); wait for it."""
+        job.moving = True
+        job.under_way = None
+        if not isinstance(reply, str):
+            await reply
+
+    async def _run(self, job: Job, body: JobBody) -> None:
+        report = job.report
+        try:
+            await body(self, job)
+        except MotionInterrupted as interrupted:
+            own = interrupted.why.endswith(f"by {self.session.source}")
+            if job.successor is not None and own:
+                self.finish(report, DONE, f"stopped short: taken over by {job.successor.what}")
+            else:
+                self.finish(report, ERROR, f"stopped short: {interrupted.why}")
+        except C2rvizError as error:
+            self.finish(report, ERROR, str(error))
+        except asyncio.CancelledError:
+            raise
+        except Exception:  # a bug costs this command, never the server
+            log.exception("internal error running %s", report.what)
+            self.finish(report, ERROR, "internal error (see the server log)")
+        else:
+            self.finish(report, DONE)
+
+    def _runs(self, report: Report) -> bool:
+        return any(job.report is report for job in self.lanes.values())
+
+    # statuses out
+
+    def finish(
+        self, report: Report, state: str, why: str | None = None, named: bool = False
+    ) -> None:
+        """``report``'s command ends in ``state``: say so (once), with ``why`` after the
+        command's name (``named``: ``why`` names it already)."""
+        if report.state != WORKING and report.state != READY:
+            return
+        report.state = state
+        report.description = why if why is None or named else f"{report.what}: {why}"
+        self._push(report)
+
+    def _push(self, report: Report) -> None:
+        self._send_status(report, full=False)
+
+    def _send_status(self, report: Report, full: bool) -> None:
+        if self._closed:
+            return
+        try:
+            self._send(self.parts.write(self.status(report, full)))
+        except C2rvizError:  # a value a status cannot carry (a bug): say it in the log
+            log.exception("cannot write a status for %s", report.what)
+
+    def status(self, report: Report, full: bool) -> CrclStatus:
+        """A status about ``report``: full (every part the reports ask for) or compact."""
+        self._status_id += 1
+        description = report.description
+        if description is not None:
+            description = xml_safe_text(description)[
+                : MAX_DESCRIPTION if full else PUSHED_DESCRIPTION
+            ]
+        program_file = report.program_file
+        command = CommandStatus(
+            command_id=report.command_id,
+            status_id=self._status_id,
+            state=report.state,
+            description=description,
+            program_file=program_file[:PUSHED_DESCRIPTION] if program_file else program_file,
+            program_index=report.program_index,
+            program_length=report.program_length,
+        )
+        parts, asked = self.parts, self.settings.status_report
+        if not full:
+            return CrclStatus(
+                command_status=command,
+                joint_statuses=parts.joints(configured_only=True),
+                pose_status=parts.pose(),
+            )
+        return CrclStatus(
+            command_status=command,
+            joint_statuses=parts.joints() if asked is None or asked.report_joint_statuses else None,
+            pose_status=parts.pose() if asked is None or asked.report_pose_status else None,
+            gripper_status=parts.gripper()
+            if asked is None or asked.report_gripper_status
+            else None,
+            settings_status=parts.settings_status()
+            if asked is None or asked.report_settings_status
+            else None,
+        )
+
+    def note(self, text: str, accepted: bool) -> None:
+        """Show ``text`` in the page's "last commands" (the world's log of commands)."""
+        self.session.world.note(self.session.source, text, accepted)
+
+    def close(self) -> None:
+        """The connection ended: nothing more is sent; commands not yet moving are dropped
+        (a motion under way goes on to its target, as a text client's does)."""
+        self._closed = True
+        for job in self.lanes.values():
+            if job.task is not None and not job.task.done():
+                job.task.cancel()

@@ -1,0 +1,274 @@
+"""The CRCL door: a TCP server whose connections are each a splitter, a session and a
+``Controller``.
+
+``CrclServer`` listens on ``127.0.0.1:64444`` by default (loopback, like the text
+port). Each connection reads what arrives, cuts it into documents with its own
+``DocumentSplitter`` and hands each to its ``Controller``, which runs it through the
+connection's ``Session`` (source ``crcl HOST:PORT``) and writes the statuses back.
+A connection never waits on a motion: GetStatus is answered while the arm moves.
+
+Bad input never costs the server or another client (every case gets a ``CRCL_Error``
+status whose ``StateDescription`` says what was wrong):
+
+- a malformed or invalid document, text or markup between documents: that error, and
+  the connection goes on with the next document;
+- a document that stalls half-sent for ``stall_timeout_s``: its bytes are dropped,
+  that error, and the connection goes on;
+- what the stream cannot be re-synchronised after (a document over
+  ``max_document_bytes``, binary bytes, a ``<!DOCTYPE`` or other markup declaration):
+  that error, then the documented close (the server ends its side, reads and drops
+  what the client still sends for up to ``LINGER_S``, then closes);
+- one connection over ``max_connections``: an error status, then the close;
+- statuses left unread past ``max_unread``: the connection is reset.
+
+A long run of documents in one read is worked through ``TURN_S`` at a time, so one
+client's flood delays the others by no more than that.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import time
+from dataclasses import dataclass
+from typing import Final
+
+from ...session.services import Services
+from ...session.session import Session
+from .actions import ACTIONS
+from .controller import Controller
+from .errors import CrclError, CrclFramingError
+from .framing import DocumentSplitter
+from .hardened import MAX_DOCUMENT_BYTES
+
+__all__ = ["DEFAULT_PORT", "LINGER_S", "READ_BYTES", "TURN_S", "CrclLimits", "CrclServer"]
+
+log = logging.getLogger("c2rviz.crcl")
+
+DEFAULT_PORT: Final = 64444
+"""NIST's Java tools' port."""
+READ_BYTES: Final = 65536
+"""Most bytes read at once from a client."""
+TURN_S: Final = 0.002
+"""Work per client per event-loop turn [s]: then the other clients go first."""
+LINGER_S: Final = 2.0
+"""After the close is decided, how long a client's input is read and dropped [s]."""
+
+
+@dataclass(frozen=True)
+class CrclLimits:
+    """What one CRCL client may cost (docs/limits.md).
+
+    Attributes:
+        max_document_bytes: The largest document [bytes]; larger closes the connection.
+        stall_timeout_s: How long half a document may wait for the rest [s].
+        max_connections: CRCL clients at once per port; one more is told so and closed.
+        max_unread: Statuses a client has not read [bytes]; more resets the connection.
+    """
+
+    max_document_bytes: int = MAX_DOCUMENT_BYTES
+    stall_timeout_s: float = 10.0
+    max_connections: int = 16
+    max_unread: int = 1 << 20
+
+
+class CrclServer:
+    """Listens for CRCL clients; each drives ``robot`` through a session of its own.
+
+    Args:
+        services: What sessions share (the world).
+        robot: The robot its clients drive (None: the world's default).
+        limits: What one client may cost.
+    """
+
+    def __init__(
+        self, services: Services, robot: str | None = None, limits: CrclLimits | None = None
+    ) -> None:
+        self.services = services
+        self.robot = robot
+        self.limits = limits or CrclLimits()
+        self._server: asyncio.Server | None = None
+        self._tasks: set[asyncio.Task[None]] = set()
+        self._open: set[_Connection] = set()
+        self._served: set[_Connection] = set()
+        self._door = f"crcl {id(self)}"
+        self.refused = 0
+        """Connections turned away (over ``max_connections``, or while stopping)."""
+        self.address: tuple[str, int] | None = None
+        """Where it listens, once started."""
+
+    @property
+    def connections(self) -> int:
+        """Clients served now."""
+        return len(self._served)
+
+    async def start(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> tuple[str, int]:
+        """Listen on ``host:port`` (0: a free port); return the address bound.
+
+        Raises:
+            OSError: the address cannot be listened on.
+        """
+        self._server = await asyncio.start_server(self._accept, host, port)
+        bound = self._server.sockets[0].getsockname()
+        self.address = (str(bound[0]), int(bound[1]))
+        return self.address
+
+    async def stop(self) -> None:
+        """Stop listening and close every connection (commands under way are dropped)."""
+        if self._server is None:
+            return
+        self._server.close()
+        for connection in list(self._open):
+            connection.shutdown()
+        if self._tasks:
+            await asyncio.wait(list(self._tasks), timeout=5.0)
+        await self._server.wait_closed()
+        self._server = None
+
+    async def _accept(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        task = asyncio.current_task()
+        assert task is not None
+        self._tasks.add(task)
+        try:
+            await self._serve(reader, writer)
+        finally:
+            self._tasks.discard(task)
+
+    async def _serve(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        peer = writer.get_extra_info("peername")
+        where = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
+        session = Session(self.services, f"crcl {where}", self.robot)
+        connection = _Connection(self, reader, writer, session)
+        self._open.add(connection)
+        try:
+            await self._connection(connection, where)
+        finally:
+            self._open.discard(connection)
+
+    async def _connection(self, connection: _Connection, where: str) -> None:
+        if self._server is None or len(self._served) >= self.limits.max_connections:
+            self.refused += 1
+            log.warning("refused CRCL client %s: %d served already", where, len(self._served))
+            limit = self.limits.max_connections
+            connection.controller.refuse_document(
+                CrclError(f"too many CRCL connections (limit {limit}); closing")
+            )
+            await connection.close()
+            return
+        self._served.add(connection)
+        self.services.count_clients(self._door, len(self._served))
+        log.info("CRCL client %s connected", where)
+        try:
+            await connection.run()
+        finally:
+            self._served.discard(connection)
+            self.services.count_clients(self._door, len(self._served))
+            log.info("CRCL client %s left", where)
+
+
+class _Connection:
+    """One client: its bytes, its splitter, its controller."""
+
+    def __init__(
+        self,
+        server: CrclServer,
+        reader: asyncio.StreamReader,
+        writer: asyncio.StreamWriter,
+        session: Session,
+    ) -> None:
+        self.limits = server.limits
+        self.reader, self.writer = reader, writer
+        self.splitter = DocumentSplitter(self.limits.max_document_bytes)
+        self.controller = Controller(session, self.send, ACTIONS)
+        self.closing = False
+
+    def send(self, document: bytes) -> None:
+        """Write one status; a client that leaves too many unread is reset."""
+        transport = self.writer.transport
+        if self.closing or transport.is_closing():
+            return
+        self.writer.write(document)
+        unread = transport.get_write_buffer_size()
+        if unread > self.limits.max_unread:
+            log.warning("resetting a CRCL client: %d bytes of statuses unread", unread)
+            self.closing = True
+            transport.abort()
+
+    async def run(self) -> None:
+        loop = asyncio.get_running_loop()
+        splitter, limits = self.splitter, self.limits
+        resumed = loop.time()  # the stall clock runs only while we read
+        try:
+            while not self.closing:
+                timeout = None
+                if splitter.pending_bytes:
+                    started = splitter.started_at
+                    began = resumed if started is None else max(started, resumed)
+                    timeout = max(began + limits.stall_timeout_s - loop.time(), 0.0)
+                try:
+                    data = await asyncio.wait_for(self.reader.read(READ_BYTES), timeout)
+                except asyncio.TimeoutError:
+                    dropped = splitter.discard_pending()
+                    self.controller.refuse_document(
+                        CrclFramingError(
+                            f"half a document ({dropped} bytes) stalled for "
+                            f"{limits.stall_timeout_s:g} s: dropped; skipping to the next "
+                            "document",
+                            recoverable=True,
+                        )
+                    )
+                    continue
+                except (ConnectionError, OSError):
+                    break
+                if not data:
+                    break
+                await self._take(splitter.feed(data, loop.time()))
+                resumed = loop.time()
+                if splitter.closed:
+                    await self.close()
+        finally:
+            self.controller.close()
+            if not self.closing:
+                self.closing = True
+                self.writer.close()
+
+    async def _take(self, items: list[bytes | CrclFramingError]) -> None:
+        """Run the documents (and report the errors) of one read, a turn's work at a time."""
+        started = time.perf_counter()
+        for item in items:
+            if self.closing:
+                return
+            if isinstance(item, CrclFramingError):
+                self.controller.refuse_document(item)
+            else:
+                self.controller.receive(item)
+            if time.perf_counter() - started > TURN_S:
+                await asyncio.sleep(0)  # the other clients' turn
+                started = time.perf_counter()
+
+    def shutdown(self) -> None:
+        """The server stops: nothing more is read or sent; the connection closes now."""
+        self.controller.close()
+        self.closing = True
+        self.writer.transport.abort()  # the reads end (EOF): run and close return
+
+    async def close(self) -> None:
+        """The documented close: statuses out, our side ended, the client's rest read and
+        dropped for up to ``LINGER_S`` (a reset would lose the last status), then closed."""
+        self.controller.close()
+        self.closing = True
+        writer = self.writer
+        if writer.transport.is_closing():
+            return
+        deadline = asyncio.get_running_loop().time() + LINGER_S
+        try:
+            if writer.can_write_eof():
+                writer.write_eof()
+            while True:
+                left = deadline - asyncio.get_running_loop().time()
+                if left <= 0 or not await asyncio.wait_for(self.reader.read(READ_BYTES), left):
+                    break
+        except (asyncio.TimeoutError, ConnectionError, OSError):
+            pass
+        finally:
+            writer.close()
