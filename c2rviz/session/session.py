@@ -12,14 +12,15 @@ bad command never moves the robot partly.
 from __future__ import annotations
 
 import asyncio
+import functools
 import math
-from collections.abc import Sequence
+from collections.abc import Awaitable, Sequence
 
 import pinocchio as pin
 
 from ..collision.model import segment
 from ..collision.other_robots import first_hit_between
-from ..errors import C2rvizError, JointLimitError, PathCollides
+from ..errors import C2rvizError, JointLimitError, MotionInterrupted, PathCollides
 from ..protocol import replies
 from ..protocol.grammar import numbers_batch, parse_line
 from ..protocol.registry import HANDLERS, Reply
@@ -113,7 +114,8 @@ class Session:
             )
         if found is not None:
             index, (first, second) = found
-            raise PathCollides(first, second, index / max(len(points) - 1, 1), at_target)
+            fraction = index / max(len(points) - 1, 1)
+            raise PathCollides(first, second, fraction, at_target, target=q)
 
     def joints_run(self, texts: Sequence[str]) -> bool:
         """A run of ``joints`` lines (their value lists) checked as one: with ``motion off``
@@ -156,11 +158,33 @@ class Session:
             if command is None:
                 return None
             reply = HANDLERS[command.__class__](self, command)
-        except C2rvizError:
+        except C2rvizError as exc:
             self.world.note(self.source, line, False)
+            self.world.refused(self.state.name, self.source, line, exc)
             raise
         self.world.note(self.source, line, True)
-        return reply
+        if isinstance(reply, str):
+            return reply
+        if isinstance(reply, asyncio.Future):
+            reply.add_done_callback(functools.partial(self._answered, self.state.name, line))
+            return reply
+        return self._awaited(self.state.name, line, reply)
+
+    def _answered(self, robot: str, line: str, reply: asyncio.Future[str]) -> None:
+        """A reply that waited came: tell the world if it is a refusal (not a preemption)."""
+        error = None if reply.cancelled() else reply.exception()
+        if isinstance(error, C2rvizError) and not isinstance(error, MotionInterrupted):
+            self.world.refused(robot, self.source, line, error)
+
+    async def _awaited(self, robot: str, line: str, reply: Awaitable[str]) -> str:
+        """``reply`` awaited; a refusal in it is told to the world (as ``_answered``)."""
+        try:
+            return await reply
+        except MotionInterrupted:
+            raise
+        except C2rvizError as exc:
+            self.world.refused(robot, self.source, line, exc)
+            raise
 
     def after(self, seconds: float, reply: str) -> asyncio.Future[str]:
         """A reply that comes ``seconds`` [s] from now (on the running loop).

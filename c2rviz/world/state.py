@@ -52,6 +52,7 @@ class RobotState:
         origin: Where its model's root stands in the world (the cell) frame.
         port: The command port that drives it by default (None: not known here).
         tool: The tool point (TCP) relative to the end-effector link.
+        ghost: Views show where it travels: its target and its path (``ghost on|off``).
     """
 
     name: str
@@ -62,6 +63,7 @@ class RobotState:
     origin: pin.SE3 = field(default_factory=pin.SE3.Identity)
     port: int | None = None
     tool: pin.SE3 = field(default_factory=pin.SE3.Identity)
+    ghost: bool = True
 
     def __post_init__(self) -> None:
         if not self.q:
