@@ -21,9 +21,8 @@ from .state import MAX_MARKERS, Marker
 if TYPE_CHECKING:
     import pinocchio as pin
 
-    from ..errors import C2rvizError
-
     from ..collision.workcell import WorkcellObject
+    from ..errors import C2rvizError
 
 __all__ = ["MAX_MARKERS", "Marker", "NullScene", "Observer", "RecordingScene", "Scene"]
 

@@ -72,9 +72,7 @@ def test_a_preempted_move_is_not_a_refusal(server: ServerThread, connect):
     assert server.call(lambda: list(server.scene.errors)) == []
 
 
-def test_ghost_is_per_robot_on_by_default_and_told_to_the_observers(
-    server: ServerThread, connect
-):
+def test_ghost_is_per_robot_on_by_default_and_told_to_the_observers(server: ServerThread, connect):
     client = connect(server)
     assert client.ask("ghost") == "ok on"
     assert client.ask("ghost off") == "ok"

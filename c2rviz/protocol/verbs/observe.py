@@ -94,5 +94,6 @@ class Ghost:
             return Ghost(None)
         action = one_word(verb, words).lower()
         if action not in GHOST_ACTIONS:
-            raise BadArguments(verb, f"unknown action {shown(action)}; choose on or off", usage(verb))
+            choose = f"unknown action {shown(action)}; choose on or off"
+            raise BadArguments(verb, choose, usage(verb))
         return Ghost(action == "on")
