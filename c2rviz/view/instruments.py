@@ -46,7 +46,7 @@ class Instruments:
     """The page's instruments; see the module docstring.
 
     Attributes:
-        origin_s: The clock time the page's times count from (its start) [s].
+        origin_s: The clock time the page's times count from (the server's start) [s].
         histories: Each robot's ``RobotHistory``, by name.
         plots: Each robot's ``RobotPlots``.
         readouts: Each robot's ``RobotReadout``.

@@ -79,7 +79,7 @@ class RobotPlots:
 
     def __init__(self, gui: viser.GuiApi, robot: Robot, origin_s: float, velocities: bool):
         """Add the charts to the folder open in ``gui``; times are plotted in seconds from
-        ``origin_s`` (the page's start) [s of the clock]."""
+        ``origin_s`` (the server's start, as ``watch``) [s of the clock]."""
         self.robot = robot
         self.origin_s = origin_s
         self._scale = np.array([1.0 if j.prismatic else 180.0 / math.pi for j in robot.joints])

@@ -1,7 +1,8 @@
 """The timeline: look back through the page's history while the robots go on.
 
 The ``Timeline`` folder holds a ``Time s`` slider over the history the page
-keeps (seconds since the page started; ``history.HISTORY_S`` at most), the time
+keeps (seconds since the server started, the times of ``watch``'s ``state``
+lines; ``history.HISTORY_S`` at most), the time
 shown, the replay buttons (a frame back, play/pause, a frame forward, live) and
 a ``Speed x`` slider (0.25 to 4). Moving the slider (or stepping) looks back: the page draws
 every robot, its markers and objects and its plots as they were at that time,
@@ -65,8 +66,8 @@ class Timeline:
                 max=1.0,
                 step=0.01,
                 initial_value=1.0,
-                hint="look back: seconds since the page started (the page keeps the last "
-                "5 minutes); the robots go on meanwhile",
+                hint="look back: seconds since the server started, as watch's state lines "
+                "(the page keeps the last 5 minutes); the robots go on meanwhile",
             )
             self.readout: Any = gui.add_text("Shown", "live", disabled=True)
             self.buttons: Any = gui.add_button_group(
@@ -99,7 +100,7 @@ class Timeline:
         return self._span
 
     def seek(self, seconds: float) -> None:
-        """Show the time ``seconds`` after the page's start; the end of the history is live.
+        """Show the time ``seconds`` after ``origin_s``; the end of the history is live.
 
         Raises:
             PageValueError: outside the history.

@@ -149,7 +149,8 @@ class ViserScene(Scene):
         self.handles = ToolHandles(server, segments, self.scheduler.request)
         self._frame_camera()
         self.page_input = PageInput(server, self.markers)
-        timeline = Timeline(server.gui, world.clock.now(), world.frame_s)
+        # the page's times are the watch stream's: seconds since the server started
+        timeline = Timeline(server.gui, self.services.watch.origin, world.frame_s)
         self.panels: dict[str, RobotPanel] = {}
         self.sessions: dict[str, Session] = {}
         for name, state in world.robots.items():
