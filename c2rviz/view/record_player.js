@@ -501,7 +501,8 @@
         q: k >= 0 && data.times.length ? Array.prototype.slice.call(data.values.subarray(k * width, k * width + n)) : null,
         markers: st.markersShown, objects: st.objectsShown.slice(), playing: st.playing,
         speed: st.speed, window: st.window, plotCursor: st.plotCursor, plotRange: st.plotRange,
-        plotDraws: st.plotDraws, problems: st.problems.slice(), refused: st.refused, endS: meta.endS
+        plotDraws: st.plotDraws, problems: st.problems.slice(), refused: st.refused, endS: meta.endS,
+        timings: st.timings
       };
     },
     seek: function (t) { pause(); return seek(t); },
@@ -514,9 +515,12 @@
   function start() {
     buildUi();
     var started = Date.now();
-    Promise.all([load(), whenViser(started)]).then(function () {
+    st.timings = { start: performance.now() };
+    var loaded = load().then(function () { st.timings.data = performance.now(); });
+    var shown = whenViser(started).then(function () { st.timings.scene = performance.now(); });
+    Promise.all([loaded, shown]).then(function () {
       st.ready = true;
-      st.loadMs = Date.now() - started;
+      st.timings.ready = performance.now();
       redraw();
       if (data.times.length > 1) play();
     }).catch(function (error) {
