@@ -33,7 +33,7 @@ PATH_POINTS = 256
 """Points of a drawn path at most."""
 PATH_RGB = (0.15, 0.45, 1.0)
 REFUSED_RGBA = (1.0, 0.1, 0.05, 0.5)
-REFUSED_S = 3.0
+REFUSED_S = 5.0
 """How long a refused target shows [s]."""
 
 
@@ -91,7 +91,7 @@ class RobotGhost:
         segments = np.stack([points[:-1], points[1:]], axis=1)
         if self.path_node is None:
             self.path_node = self._scene.add_line_segments(
-                f"{self.view.prefix}/path", points=segments, colors=PATH_RGB, thickness=0.004
+                f"{self.view.prefix}/path", points=segments, colors=PATH_RGB, thickness=0.008
             )
         else:
             self.path_node.points = segments

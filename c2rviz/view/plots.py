@@ -19,6 +19,7 @@ every control: all tabs show the same ones, and a late tab is sent their state.
 
 from __future__ import annotations
 
+import html
 import math
 from typing import Any
 
@@ -53,6 +54,15 @@ _X = uplot.Series(label="t [s]")
 _SCALES = {"x": uplot.Scale(time=False)}
 
 
+def legend(robot: Robot) -> str:
+    """The charts' key: each joint's name in its colour (markdown; the names escaped)."""
+    keys = " ".join(
+        f'<span style="color:{COLORS[i % len(COLORS)]}">&#9473;&nbsp;{html.escape(j.name)}</span>'
+        for i, j in enumerate(robot.joints)
+    )
+    return f"{keys} <span style='color:#888'>(dashed: its limits)</span>"
+
+
 def thin(count: int, points: int = PLOT_POINTS) -> np.ndarray:
     """Indices of at most ``points`` samples of ``count``, evenly spread, first and last
     kept."""
@@ -70,6 +80,7 @@ class RobotPlots:
         pause: The ``Pause plots`` checkbox.
         velocities: The ``Velocities`` checkbox.
         joints: A checkbox per joint of the chain: plotted or not.
+        legend: Each joint's colour (the charts draw no legend of their own).
         positions: The joint chart [deg or m].
         speeds: The velocity chart [deg/s or m/s].
         tool_speed: The tool point's speed chart [m/s].
@@ -108,13 +119,14 @@ class RobotPlots:
                     gui.add_checkbox(short_label(j.name), True, hint=f"plot {j.name}")
                     for j in robot.joints
                 ]
+            self.legend: Any = gui.add_markdown(legend(robot))
             empty = (np.zeros(1), *(np.zeros(1) for _ in robot.joints))
             self.positions: Any = gui.add_uplot(
                 empty,
                 (_X, *self._joint_series(range(robot.n))),
                 title=f"joints [{self._unit_text()}]",
                 scales=_SCALES,
-                legend=uplot.Legend(live=False),
+                legend=uplot.Legend(show=False),  # the colours are in ``legend``, once
                 aspect=1.4,
             )
             self.speeds: Any = gui.add_uplot(
