@@ -23,6 +23,7 @@ import base64
 import importlib.resources
 import json
 import logging
+import os
 import zlib
 from pathlib import Path
 from typing import Any
@@ -94,7 +95,9 @@ def write_html(recorded: Recorded, state: RobotState) -> Path:
         "marks": commands.marks.astype("<f8"),
     }
     path = recorded.csv.with_suffix(".html")
-    with open(path, "w", encoding="utf-8") as out:
+    part = path.with_name(f".{path.name}.part")  # then renamed: NAME.html whole, or not at all
+    flags = os.O_WRONLY | os.O_CREAT | os.O_TRUNC | getattr(os, "O_NOFOLLOW", 0)
+    with open(os.open(part, flags, 0o644), "w", encoding="utf-8") as out:
         head, tail = scene.rsplit("</body>", 1)
         out.write(head)
         out.write(f'<script type="application/json" id="c2rviz-recording">{_json(meta)}</script>\n')
@@ -105,6 +108,7 @@ def write_html(recorded: Recorded, state: RobotState) -> Path:
         out.write(f"<style>{_asset('record_player.css')}</style>\n")
         out.write(f"<script>{_asset('record_player.js')}</script>\n</body>")
         out.write(tail)
+    os.replace(part, path)  # a link at NAME.html is replaced, never followed
     for problem in problems:
         log.warning("recording %s: %s", recorded.name, problem)
     return path

@@ -275,3 +275,17 @@ def test_files_that_disagree_open_with_a_message(tmp_path: Path, change: str, me
         record = dataclasses.replace(record, error="write error: No space left on device")
     meta = page_meta(write_html(record, RobotState("arm", robot)))
     assert any(message in problem for problem in meta["problems"]), meta["problems"]
+
+
+def test_a_link_at_name_html_is_replaced_never_followed(tmp_path: Path) -> None:
+    robot = load_robot()
+    folder = tmp_path / "rec"
+    folder.mkdir()
+    csv, txt = write_recording(folder, robot, 30)
+    outside = tmp_path / "outside.html"
+    outside.write_text("keep me")
+    (folder / "take.html").symlink_to(outside)
+    path = write_html(recorded(csv, txt, robot), RobotState("arm", robot))
+    assert outside.read_text() == "keep me"
+    assert not path.is_symlink() and page_meta(path)["problems"] == []
+    assert sorted(p.name for p in folder.iterdir()) == ["take.csv", "take.html", "take.txt"]
