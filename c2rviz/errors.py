@@ -161,9 +161,18 @@ class MotionInterrupted(C2rvizError):
 class PathCollides(C2rvizError):
     """A guarded command whose target, or a point of its way there, collides."""
 
-    def __init__(self, first: str, second: str, fraction: float, at_target: bool) -> None:
+    def __init__(
+        self,
+        first: str,
+        second: str,
+        fraction: float,
+        at_target: bool,
+        target: Sequence[float] | None = None,
+    ) -> None:
         self.pair = (first, second)
         self.fraction = fraction
+        self.target = None if target is None else tuple(target)
+        """The refused command's target [rad or m], when known (the page shows it)."""
         where = "at the target" if at_target else f"at {fraction * 100:.0f}% of the move"
         super().__init__(f"{first} would hit {second} {where}")
 

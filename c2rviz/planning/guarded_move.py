@@ -152,7 +152,7 @@ class MoveChecker:
         if request.target_only:
             blocked = first_blocked(checker, goal[None, :], allowed)
             if blocked is not None:
-                raise PathCollides(*blocked[1], 1.0, True)
+                raise PathCollides(*blocked[1], 1.0, True, target=goal.tolist())
             return CheckedMove(np.array([start, goal]), None, allowed, revision)
         waypoints = request.path if request.path is not None else np.array([start, goal])
         points = path_points(checker, waypoints)
@@ -160,7 +160,10 @@ class MoveChecker:
         if blocked is None:
             return CheckedMove(np.asarray(waypoints, dtype=float), None, allowed, revision)
         index, pair = blocked
-        collides = PathCollides(*pair, index / max(len(points) - 1, 1), False)
+        end = waypoints[-1] if request.path is not None else goal
+        collides = PathCollides(
+            *pair, index / max(len(points) - 1, 1), False, target=np.asarray(end).tolist()
+        )
         if request.plan != "blocked" or request.path is not None:
             raise collides
         try:

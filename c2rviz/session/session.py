@@ -19,7 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
-from ..errors import C2rvizError, JointLimitError, PathCollides
+from ..errors import C2rvizError, JointLimitError, MotionInterrupted, PathCollides
 from ..planning import EdgeResolution, MoveChecker, edge_resolution, first_blocked, path_points
 from ..protocol import replies
 from ..protocol.grammar import ForeignProtocol, numbers_batch, parse_line
@@ -157,7 +157,8 @@ class Session:
         found = first_blocked(checker, points, allowed)
         if found is not None:
             index, (first, second) = found
-            raise PathCollides(first, second, index / max(len(points) - 1, 1), at_target)
+            fraction = index / max(len(points) - 1, 1)
+            raise PathCollides(first, second, fraction, at_target, target=q)
 
     def joints_run(self, texts: Sequence[str]) -> bool:
         """A run of ``joints`` lines (their value lists) checked as one: with ``motion off``
@@ -204,6 +205,7 @@ class Session:
             reply = HANDLERS[command.__class__](self, command)
         except C2rvizError as exc:
             world.note(self.source, line, False)
+            world.refused(self.state.name, self.source, line, exc)
             if not isinstance(exc, ForeignProtocol):  # a door answers that one its own way
                 world.replied(self.source, line, replies.error(exc))
             raise
@@ -212,11 +214,12 @@ class Session:
             world.replied(self.source, line, reply)
             return reply
         later = asyncio.ensure_future(reply)
-        later.add_done_callback(functools.partial(self._replied, line))
+        later.add_done_callback(functools.partial(self._replied, self.state.name, line))
         return later
 
-    def _replied(self, line: str, later: asyncio.Future[str]) -> None:
-        """A reply that waited has come (one cancelled never reached anyone)."""
+    def _replied(self, robot: str, line: str, later: asyncio.Future[str]) -> None:
+        """A reply that waited has come (one cancelled never reached anyone): the world
+        hears it, and a refusal (not a preemption) as a refusal."""
         if later.cancelled():
             return
         error = later.exception()
@@ -224,6 +227,8 @@ class Session:
             text = later.result()
         elif isinstance(error, C2rvizError):
             text = replies.error(error)
+            if not isinstance(error, MotionInterrupted):
+                self.world.refused(robot, self.source, line, error)
         else:
             text = replies.error("internal error (see the server log)")
         self.world.replied(self.source, line, text)

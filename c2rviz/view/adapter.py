@@ -185,23 +185,28 @@ def accept_input(
     callback: InputCallback,
     refused: Callable[[int], None] | None = None,
 ) -> None:
-    """Let the page set ``handle`` (a slider, number, checkbox or button) through ``callback``.
+    """Let the page set ``handle`` (a slider, number, checkbox, button or button group)
+    through ``callback``.
 
     The page's ``{"value": v}`` for the handle goes to ``callback(client_id, v)``
-    (viser's client id; ``v`` a float, or a bool for a checkbox or button) on
+    (viser's client id; ``v`` a float, a bool for a checkbox or button, one of
+    the buttons' labels for a button group) on
     viser's thread, and nowhere else: viser neither applies it nor shows it to
     other tabs. The caller decides the true value and sends it with
     ``set_gui_value``. A value the door drops for the handle (NaN, a word) goes
     to ``refused(client_id)``. A handle not registered cannot be set from the page.
     """
     state = handle._impl
+    choices: frozenset[str] = frozenset()
     if isinstance(state.value, bool):
         kind: type = bool
     elif isinstance(state.value, (int, float)):
         kind = float
+    elif isinstance(state.value, str) and hasattr(handle, "options"):  # a button group
+        kind, choices = str, frozenset(handle.options)
     else:
         raise TypeError(f"page input {handle.label!r} holds {type(state.value).__name__}")
-    door(server).accept_input(state.uuid, kind, callback, refused)
+    door(server).accept_input(state.uuid, kind, callback, refused, choices)
 
 
 def accept_handle(
@@ -260,7 +265,7 @@ def queue_pose(handle: Any, position: np.ndarray, wxyz: np.ndarray, force: bool 
 
 
 def set_gui_value(
-    handle: Any, value: float | bool, exclude_client: int | None = None, force: bool = False
+    handle: Any, value: float | bool | str, exclude_client: int | None = None, force: bool = False
 ) -> bool:
     """``handle.value = value`` without calling the handle's own update callbacks.
 

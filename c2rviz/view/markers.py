@@ -12,7 +12,7 @@ update per node whatever the number of markers sent.
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any
 
 import numpy as np
@@ -145,6 +145,29 @@ class MarkerLayer:
             for shape, k in self._shape_index.items():
                 chosen = np.flatnonzero(shapes == k)
                 self._show(robot, shape, ring, chosen)
+
+    def draw_these(self, robot: str, markers: Iterable[Marker]) -> None:
+        """Draw ``markers`` as ``robot``'s instead of those it holds (the page looking back);
+        a click on them picks nothing. ``redraw`` shows the held ones again."""
+        ring = _Ring()
+        for k, marker in enumerate(markers):
+            ring.positions[k] = marker.position
+            ring.wxyzs[k] = marker.wxyz
+            ring.colors[k] = [round(c * 255.0) for c in marker.rgb]
+            ring.shapes[k] = self._shape_index.get(marker.shape, 0)
+            ring.count = k + 1
+        shapes = ring.shapes[: ring.count]
+        for shape, k in self._shape_index.items():
+            self._show(robot, shape, ring, np.flatnonzero(shapes == k))
+            self._instances.pop((robot, shape), None)
+
+    def redraw(self) -> None:
+        """Draw every robot's held markers again at the next ``draw``."""
+        for robot, _ in self.nodes:
+            self._rings.setdefault(robot, _Ring())
+        for ring in self._rings.values():
+            ring.dirty = True
+        self.dirty = True
 
     def _show(self, robot: str, shape: str, ring: _Ring, chosen: np.ndarray) -> None:
         node = self.nodes.get((robot, shape))

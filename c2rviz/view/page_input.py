@@ -4,8 +4,11 @@ The page is a source of commands like any TCP client: a slider dragged to 30
 becomes ``move 1 30.0`` on that robot's page session (source ``page``,
 degrees mode), the Home / Random / Stop buttons ``home`` / ``rand`` /
 ``stop``, the speed slider ``speed 40.0``, the Trail checkbox ``trail on`` /
-``trail off``. The session checks them; a refused value is sent back to the
-tab as the true one, and so is a value the door drops (NaN, a word). A click
+``trail off``, the Ghost checkbox ``ghost on`` / ``ghost off``. The session
+checks them; a refused value is sent back to the tab as the true one, and so is
+a value the door drops (NaN, a word). The page's own controls (the plots', the
+timeline's) go the same way and are checked where they are applied
+(``add_setting``): a value out of range is refused and shown true again. A click
 on a marker chooses it in its robot's folder; "Go to marker" then runs
 ``moveto marker N`` (N: where the chosen marker stands now among the robot's
 markers).
@@ -78,6 +81,7 @@ class PageInput:
         for line, button in panel.buttons.items():
             self._bind(button, functools.partial(self._click, session, line))
         self._bind(panel.trail, functools.partial(self._trail, panel, session))
+        self._bind(panel.ghost, functools.partial(self._ghost, panel, session))
         self._bind(panel.goto, functools.partial(self._goto, panel, session))
         self._panels[session.state.name] = panel
 
@@ -89,6 +93,32 @@ class PageInput:
             adapter.set_gui_value(checkbox, bool(value), exclude_client=client)
 
         self._bind(checkbox, toggle)
+
+    def add_setting(
+        self,
+        handle: Any,
+        apply: Callable[[Any], object],
+        after: Callable[[], None],
+        button: bool = False,
+    ) -> None:
+        """Bind a control of the page's own (a plot's window, the timeline): ``apply(value)``
+        takes the value, or raises a ``C2rvizError`` to refuse it (the control then shows
+        the true value again); every tab is shown a value taken (not a ``button``'s click),
+        and ``after()`` runs (a redraw)."""
+
+        def run(client: int, value: Any) -> None:
+            try:
+                apply(value)
+            except C2rvizError as exc:
+                self._refuse(f"{handle.label} {value!r}", exc)
+                if not button:
+                    adapter.set_gui_value(handle, handle.value, force=True)
+            else:
+                if not button:
+                    adapter.set_gui_value(handle, value, exclude_client=client)
+            after()
+
+        self._bind(handle, run)
 
     def busy(self, handle: Any) -> bool:
         """Whether a page value for ``handle`` waits to be run (leave the control alone)."""
@@ -164,6 +194,10 @@ class PageInput:
         self._line(session, "trail on" if value is True else "trail off")
         on = session.state.name in session.services.trails.trails
         adapter.set_gui_value(panel.trail, on, force=True)
+
+    def _ghost(self, panel: RobotPanel, session: Session, client: int, value: Any) -> None:
+        self._line(session, "ghost on" if value is True else "ghost off")
+        adapter.set_gui_value(panel.ghost, session.state.ghost, force=True)
 
     def _line(self, session: Session, line: str) -> bool:
         """Run ``line`` on ``session``; whether it was accepted (a later reply: so far)."""

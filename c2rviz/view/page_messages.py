@@ -62,7 +62,7 @@ class _Envelope(msgspec.Struct):
 
 
 class _Value(msgspec.Struct, forbid_unknown_fields=True):
-    value: bool | float
+    value: bool | float | str
 
 
 class GuiUpdate(msgspec.Struct, forbid_unknown_fields=True):
@@ -134,7 +134,7 @@ def read_type(frame: str | bytes) -> str:
 
 
 def read_input(frame: bytes) -> GuiUpdate:
-    """A ``{"value": v}`` update of a control (v a number or true/false)."""
+    """A ``{"value": v}`` update of a control (v a number, true/false or a button's label)."""
     try:
         return _GUI_UPDATE.decode(frame)
     except msgspec.MsgspecError:
@@ -143,7 +143,7 @@ def read_input(frame: bytes) -> GuiUpdate:
         except msgspec.MsgspecError:
             uuid = None
         raise Dropped(
-            "input", "an input update other than {'value': a number or true/false}", uuid
+            "input", "an input update other than {'value': a number, true/false or a label}", uuid
         ) from None
 
 

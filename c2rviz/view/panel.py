@@ -3,7 +3,7 @@
 Each robot's folder (headed by its name in the world) holds a slider per
 joint (degrees, metres for a prismatic joint), a speed slider for the page's
 own moves, Home / Random / Stop buttons, the end effector's pose and the
-motion status, a Trail checkbox, the colliding pairs, and the marker last
+motion status, Trail and Ghost checkboxes, the colliding pairs, and the marker last
 clicked in the scene with a "Go to marker" button. The ``State`` folder
 shows the TCP client count and the last commands, newest first, a refused
 one marked so; a checkbox shows the collision geometry.
@@ -60,6 +60,8 @@ class RobotPanel:
         pose: The end-effector readout (in the base frame).
         motion: ``idle`` or ``moving, 1.20 s left``.
         trail: The Trail checkbox (runs ``trail on`` / ``trail off``).
+        ghost: The Ghost checkbox (runs ``ghost on`` / ``ghost off``).
+        folder: The folder (the plots and the readout are added to it).
         collisions: The colliding pairs readout.
         marker: The readout of the marker clicked last (``chosen``).
         goto: The "Go to marker" button (runs ``moveto marker N``).
@@ -72,7 +74,8 @@ class RobotPanel:
         self.robot = robot
         self.ranges: list[tuple[float, float]] = []
         self.sliders: list[Any] = []
-        with gui.add_folder(state.name):
+        self.folder: Any = gui.add_folder(state.name)
+        with self.folder:
             for i, joint in enumerate(robot.joints):
                 if joint.prismatic:
                     low, high, step, unit = joint.lower, joint.upper, 0.001, "m"
@@ -125,6 +128,12 @@ class RobotPanel:
             self.motion: Any = gui.add_text("Motion", "idle", disabled=True)
             self.trail: Any = gui.add_checkbox(
                 "Trail", False, hint="draw the end effector's path (trail on / trail off)"
+            )
+            self.ghost: Any = gui.add_checkbox(
+                "Ghost",
+                state.ghost,
+                hint="while it travels: the target as a ghost, a movel or planned path as a "
+                "line (ghost on / ghost off)",
             )
             self.collisions: Any = gui.add_text(
                 "Collisions", "none", disabled=True, hint="colliding pairs, link~object"
@@ -194,6 +203,10 @@ class RobotPanel:
     def show_trail(self, on: bool) -> None:
         """The Trail checkbox to ``on`` (set by a ``trail`` line from anywhere)."""
         adapter.set_gui_value(self.trail, on)
+
+    def show_ghost(self, on: bool) -> None:
+        """The Ghost checkbox to ``on`` (set by a ``ghost`` line from anywhere)."""
+        adapter.set_gui_value(self.ghost, on)
 
 
 class StatePanel:

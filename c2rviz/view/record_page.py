@@ -1,123 +1,222 @@
-"""NAME.html: a recording as a self-contained page that plays in any browser, no server.
+"""NAME.html: a recording as a self-contained page with a player of its own, no server.
 
-The frames of NAME.csv are replayed into a private, offline viser scene (the
-page's own robot view and marker layer, so it looks as the live page does)
-while viser's scene serializer keeps every message and the pauses between
-them; the markers come from NAME.txt (its ``mark``, ``color``, ``marker`` and
-``clear`` lines, timed by its ``sleep`` lines) and appear at the first frame
-at or after their time. ``as_html`` then bundles the player (play/pause, a
-timeline) and the recording into one file.
-Frames are thinned to at most ``HTML_HZ`` a second and ``MAX_HTML_FRAMES`` in
-all, so a long run stays a page a browser opens (README: Record and replay).
+The page is viser's client showing a static scene (the grid, the robot as the
+live page draws it, a batched node per marker shape, a hidden node per object
+the recording places), built in a private offline viser server and serialized
+by viser, and our player (``record_player.js`` and ``.css``, next to this
+module), which poses the arm from the recording's frames in the browser
+(``record_kinematics``: Pinocchio's numbers), shows the markers and objects at
+their times, backwards too, and gives play/pause, seek, speed (0.25x to 4x), a
+frame back and on, the time shown, a readout and plots that follow the time
+shown.
+
+Building it streams NAME.csv and NAME.txt (``record_rows``, ``record_commands``):
+its memory does not grow with the recording's length, and the page keeps at most
+``HTML_HZ`` frames a second (``MAX_HTML_FRAMES`` in all: a longer run is thinned
+more). A recording whose files disagree, or that was cut short, opens with what
+was good and a sentence saying what was not, never a blank or frozen page.
 """
 
 from __future__ import annotations
 
-import csv
+import base64
+import importlib.resources
+import json
 import logging
-from collections.abc import Iterator
+import os
+import zlib
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
+from ..collision.workcell import WorkcellObject
 from ..observers.recorder import Recorded
-from ..protocol.grammar import parse_line
-from ..protocol.verbs.connection import Sleep
-from ..protocol.verbs.markers import Clear, Color, Mark, MarkerShape
+from ..protocol.grammar import MARKER_SHAPES
 from ..robot.model import Robot
 from ..robot.visuals import load_link_geometry
-from ..world.effects import Marker
 from ..world.state import RobotState
 from . import adapter
-from .markers import MarkerLayer
-from .robot_view import RobotView
+from .markers import marker_mesh
+from .record_commands import Commands, read_commands
+from .record_kinematics import chain_kinematics
+from .record_rows import HTML_HZ, MAX_HTML_FRAMES, Frames, read_frames
+from .robot_view import RobotView, node_name
+from .workcell_layer import add_object
 
 __all__ = ["HTML_HZ", "MAX_HTML_FRAMES", "write_html"]
 
 log = logging.getLogger("c2rviz.record")
 
-HTML_HZ = 30.0
-"""Most frames a second kept in NAME.html."""
-MAX_HTML_FRAMES = 20_000
-"""Most frames kept in NAME.html (11 minutes at ``HTML_HZ``); a longer run is thinned."""
+_SEGMENT = "robot"  # the robot's node segment in the page (/robots/robot/...)
 
 
 def write_html(recorded: Recorded, state: RobotState) -> Path:
     """Write NAME.html next to NAME.csv for the recording of ``state``'s robot; blocking
     (for a thread). Returns its path (an ``observers.recordings.Exporter``)."""
-    robot, origin = state.robot, state.origin
-    times, joints = _frames(recorded.csv, robot.n)
-    server = adapter.start("127.0.0.1", 0)  # offline: nothing connects to it
-    try:
-        server.scene.add_grid("/grid", width=4.0, height=4.0, cell_size=0.25, section_size=1.0)
-        view = RobotView(
-            server, recorded.name, robot, origin, load_link_geometry(robot.source), "robot"
-        )
-        markers = MarkerLayer(server, {recorded.name: "robot"})
-        events = _marker_events(recorded.txt, robot, origin)
-        event = next(events, None)
-        serializer = server.get_scene_serializer()
-        for k, (now, q) in enumerate(zip(times, joints)):
-            if k:
-                serializer.insert_sleep(now - times[k - 1])
-            while event is not None and event[0] <= now:
-                if event[1] is None:
-                    markers.clear(recorded.name)
-                else:
-                    markers.add(recorded.name, event[1])
-                event = next(events, None)
-            view.draw(q)
-            markers.draw()
-        html = serializer.as_html()
-    finally:
-        adapter.stop(server)
+    robot = state.robot
+    frames = read_frames(recorded.csv, robot.joint_names)
+    base = state.origin * robot.base_placement
+    if recorded.txt is None:
+        why = recorded.error or "it was not written"
+        commands = Commands(problems=[f"{recorded.name}.txt is missing ({why}): no markers"])
+    else:
+        commands = read_commands(recorded.txt, base)
+    problems = [*frames.problems, *commands.problems]
+    problems += _disagreements(recorded.name, robot, frames, commands)
+    scene, nodes = _scene(recorded.name, state, frames, commands)
+    end = max(frames.end_s, commands.end_s if recorded.txt is not None else 0.0)
+    meta = {
+        "name": recorded.name,
+        "robot": robot.name,
+        "joints": [
+            {
+                "name": j.name,
+                "prismatic": j.prismatic,
+                "continuous": j.continuous,
+                "lower": j.lower,
+                "upper": j.upper,
+            }
+            for j in robot.joints
+        ],
+        "kinematics": chain_kinematics(robot),
+        "frames": len(frames.times),
+        "rows": frames.rows,
+        "endS": end,
+        "problems": problems,
+        "shapes": list(MARKER_SHAPES),
+        "objectChanges": [[t, list(ids)] for t, ids in commands.object_changes],
+        **nodes,
+    }
+    blobs = {
+        "times": frames.times.astype("<f8"),
+        "values": frames.values.astype("<f4"),
+        "marks": commands.marks.astype("<f8"),
+    }
     path = recorded.csv.with_suffix(".html")
-    path.write_text(html, encoding="utf-8")
+    part = path.with_name(f".{path.name}.part")  # then renamed: NAME.html whole, or not at all
+    flags = os.O_WRONLY | os.O_CREAT | os.O_TRUNC | getattr(os, "O_NOFOLLOW", 0)
+    with open(os.open(part, flags, 0o644), "w", encoding="utf-8") as out:
+        head, tail = scene.rsplit("</body>", 1)
+        out.write(head)
+        out.write(f'<script type="application/json" id="c2rviz-recording">{_json(meta)}</script>\n')
+        for name, array in blobs.items():
+            out.write(f'<script type="application/octet-stream" id="c2rviz-{name}">')
+            out.write(_packed(array))
+            out.write("</script>\n")
+        out.write(f"<style>{_asset('record_player.css')}</style>\n")
+        out.write(f"<script>{_asset('record_player.js')}</script>\n</body>")
+        out.write(tail)
+    os.replace(part, path)  # a link at NAME.html is replaced, never followed
+    for problem in problems:
+        log.warning("recording %s: %s", recorded.name, problem)
     return path
 
 
-def _marker_events(
-    txt: Path | None, robot: Robot, origin: pin.SE3
-) -> Iterator[tuple[float, Marker | None]]:
-    """NAME.txt's markers in order, each with its time [s] from the start (None: a clear)."""
-    if txt is None:  # a write error stopped the recording: no command file
-        return
-    t, rgb, shape = 0.0, (1.0, 0.0, 0.0), "sphere"  # a replaying session's style
-    base = origin * robot.base_placement
-    with open(txt, encoding="ascii") as file:
-        for line in file:
-            command = parse_line(line)  # written by the recorder: radians, base frame
-            if isinstance(command, Sleep):
-                t += command.seconds
-            elif isinstance(command, Color):
-                rgb = command.rgb
-            elif isinstance(command, MarkerShape):
-                shape = command.shape
-            elif isinstance(command, Clear):
-                yield t, None
-            elif isinstance(command, Mark) and command.pose is not None:
-                x, y, z, roll, pitch, yaw = command.pose
-                pose = pin.SE3(pin.rpy.rpyToMatrix(roll, pitch, yaw), np.array([x, y, z]))
-                placement = pose if command.in_world else base * pose
-                qx, qy, qz, qw = map(float, pin.Quaternion(placement.rotation).coeffs())
-                px, py, pz = map(float, placement.translation)
-                yield t, Marker((px, py, pz), (qw, qx, qy, qz), rgb, shape)
+def _disagreements(name: str, robot: Robot, frames: Frames, commands: Commands) -> list[str]:
+    """Where NAME.txt and NAME.csv do not tell one recording of this robot."""
+    out = []
+    if commands.robot is not None and commands.robot != robot.name:
+        out.append(f"{name}.txt is a recording of {commands.robot}, not of {robot.name}")
+    if commands.frames is not None and frames.rows and frames.rows != commands.frames:
+        which = "cut short" if frames.rows < commands.frames else "not from this recording"
+        out.append(
+            f"{name}.csv holds {frames.rows} frames but {name}.txt counts {commands.frames}: "
+            f"the frames were {which}"
+        )
+    elif commands.last_joints is not None and len(frames.times):
+        last = frames.values[-1, : robot.n].astype(float)
+        mine = np.asarray(commands.last_joints[: robot.n])
+        if len(commands.last_joints) != robot.n or not np.allclose(
+            last, mine, rtol=1e-6, atol=1e-6
+        ):
+            out.append(
+                f"{name}.csv's last frame is not {name}.txt's last joints: the two files "
+                "are not one recording"
+            )
+    if commands.end_s and frames.end_s > commands.end_s + 1e-3:
+        out.append(
+            f"{name}.csv goes on to {frames.end_s:.3f} s, past the end of {name}.txt "
+            f"({commands.end_s:.3f} s)"
+        )
+    return out
 
 
-def _frames(path: Path, n: int) -> tuple[list[float], list[tuple[float, ...]]]:
-    """The CSV's times and joint values, at most ``HTML_HZ`` a second and
-    ``MAX_HTML_FRAMES`` in all (the first and last frames always kept)."""
-    with open(path, newline="") as file:
-        rows = [[float(v) for v in row[: 1 + n]] for row in list(csv.reader(file))[1:]]
-    if not rows:
-        return [], []
-    span = rows[-1][0] - rows[0][0]
-    step = max(1.0 / HTML_HZ, span / MAX_HTML_FRAMES)
-    kept = [rows[0]]
-    for row in rows[1:-1]:
-        if row[0] - kept[-1][0] >= step:
-            kept.append(row)
-    if len(rows) > 1:
-        kept.append(rows[-1])
-    return [row[0] for row in kept], [tuple(row[1:]) for row in kept]
+def _scene(
+    name: str, state: RobotState, frames: Frames, commands: Commands
+) -> tuple[str, dict[str, Any]]:
+    """The static scene as viser's page, and the nodes the player moves, by role."""
+    robot, origin = state.robot, state.origin
+    server = adapter.start("127.0.0.1", 0)  # offline: nothing connects to it
+    try:
+        server.scene.add_grid("/grid", width=4.0, height=4.0, cell_size=0.25, section_size=1.0)
+        view = RobotView(server, name, robot, origin, load_link_geometry(robot.source), _SEGMENT)
+        first = tuple(map(float, frames.values[0, : robot.n])) if len(frames.times) else None
+        view.draw(first or robot.home)
+        links = [f"{view.prefix}/links/{node_name(link)}" for link in robot.link_names()]
+        markers = {}
+        used = {int(s) for s in commands.marks[:, 12]} if len(commands.marks) else set()
+        for k in sorted(used):
+            shape = MARKER_SHAPES[k]
+            mesh = marker_mesh(shape)
+            markers[shape] = node = f"/markers/{_SEGMENT}/{shape}"
+            server.scene.add_batched_meshes_simple(
+                node,
+                mesh.vertices,
+                mesh.faces,
+                batched_wxyzs=np.zeros((0, 4)),
+                batched_positions=np.zeros((0, 3)),
+                batched_colors=np.zeros((0, 3), dtype=np.uint8),
+                lod="off",
+                cast_shadow=False,
+                visible=False,
+            )
+        objects = []
+        for k, version in enumerate(commands.objects):
+            node = f"{view.prefix}/objects/{k}_{node_name(version.name)}"
+            x, y, z, roll, pitch, yaw = version.pose
+            placement = pin.SE3(pin.rpy.rpyToMatrix(roll, pitch, yaw), np.array([x, y, z]))
+            obj = WorkcellObject(version.name, version.shape, version.size, placement)
+            add_object(server.scene, node, obj, robot.base_placement * placement).visible = False
+            objects.append(node)
+        _aim_camera(server, view)
+        html = server.get_scene_serializer().as_html()
+    finally:
+        adapter.stop(server)
+    return html, {"linkNodes": links, "markerNodes": markers, "objectNodes": objects}
+
+
+def _aim_camera(server: Any, view: RobotView) -> None:
+    """Look at the robot from the front right, a little above (as the live page does)."""
+    reach = max(view.reach(), 0.5)
+    look_at = view.origin.translation + np.array([0.0, 0.0, 0.4 * reach])
+    server.initial_camera.look_at = look_at
+    server.initial_camera.position = look_at + reach * np.array([1.15, 0.9, 0.45])
+
+
+def _packed(array: np.ndarray) -> str:
+    """``array``'s bytes, gzipped, in base64 (the page inflates them with the browser's own
+    DecompressionStream)."""
+    squeeze = zlib.compressobj(6, zlib.DEFLATED, 31)  # 31: a gzip stream
+    data = squeeze.compress(np.ascontiguousarray(array).tobytes()) + squeeze.flush()
+    return base64.b64encode(data).decode("ascii")
+
+
+def _json(value: Any) -> str:
+    """``value`` as JSON safe inside a <script> element (no '<' to end it early)."""
+    text = json.dumps(value, allow_nan=False, separators=(",", ":"), default=_finite)
+    return text.replace("<", "\\u003c").replace(">", "\\u003e").replace("&", "\\u0026")
+
+
+def _finite(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"{type(value).__name__} is not JSON")
+
+
+def _asset(name: str) -> str:
+    text = importlib.resources.files(__package__).joinpath(name).read_text(encoding="utf-8")
+    if "</script" in text.lower():  # it is inlined in a <script> element
+        raise ValueError(f"{name} must not hold '</script'")
+    return text

@@ -9,7 +9,8 @@ kinematic truth): a link's pose in the world is ``origin * oMf``. Each link's
 URDF geometry hangs below its frame at its URDF origin.
 
 While the robot travels, a translucent copy of the arm (the target ghost,
-``/robots/<name>/target``) stands where the move ends.
+``/robots/<name>/target``) stands where the move ends; ``add_copy`` makes such
+copies (``view.ghost`` adds the refused target's, in red).
 """
 
 from __future__ import annotations
@@ -143,25 +144,40 @@ class RobotView:
             self.target_root.visible = False
         else:
             if self.target_root is None:
-                self._build_ghost()
+                self.target_root, self._target_frames = self.add_copy("target")
+                self.target_frames = {
+                    link: handle
+                    for link, (_, handle) in zip(self.robot.link_names(), self._target_frames)
+                }
             self._pose(self._target_frames, target)
             if self.sent_target is None:
                 self.target_root.visible = True
         self.sent_target = target
 
-    def _build_ghost(self) -> None:
-        """The ghost's nodes: each link's visual geometry again, translucent."""
-        self.target_root = self._scene.add_frame(
-            f"{self.prefix}/target", show_axes=False, visible=False
-        )
+    def add_copy(
+        self, segment: str, rgba: tuple[float, float, float, float] | None = None
+    ) -> tuple[Any, list[tuple[int, Any]]]:
+        """A copy of the arm under ``<prefix>/<segment>`` (hidden): each link's visual
+        geometry again, translucent in its colours (``GHOST_OPACITY``), or all in ``rgba``.
+
+        Returns:
+            Its root node and its link frames (Pinocchio frame id, node), for ``pose_copy``.
+        """
+        root = self._scene.add_frame(f"{self.prefix}/{segment}", show_axes=False, visible=False)
+        frames = []
         for link in self.robot.link_names():
-            node = f"{self.prefix}/target/{node_name(link)}"
+            node = f"{self.prefix}/{segment}/{node_name(link)}"
             handle = self._scene.add_frame(node, show_axes=False)
-            self._target_frames.append((self.robot.model.getFrameId(link, pin.BODY), handle))
-            self.target_frames[link] = handle
+            frames.append((self.robot.model.getFrameId(link, pin.BODY), handle))
             shapes = self._geometry.get(link)
             for k, shape in enumerate(shapes.visual if shapes is not None else ()):
-                self._add_shape(f"{node}/visual_{k}", shape, visible=True, ghost=True)
+                tinted = shape if rgba is None else dataclasses.replace(shape, rgba=rgba)
+                self._add_shape(f"{node}/visual_{k}", tinted, visible=True, ghost=rgba is None)
+        return root, frames
+
+    def pose_copy(self, frames: list[tuple[int, Any]], q: tuple[float, ...]) -> None:
+        """Pose a copy's link frames (``add_copy``) for chain values ``q`` [rad or m]."""
+        self._pose(frames, q)
 
     def add_overlay(self, link: str, rgba: tuple[float, float, float, float]) -> list[Any]:
         """A copy of ``link``'s visual geometry in ``rgba``, over the link (hidden).

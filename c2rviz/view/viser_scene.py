@@ -2,7 +2,8 @@
 
 ``ViserScene`` implements ``scene.Scene`` by composing the parts of the page,
 each in its own module: a ``RobotView`` per robot (``robot_view``), the
-``MarkerLayer`` (``markers``), the panel (``panel``), the page's input
+``MarkerLayer`` (``markers``), the panel (``panel``), the plots, readouts,
+ghosts, history and timeline (``instruments``), the page's input
 (``page_input``) and the ``SendScheduler`` (``scheduler``). viser runs behind
 the door of ``adapter`` (origins, token, client and frame limits; all use of
 viser's internals is there).
@@ -10,9 +11,10 @@ viser's internals is there).
 The world calls the scene on every accepted change, possibly hundreds of
 thousands of times a second; each call only records what changed and asks
 for a send. A send, at most one per frame (``1/hz``), draws the latest state:
-each changed robot's links (Pinocchio FK), its target ghost while it moves,
-its panel, the markers, the workcell objects and collisions, the trails
-(``workcell_layer``), in one atomic batch.
+each changed robot's links (Pinocchio FK), its target ghost and path while it
+moves, its panel, the markers, the workcell objects and collisions, the trails
+(``workcell_layer``), the plots and readouts when due, in one atomic batch; or,
+while the timeline looks back, every robot as it was at that time.
 """
 
 from __future__ import annotations
@@ -27,18 +29,21 @@ import numpy as np
 import pinocchio as pin
 
 from ..collision.workcell import WorkcellObject
+from ..errors import C2rvizError
 from ..robot.visuals import LinkGeometry, load_link_geometry
 from ..session.services import Services
 from ..session.session import Session
 from ..world.effects import Marker, Scene
 from . import adapter
 from .handle import ToolHandles
+from .instruments import Instruments
 from .markers import MarkerLayer
 from .page_input import PageInput
 from .panel import RECENT_COMMANDS, RobotPanel, StatePanel
 from .policy import DoorPolicy
 from .robot_view import RobotView, node_name
 from .scheduler import SendScheduler
+from .timeline import Timeline
 from .workcell_layer import TrailLayer, WorkcellLayer
 
 __all__ = ["RECENT_COMMANDS", "STOP_TIMEOUT_S", "ViserScene"]
@@ -144,6 +149,8 @@ class ViserScene(Scene):
         self.handles = ToolHandles(server, segments, self.scheduler.request)
         self._frame_camera()
         self.page_input = PageInput(server, self.markers)
+        # the page's times are the watch stream's: seconds since the server started
+        timeline = Timeline(server.gui, self.services.watch.origin, world.frame_s)
         self.panels: dict[str, RobotPanel] = {}
         self.sessions: dict[str, Session] = {}
         for name, state in world.robots.items():
@@ -154,6 +161,18 @@ class ViserScene(Scene):
             self.panels[name] = RobotPanel(server.gui, state, session.speed)
             self.page_input.add_robot(self.panels[name], session)
             self.handles.bind(name, session)
+        velocities = self.services.defaults.motion != "off"
+        self.instruments = Instruments(
+            server,
+            world,
+            self.views,
+            self.panels,
+            self.markers,
+            self.workcells,
+            timeline,
+            velocities,
+        )
+        self.instruments.bind(self.page_input)
         self.state_panel = StatePanel(server.gui)
         self.page_input.add_toggle(self.state_panel.collision, self._show_collision)
         for name, state in world.robots.items():
@@ -180,6 +199,7 @@ class ViserScene(Scene):
 
     def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
         self._dirty.add(robot)
+        self.instruments.on_joints(robot, q, t)
         self.scheduler.request()
 
     def on_gripper(self, robot: str, opening: float, t: float) -> None:
@@ -188,10 +208,12 @@ class ViserScene(Scene):
 
     def on_marker(self, robot: str, marker: Marker) -> None:
         self.markers.add(robot, marker)
+        self.instruments.on_marker(robot, marker)
         self.scheduler.request()
 
     def on_clear_markers(self, robot: str) -> None:
         self.markers.clear(robot)
+        self.instruments.on_clear_markers(robot)
         panel = self.panels.get(robot)
         if panel is not None and panel.chosen is not None:
             panel.choose(None)
@@ -213,6 +235,18 @@ class ViserScene(Scene):
 
     def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
         self._objects[robot] = list(objects)
+        self.instruments.on_objects(robot, objects)
+        self.scheduler.request()
+
+    def on_refused(self, robot: str, source: str, line: str, error: C2rvizError) -> None:
+        self.instruments.on_refused(robot, line, error)
+        self.scheduler.request()
+
+    def on_ghost(self, robot: str, shown: bool) -> None:
+        panel = self.panels.get(robot)
+        if panel is not None:
+            panel.show_ghost(shown)
+        self._dirty.add(robot)
         self.scheduler.request()
 
     def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
@@ -230,6 +264,7 @@ class ViserScene(Scene):
         self._loop = loop
         self.page_input.start(loop)
         self.handles.start(loop)
+        self.instruments.start(loop, self.scheduler.request)
         self._dirty.update(self.world.robots)
         self.scheduler.start(loop)
 
@@ -239,6 +274,7 @@ class ViserScene(Scene):
             return
         self._stopped = True
         self.scheduler.stop()
+        self.instruments.stop()
         self.page_input.stop()
         self.handles.stop()
         adapter.stop(self.server, timeout_s=STOP_TIMEOUT_S)
@@ -271,35 +307,46 @@ class ViserScene(Scene):
         """Draw whatever changed since the last send, in one atomic batch."""
         if self._stopped:
             return
-        world, busy = self.world, self.page_input.busy
+        world, busy, instruments = self.world, self.page_input.busy, self.instruments
         with self.server.atomic():
-            for name in self._dirty:
-                state = world.robots.get(name)
-                if state is None:
-                    continue
-                view, panel = self.views[name], self.panels[name]
-                panel.show_pose(view.draw(state.q, state.opening))
-                moving = world.moving(name)
-                view.show_target(state.target if moving else None)
-                panel.show_joints(state.target, busy)
-                panel.show_motion(moving, world.travels.seconds_left(state))
-            for name in self._dirty | self.handles.due():
+            shown = instruments.shown()  # None: now; else the time the page looks back at
+            if shown is None:
+                objects_now = instruments.back_to_live()
+                if objects_now is not None:  # back from looking back: everything, as it is now
+                    self._objects.update(objects_now)
+                    self._dirty.update(world.robots)
+                for name in self._dirty:
+                    state = world.robots.get(name)
+                    if state is None:
+                        continue
+                    view, panel = self.views[name], self.panels[name]
+                    panel.show_pose(view.draw(state.q, state.opening))
+                    instruments.draw_live(name)
+                    panel.show_joints(state.target, busy)
+                    panel.show_motion(world.moving(name), world.travels.seconds_left(state))
+                self.markers.draw()
+            else:
+                instruments.draw_past(shown)
+            for name in self.handles.due() | (self._dirty if shown is None else set()):
                 if name in world.robots:
                     self.handles.draw(world.robots[name])
-            self._dirty.clear()
-            self.markers.draw()
-            self._draw_workcells()
+            if shown is None:
+                self._dirty.clear()
+            self._draw_workcells(shown is None)
+            instruments.draw(shown)
             if self._state_dirty:
                 self._state_dirty = False
                 self.state_panel.show(self._client_count, self._commands)
         self.server.flush()
 
-    def _draw_workcells(self) -> None:
-        """The objects and collisions that changed, and the trails if they moved."""
-        for name, objects in self._objects.items():
-            if name in self.workcells:
-                self.workcells[name].show_objects(objects)
-        self._objects.clear()
+    def _draw_workcells(self, live: bool) -> None:
+        """The objects (``live``: looking back draws its own) and collisions that changed,
+        and the trails if they moved."""
+        if live:
+            for name, objects in self._objects.items():
+                if name in self.workcells:
+                    self.workcells[name].show_objects(objects)
+            self._objects.clear()
         for name, pairs in self._collisions.items():
             if name in self.workcells:
                 self.workcells[name].show_collisions(pairs)

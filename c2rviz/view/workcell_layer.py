@@ -24,7 +24,7 @@ from ..collision.workcell import WorkcellObject
 from ..observers.trail import TrailKeeper
 from .robot_view import RobotView, node_name, wxyz
 
-__all__ = ["COLLISION_RGBA", "TRAIL_RGB", "TrailLayer", "WorkcellLayer"]
+__all__ = ["COLLISION_RGBA", "TRAIL_RGB", "TrailLayer", "WorkcellLayer", "add_object"]
 
 COLLISION_RGBA = (1.0, 0.0, 0.0, 0.6)  # a colliding link's overlay, a hit object
 TRAIL_RGB = (1.0, 0.6, 0.0)
@@ -55,7 +55,7 @@ class WorkcellLayer:
         base = self._view.robot.base_placement
         for obj in objects:
             name = f"{self._view.prefix}/objects/{node_name(obj.name)}"
-            self.objects[obj.name] = _add_object(self._scene, name, obj, base * obj.placement)
+            self.objects[obj.name] = add_object(self._scene, name, obj, base * obj.placement)
             self._rgba[obj.name] = obj.rgba
         self._tint(self.colliding)
 
@@ -78,7 +78,8 @@ class WorkcellLayer:
         self.colliding = names
 
 
-def _add_object(scene: Any, name: str, obj: WorkcellObject, placement: pin.SE3) -> Any:
+def add_object(scene: Any, name: str, obj: WorkcellObject, placement: pin.SE3) -> Any:
+    """A node for ``obj`` at ``placement`` (its parent's frame), translucent in its colour."""
     rgb, alpha = obj.rgba[:3], obj.rgba[3]
     common: dict[str, Any] = {
         "position": placement.translation,

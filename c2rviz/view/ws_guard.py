@@ -67,7 +67,7 @@ __all__ = [
 
 log = logging.getLogger("c2rviz.view")
 
-InputCallback = Callable[[int, "bool | float"], None]
+InputCallback = Callable[[int, "bool | float | str"], None]
 HandleCallback = Callable[
     [int, tuple[float, float, float, float], tuple[float, float, float]], None
 ]
@@ -86,6 +86,7 @@ class _Input:
     kind: type
     callback: InputCallback
     refused: Callable[[int], None] | None
+    choices: frozenset[str] = frozenset()
 
 
 class Door:
@@ -137,18 +138,20 @@ class Door:
         kind: type,
         callback: InputCallback,
         refused: Callable[[int], None] | None = None,
+        choices: frozenset[str] = frozenset(),
     ) -> None:
         """Hand ``{"value": v}`` for ``uuid`` to ``callback(client_id, v)``.
 
-        ``kind`` is ``bool`` (a checkbox or button: only true/false) or
-        ``float`` (a slider or number: any finite number, as a float). A value
+        ``kind`` is ``bool`` (a checkbox or button: only true/false),
+        ``float`` (a slider or number: any finite number, as a float) or ``str``
+        (a button group: one of its ``choices``, the buttons' labels). A value
         dropped for ``uuid`` (NaN, a word, another field) goes to
         ``refused(client_id)``, so the tab can be shown the true value again.
         Both run on viser's thread and must return at once.
         """
-        if kind not in (bool, float):
-            raise TypeError(f"an input's kind is bool or float, not {kind!r}")
-        self._inputs[uuid] = _Input(kind, callback, refused)
+        if kind not in (bool, float, str):
+            raise TypeError(f"an input's kind is bool, float or str, not {kind!r}")
+        self._inputs[uuid] = _Input(kind, callback, refused, frozenset(choices))
 
     def forget_input(self, uuid: str) -> None:
         self._inputs.pop(uuid, None)
@@ -306,11 +309,16 @@ class Door:
             self._drop("input", f"a value for {shown(update.uuid)}, not one of the page's inputs")
             return
         if target.kind is bool and not isinstance(value, bool):
-            self._drop("input", "a number for a checkbox or button")
+            self._drop("input", "a number or a word for a checkbox or button")
             self._refused(connection, update.uuid)
             return
-        if target.kind is float and (isinstance(value, bool) or not math.isfinite(value)):
-            self._drop("input", f"{value!r} for a slider (a finite number is needed)")
+        if target.kind is float and (isinstance(value, (bool, str)) or not math.isfinite(value)):
+            shown_value = shown(value) if isinstance(value, str) else repr(value)
+            self._drop("input", f"{shown_value} for a slider (a finite number is needed)")
+            self._refused(connection, update.uuid)
+            return
+        if target.kind is str and value not in target.choices:
+            self._drop("input", f"{shown(str(value))} for a button group (not one of its buttons)")
             self._refused(connection, update.uuid)
             return
         self._call(target.callback, self.identify(connection), value)

@@ -22,6 +22,7 @@ if TYPE_CHECKING:
     import pinocchio as pin
 
     from ..collision.workcell import WorkcellObject
+    from ..errors import C2rvizError
 
 __all__ = ["MAX_MARKERS", "Marker", "NullScene", "Observer", "RecordingScene", "Scene"]
 
@@ -70,6 +71,13 @@ class Observer:
     def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
         """``robot``'s colliding pairs are now ``pairs`` (link or object names)."""
 
+    def on_refused(self, robot: str, source: str, line: str, error: C2rvizError) -> None:
+        """``source``'s ``line`` for ``robot`` was refused with ``error`` (at once, or when
+        its reply came: a guarded ``movel``); a ``PathCollides`` carries its ``target``."""
+
+    def on_ghost(self, robot: str, shown: bool) -> None:
+        """``robot``'s ghost (its target while it travels, its path) is now ``shown`` or not."""
+
 
 class Scene(Observer):
     """An observer that is a view: it starts with the world and stops with the program."""
@@ -105,6 +113,9 @@ class RecordingScene(Scene):
     collisions: list[tuple[str, list[tuple[str, str]]]] = field(default_factory=list)
     openings: list[tuple[float, float]] = field(default_factory=list)
     """Each gripper opening published and its clock time [s]."""
+    errors: list[tuple[str, str, str]] = field(default_factory=list)
+    """(robot, line, message) of each refusal."""
+    ghosts: list[tuple[str, bool]] = field(default_factory=list)
 
     def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
         self.joints.append(tuple(q))
@@ -132,3 +143,9 @@ class RecordingScene(Scene):
 
     def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
         self.collisions.append((robot, list(pairs)))
+
+    def on_refused(self, robot: str, source: str, line: str, error: C2rvizError) -> None:
+        self.errors.append((robot, line, str(error)))
+
+    def on_ghost(self, robot: str, shown: bool) -> None:
+        self.ghosts.append((robot, shown))

@@ -54,6 +54,7 @@ class RobotState:
         tool: The tool point (TCP) relative to the end-effector link.
         opening: Its gripper's opening shown now, 0 closed .. 1 open (0 without one).
         opening_target: The opening it was last commanded to.
+        ghost: Views show where it travels: its target and its path (``ghost on|off``).
     """
 
     name: str
@@ -66,6 +67,7 @@ class RobotState:
     tool: pin.SE3 = field(default_factory=pin.SE3.Identity)
     opening: float = 0.0
     opening_target: float = 0.0
+    ghost: bool = True
 
     def __post_init__(self) -> None:
         if not self.q:

@@ -18,7 +18,7 @@ import pinocchio as pin
 
 from ..collision.model import CollisionModel, Pair
 from ..collision.workcell import MAX_OBJECTS
-from ..errors import UnknownRobot
+from ..errors import C2rvizError, UnknownRobot
 from ..motion.planner import MotionLimits, motion_limits
 from ..robot.frames import se3_wxyz
 from ..robot.model import Robot
@@ -212,6 +212,19 @@ class World:
         state.tool = tool
         for observer in self.observers:
             observer.on_tool(state.name, tool)
+
+    def set_ghost(self, robot: str, shown: bool) -> None:
+        """Show ``robot``'s ghost (its target and path while it travels) or not."""
+        state = self.state(robot)
+        state.ghost = shown
+        for observer in self.observers:
+            observer.on_ghost(state.name, shown)
+
+    def refused(self, robot: str, source: str, line: str, error: C2rvizError) -> None:
+        """``source``'s ``line`` for ``robot`` was refused with ``error``: tell the observers
+        (the page shows the last error, and a guarded target in red)."""
+        for observer in self.observers:
+            observer.on_refused(robot, source, line, error)
 
     def close(self) -> None:
         """The program stops: no more frames, checks or solves."""

@@ -20,7 +20,7 @@ from c2rviz.protocol.verbs.gripper import Grip
 from c2rviz.protocol.verbs.joints import Home, Joints, Move, Rand, Units
 from c2rviz.protocol.verbs.markers import Clear, Color, Mark, MarkerShape
 from c2rviz.protocol.verbs.motion import MotionMode, Speed, Status, Stop, Target, Wait
-from c2rviz.protocol.verbs.observe import Trail, Unwatch, Watch
+from c2rviz.protocol.verbs.observe import Ghost, Trail, Unwatch, Watch
 from c2rviz.protocol.verbs.planning import Plan
 from c2rviz.protocol.verbs.queries import Help, Limits, Names, Pose, Version, Where
 from c2rviz.protocol.verbs.record import Record
@@ -119,6 +119,9 @@ GOOD = [
     ("trail on", Trail("on"), "trail-on"),
     ("trail OFF", Trail("off"), "trail-off"),
     ("trail clear", Trail("clear"), "trail-clear"),
+    ("ghost", Ghost(None), "ghost-ask"),
+    ("ghost off", Ghost(False), "ghost-off"),
+    ("GHOST On", Ghost(True), "ghost-on"),
     ("record", Record(), "record-ask"),
     ("record demo_1", Record("demo_1"), "record"),
     ("record Take-2.v3 OVERWRITE", Record("Take-2.v3", overwrite=True), "record-overwrite"),
@@ -227,6 +230,8 @@ BAD = [
     ("unwatch now", BadArguments, "unwatch: takes no arguments", "unwatch-arg"),
     ("trail sideways", BadArguments, "unknown action 'sideways'; choose on, off", "trail-bad"),
     ("trail on off", BadArguments, "trail: takes 1 argument, got 2", "trail-two"),
+    ("ghost maybe", BadArguments, "unknown action 'maybe'; choose on or off", "ghost-bad"),
+    ("ghost on off", BadArguments, "ghost: takes 1 argument, got 2", "ghost-two"),
     ("record ../x", BadArguments, "bad name '../x'", "record-parent"),
     ("record a/b", BadArguments, "bad name 'a/b'", "record-folder"),
     ("record .hidden", BadArguments, "not starting with '.'", "record-dot"),

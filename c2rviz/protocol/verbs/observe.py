@@ -1,4 +1,4 @@
-"""Verbs that show what happens: the ``watch`` stream and the tool's ``trail``."""
+"""Verbs that show what happens: the ``watch`` stream, the tool's ``trail`` and the ``ghost``."""
 
 from __future__ import annotations
 
@@ -8,11 +8,12 @@ from ...errors import BadArguments, shown
 from ..grammar import numbers_arg, one_word
 from ..registry import usage, verb
 
-__all__ = ["MAX_WATCH_HZ", "TRAIL_ACTIONS", "Trail", "Unwatch", "Watch"]
+__all__ = ["GHOST_ACTIONS", "MAX_WATCH_HZ", "TRAIL_ACTIONS", "Ghost", "Trail", "Unwatch", "Watch"]
 
 MAX_WATCH_HZ = 1000.0
 """Most ``state`` lines a second a watcher may ask for (the highest frame rate)."""
 TRAIL_ACTIONS = ("on", "off", "clear")
+GHOST_ACTIONS = ("on", "off")
 
 
 @verb(
@@ -72,3 +73,27 @@ class Trail:
                 verb, f"unknown action {shown(action)}; choose on, off or clear", usage(verb)
             )
         return Trail(action)
+
+
+@verb(
+    "ghost",
+    "[on|off]",
+    "while this connection's robot travels, the page shows its target as a translucent "
+    "ghost and a `movel` or planned path as a line: `off` hides both, `on` shows them "
+    "(the default); alone, reply `ok on` or `ok off`",
+)
+@dataclass(frozen=True, slots=True)
+class Ghost:
+    """Show this connection's robot's ghost and path (True), hide them, or (None) ask."""
+
+    shown: bool | None
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> Ghost:
+        if not words:
+            return Ghost(None)
+        action = one_word(verb, words).lower()
+        if action not in GHOST_ACTIONS:
+            choose = f"unknown action {shown(action)}; choose on or off"
+            raise BadArguments(verb, choose, usage(verb))
+        return Ghost(action == "on")

@@ -1,4 +1,4 @@
-"""What the verbs that show what happens do: ``watch``, ``unwatch``, ``trail``."""
+"""What the verbs that show what happens do: ``watch``, ``unwatch``, ``trail``, ``ghost``."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ from typing import TYPE_CHECKING
 
 from ...protocol import replies
 from ...protocol.registry import handler
-from ...protocol.verbs.observe import Trail, Unwatch, Watch
+from ...protocol.verbs.observe import Ghost, Trail, Unwatch, Watch
 
 if TYPE_CHECKING:
     from ..session import Session
@@ -39,4 +39,13 @@ def trail(session: Session, command: Trail) -> str:
         keeper.stop(robot)
     else:
         keeper.clear(robot)
+    return replies.OK
+
+
+@handler(Ghost)
+def ghost(session: Session, command: Ghost) -> str:
+    state = session.state
+    if command.shown is None:
+        return replies.ok("on" if state.ghost else "off")
+    session.world.set_ghost(state.name, command.shown)
     return replies.OK

@@ -1,0 +1,86 @@
+"""The live page's memory (``view.history``): what it keeps, for how long, and within what."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from support import load_robot
+
+from c2rviz.collision.workcell import WorkcellObject
+from c2rviz.view.history import HISTORY_S, MAX_MARKER_EVENTS, MAX_SAMPLES, RobotHistory
+from c2rviz.view.plots import thin
+from c2rviz.world.state import Marker, RobotState
+
+
+def history(now: float = 0.0) -> RobotHistory:
+    return RobotHistory(RobotState("arm", load_robot()), 0.01, now, [])
+
+
+def marker(x: float) -> Marker:
+    return Marker((x, 0.0, 0.0), (1.0, 0.0, 0.0, 0.0), (1.0, 0.0, 0.0), "sphere")
+
+
+def test_samples_come_at_most_once_a_period_and_the_latest_state_wins() -> None:
+    h = history()
+    for k in range(1, 1001):  # a flood within one period: only the last is kept
+        h.add((k * 1e-4,) * 7, 0.005)
+    h.add((0.5,) * 7, 0.02)
+    h.add((0.6,) * 7, 0.021)  # pending: the history still ends at it
+    window = h.window(-1.0, 1.0)
+    assert list(window.times) == [0.0, 0.02, 0.021]
+    assert window.qs[-1] == pytest.approx([0.6] * 7)
+    assert h.at(0.0205) == pytest.approx((0.5,) * 7)
+    assert h.at(-5.0) == pytest.approx((0.0,) * 7)  # before the start: the oldest kept
+
+
+def test_the_window_is_bounded_in_samples_and_in_time() -> None:
+    h = history()
+    for k in range(1, 2 * MAX_SAMPLES):
+        h.add((k * 1e-6,) * 7, k * 0.01)
+    window = h.window(-np.inf, np.inf)
+    assert len(window) <= MAX_SAMPLES + 1  # HISTORY_S at 100 a second, both ends kept
+    assert h.end == pytest.approx((2 * MAX_SAMPLES - 1) * 0.01)
+    assert h.start >= h.end - HISTORY_S
+    assert np.all(np.diff(window.times) > 0)
+    assert h._qs.shape[0] < 2 * MAX_SAMPLES  # a quarter of slack, not a second copy
+
+
+def test_markers_are_replayed_to_any_time_backwards_too() -> None:
+    h = history()
+    h.mark(marker(1.0), 1.0)
+    h.mark(marker(2.0), 2.0)
+    h.clear(3.0)
+    h.mark(marker(4.0), 4.0)
+    seen = {t: [m.position[0] for m in h.markers_at(t)[1]] for t in (0.5, 2.5, 3.5, 4.5)}
+    assert seen == {0.5: [], 2.5: [1.0, 2.0], 3.5: [], 4.5: [4.0]}
+    key_a, _ = h.markers_at(2.5)
+    key_b, _ = h.markers_at(2.6)
+    assert key_a == key_b  # nothing happened between: nothing to redraw
+    assert [m.position[0] for m in h.markers_at(1.5)[1]] == [1.0]  # and back again
+
+
+def test_a_flood_of_marks_folds_into_the_start_and_moves_it() -> None:
+    h = history()
+    h.add((0.0,) * 7, 10.0)
+    for k in range(MAX_MARKER_EVENTS + 10):
+        h.mark(marker(float(k)), 1.0 + k * 1e-4)
+    assert len(h._marks) == MAX_MARKER_EVENTS
+    assert h.start == pytest.approx(1.0 + 9 * 1e-4)  # what was folded cannot be shown
+    shown = h.markers_at(h.start)[1]  # the ten folded ones, as they were then
+    assert [m.position[0] for m in shown] == [float(k) for k in range(10)]
+    last = h.markers_at(np.inf)[1]  # at the end, the newest MAX_MARKERS
+    assert len(last) == 1000 and last[-1].position[0] == MAX_MARKER_EVENTS + 9
+
+
+def test_objects_as_they_were() -> None:
+    crate = WorkcellObject.__new__(WorkcellObject)  # identity is all the history looks at
+    h = history()
+    h.objects([crate], 2.0)
+    h.objects([], 3.0)
+    assert h.objects_at(1.0) == [] and h.objects_at(2.5) == [crate] and h.objects_at(3.5) == []
+
+
+def test_thinning_keeps_the_ends() -> None:
+    assert list(thin(5, 10)) == [0, 1, 2, 3, 4]
+    picked = thin(10_000, 200)
+    assert len(picked) <= 200 and picked[0] == 0 and picked[-1] == 9_999
