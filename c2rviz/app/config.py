@@ -22,6 +22,7 @@ from ..ini import INI_NAME, find_ini, number, read_ini
 from ..robot.catalogue import catalogue, find_robot
 from ..robot.sources import split_package_path
 from ..session.settings import ServerLimits, SessionDefaults
+from ..world.clocks import parse_clock
 
 __all__ = [
     "INI_NAME",
@@ -117,6 +118,9 @@ class Settings:
     """Serve the robots of this cell (``--cell``): an ini section's name, or an ini file."""
     motion_flags: tuple[tuple[str, str], ...] = ()
     """``--max-velocity`` and the like as given, (key, text), over every robot's ini ones."""
+    clock: str = "real"
+    """The world's clock (``--clock``): ``real``, ``scaled:N`` or ``virtual``
+    (``world.clock.parse_clock``)."""
     robot_flag: bool = False
     """``--robot`` was given."""
     urdf_flag: bool = False
@@ -148,6 +152,7 @@ _TEXT_OPTIONS = (
     "record_dir",
     "viewer_token",
     "viewer_origins",
+    "clock",
 )
 _CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on")}
 MOTION_FLAGS = ("max_velocity", "max_acceleration", "max_jerk")
@@ -242,6 +247,8 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
     if "guard" in given:
         given["guard"] = given["guard"] == "on"
     values.update(given)
+    if "clock" in values:  # a bad clock stops the program here, naming the forms
+        parse_clock(values["clock"], "--clock" if "clock" in given else "[options] clock")
     if "record_dir" in values:
         values["record_dir"] = Path(values["record_dir"])
     for key in ("package_paths", "xacro_args", "viewer_origins"):
