@@ -2,7 +2,9 @@
 
 A ROS-free re-creation of NIST's "text based command and control of a ROS RViz
 visualization": clients send one-line commands over TCP (port 31000) and the
-arm moves in a viser page. The parts, each usable alone:
+arm moves in a viser page. A controller talks to it with ``Client`` (blocking) or
+``AsyncClient`` (asyncio): one typed method per verb (docs/testing.md). The parts, each
+usable alone:
 
 - ``commands``: the pure parser (line -> frozen command);
 - ``robot`` / ``sources``: the Pinocchio model and its serial chain, and where
@@ -17,24 +19,49 @@ parts (Pinocchio, viser) load when first named.
 """
 
 from importlib import import_module
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # what type checkers see of the lazy names below
+    from .clients.async_client import AsyncClient
+    from .clients.client import Client
+    from .clients.connect import ServerUnavailable
+    from .clients.errors import CommandError, ConnectionLost
+    from .clients.records import Event, JointLimit, Pose, State
 
 __all__ = [
     "__version__",
+    "AsyncClient",
     "C2rvizError",
+    "Client",
+    "CommandError",
+    "ConnectionLost",
     "CommandServer",
+    "Event",
+    "JointLimit",
     "Marker",
+    "Pose",
     "RecordingScene",
     "Robot",
     "Scene",
+    "ServerUnavailable",
     "Session",
+    "State",
     "World",
     "parse_line",
 ]
 from .version import __version__
 
 _HOME = {
+    "AsyncClient": "clients.async_client",
     "C2rvizError": "errors",
+    "Client": "clients.client",
+    "CommandError": "clients.errors",
+    "ConnectionLost": "clients.errors",
+    "Event": "clients.records",
+    "JointLimit": "clients.records",
+    "Pose": "clients.records",
+    "ServerUnavailable": "clients.connect",
+    "State": "clients.records",
     "CommandServer": "transports.tcp_text",
     "Marker": "world.effects",
     "RecordingScene": "world.effects",

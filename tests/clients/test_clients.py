@@ -29,9 +29,9 @@ from c2rviz.clients.client import (
     Client,
     ServerUnavailable,
     default_address,
-    motion_of,
     server_address,
 )
+from c2rviz.clients.goto import motion_of
 from c2rviz.errors import C2rvizError, ConfigError
 from c2rviz.protocol import registry
 
@@ -118,12 +118,12 @@ def test_flags_win_and_the_ini_fills_in_the_rest(tmp_path):
 def test_client_tracks_units_and_restores_them_after_a_reconnect(server, connect):
     client = Client(server.host, server.port)
     assert client.ask("degrees") == "ok"
-    assert client.degrees
+    assert client.in_degrees
     client.close()
     assert client.ask("move 0 90") == "ok"  # reconnected, still in degrees
     assert math.isclose(server.q[0], math.pi / 2)
     assert client.ask("RADIANS # back") == "ok"
-    assert not client.degrees
+    assert not client.in_degrees
     client.close()
 
 
@@ -168,10 +168,10 @@ def cell():
 
 def test_client_restores_its_robot_after_a_reconnect(cell):
     client = Client(cell.host, cell.port)
-    assert client.joint_names()[0] == "joint_s" and client.robot == "left"
+    assert client.joint_names()[0] == "joint_s" and client.robot_name == "left"
     assert client.ask("robot right") == "ok"
     assert client.chosen_robot == "right"
-    assert client.joint_names()[0] == "lwr_0_joint" and client.robot == "right"  # asked again
+    assert client.joint_names()[0] == "lwr_0_joint" and client.robot_name == "right"  # asked again
     client.close()
     assert client.ask("robot") == "ok right"  # a new connection, the same robot
     client.close()
@@ -476,11 +476,12 @@ def test_repl_piped(old_server, connect, monkeypatch, capsys):
     assert not any(line.startswith(">") for line in captured.out.splitlines())  # no prompt
     out = captured.out
     assert "[16/16] move 0,1 -90,-90 -> ok" in out
-    first, second = out.split("motoman_sia20d (degrees):")[1:]
-    assert "0  joint_s  -90" in first and "1  joint_l  -90" in first
+    # Piped, `where` is the server's own reply (the table is for a person at a terminal).
+    assert "motoman_sia20d (degrees):" not in out
+    assert out.count("ok -90,-90,0,0,0,0,0\n") == 1  # after the file
     assert "ok (goto: 22 steps" in out  # 110 degrees in 5-degree steps
     assert "error: unknown command 'frobnicate' (try 'help')" in out
-    assert "0  joint_s  10" in second and "1  joint_l  20" in second
+    assert out.count("ok 10,20,0,0,0,0,0\n") == 1  # after goto
     # q leaves the server running
     assert where_degrees(server, connect) == "ok 10,20,0,0,0,0,0"
 
@@ -607,7 +608,7 @@ def test_repl_file_stops_at_the_first_error(server, tmp_path, monkeypatch, capsy
     assert f"{limit}:3: error: joint_l (index 1) = 500 deg" in out
     assert "[4/4]" not in out
     assert "error: file: no command file 'nonesuch.txt'" in out
-    assert "(degrees)" in out.split("nonesuch")[-1]  # the file's `degrees` was tracked
+    assert out.split("nonesuch")[-1].endswith("\nok 10,0,0,0,0,0,0\n")  # still in degrees
 
 
 def test_repl_quit_stops_the_server(c2rviz_process, monkeypatch, capsys):
