@@ -22,6 +22,7 @@ from c2rviz.app.program import write_page
 from c2rviz.robot.model import Robot
 from c2rviz.session import ServerLimits, Services
 from c2rviz.transports.tcp_text import CommandServer
+from c2rviz.world.clock import Clock
 from c2rviz.world.effects import RecordingScene
 from c2rviz.world.world import World
 
@@ -61,11 +62,15 @@ class ServerThread:
     quit: threading.Event = field(default_factory=threading.Event)
     host: str = "127.0.0.1"
     port: int = 0
+    clock: Clock | None = None
+    hz: float = 100.0
+    record_dir: Path | None = None
 
     def start(self) -> ServerThread:
         self.loop = asyncio.new_event_loop()
-        self.world = World(self.robot, self.scene)
-        self.services = Services(self.world, limits=self.limits, exporters=(write_page,))
+        self.world = World(self.robot, self.scene, clock=self.clock, hz=self.hz)
+        folder = {} if self.record_dir is None else {"record_dir": self.record_dir}
+        self.services = Services(self.world, limits=self.limits, exporters=(write_page,), **folder)
         self.server = CommandServer(self.services, on_quit=self.quit.set)
         self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
         self.thread.start()

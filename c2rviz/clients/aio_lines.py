@@ -185,9 +185,9 @@ class AsyncLineClient:
             writer.write(line.encode() + b"\n")
             await writer.drain()
             if self.timeout is None:
-                reply = await self._reader.next(line)
+                reply = await self._reply(line)
             else:
-                reply = await asyncio.wait_for(self._reader.next(line), self.timeout)
+                reply = await asyncio.wait_for(self._reply(line), self.timeout)
         except asyncio.TimeoutError:
             await self._close()
             raise ReplyTimeout(line, self.timeout or 0.0) from None
@@ -206,6 +206,14 @@ class AsyncLineClient:
                 self.chosen_robot = tracked.name
                 self._names = None
         return reply
+
+    async def _reply(self, line: str) -> str | None:
+        """The next line that is not a ``watch`` stream's (see ``LineClient``)."""
+        assert self._reader is not None
+        while True:
+            reply = await self._reader.next(line)
+            if reply is None or not reply.startswith(("state ", "event ")):
+                return reply
 
     async def joint_names(self) -> tuple[str, ...]:
         """The chain's joint names, in index order (asked once per connection and robot)."""

@@ -84,6 +84,7 @@ class AsyncClient(AsyncLineClient):
             raise CommandError(text, reply)
         return reply
 
+    @speaks("watch")
     def watch(self, hz: float | None = None) -> AsyncWatchStream:
         """The ``watch`` stream on a connection of its own (``async for`` its ``State`` and
         ``Event`` records; ``async with`` or ``close()``); ``hz``: most states a second."""
@@ -146,7 +147,9 @@ class AsyncClient(AsyncLineClient):
     @speaks("names")
     async def names(self) -> RobotNames:
         """The robot this connection drives and its chain's joint names, in index order."""
-        return await self.call(calls.NAMES)
+        names = await self.call(calls.NAMES)
+        self.robot_name, self._names = names  # what a joint count is checked against
+        return names
 
     @speaks("version")
     async def version(self) -> VersionInfo:
@@ -183,12 +186,12 @@ class AsyncClient(AsyncLineClient):
 
     @speaks("color")
     async def color(self, r: float, g: float, b: float) -> None:
-        """Colour of this connection's next markers, each channel 0..1."""
+        """Colour of this connection's next markers, each channel [0..1]."""
         return await self.call(calls.color("color", (r, g, b)))
 
     @speaks("rgb")
     async def rgb(self, r: float, g: float, b: float) -> None:
-        """Colour of this connection's next markers, each channel 0..255."""
+        """Colour of this connection's next markers, each channel [0..255]."""
         return await self.call(calls.color("rgb", (r, g, b)))
 
     @speaks("marker")
@@ -240,7 +243,7 @@ class AsyncClient(AsyncLineClient):
 
     @speaks("speed")
     async def speed(self, percent: float | None = None) -> float:
-        """Set this connection's moves to ``percent`` (1..100) of the joints' limits;
+        """Set this connection's moves to ``percent`` [% of the joints' limits, 1..100];
         return it (without one: as it is)."""
         return float(
             await self.call(calls.setting("speed", "percent", percent, records.read_number))

@@ -104,6 +104,7 @@ class Client(LineClient):
             raise CommandError(line.strip(), reply)
         return reply
 
+    @speaks("watch")
     def watch(self, hz: float | None = None) -> WatchStream:
         """The ``watch`` stream, on a connection of its own (this one's robot and units):
         iterate it for ``State`` and ``Event`` records; ``close()`` it (or use ``with``).
@@ -174,7 +175,9 @@ class Client(LineClient):
     @speaks("names")
     def names(self) -> RobotNames:
         """The robot this connection drives and its chain's joint names, in index order."""
-        return self.call(calls.NAMES)
+        names = self.call(calls.NAMES)
+        self.robot_name, self._names = names  # what a joint count is checked against
+        return names
 
     @speaks("version")
     def version(self) -> VersionInfo:
@@ -215,12 +218,12 @@ class Client(LineClient):
 
     @speaks("color")
     def color(self, r: float, g: float, b: float) -> None:
-        """Colour of this connection's next markers, each channel 0..1."""
+        """Colour of this connection's next markers, each channel [0..1]."""
         return self.call(calls.color("color", (r, g, b)))
 
     @speaks("rgb")
     def rgb(self, r: float, g: float, b: float) -> None:
-        """Colour of this connection's next markers, each channel 0..255."""
+        """Colour of this connection's next markers, each channel [0..255]."""
         return self.call(calls.color("rgb", (r, g, b)))
 
     @speaks("marker")
@@ -274,7 +277,7 @@ class Client(LineClient):
 
     @speaks("speed")
     def speed(self, percent: float | None = None) -> float:
-        """Set this connection's moves to ``percent`` (1..100) of the joints' limits;
+        """Set this connection's moves to ``percent`` [% of the joints' limits, 1..100];
         return it (without one: as it is)."""
         return float(self.call(calls.setting("speed", "percent", percent, records.read_number)))
 

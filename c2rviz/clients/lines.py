@@ -29,6 +29,7 @@ __all__ = ["MAX_REPLY_BYTES", "LineClient"]
 MAX_REPLY_BYTES = 1 << 20
 """Longest reply line a client reads [bytes]; past it the connection is closed."""
 _CHUNK = 65536
+_STREAM = ("state ", "event ")  # a watch stream's lines, which no reply starts with
 
 
 class LineClient:
@@ -216,6 +217,8 @@ class LineClient:
         line, tracked = self._sent[0]
         try:
             raw = self._read_line()
+            while isinstance(raw, str) and raw.startswith(_STREAM):  # `watch` on this connection
+                raw = self._read_line()
         except TimeoutError:
             self.close()
             raise ReplyTimeout(line, self.timeout or 0.0) from None

@@ -67,7 +67,8 @@ def run_repl(monkeypatch, text: str, *args: str) -> int:
 
 
 def env() -> dict[str, str]:
-    return {**os.environ, "PYTHONUNBUFFERED": "1", "TERM": "dumb"}
+    """A client process's environment: this tree's c2rviz, not the one installed."""
+    return {**os.environ, "PYTHONUNBUFFERED": "1", "TERM": "dumb", "PYTHONPATH": str(ROOT)}
 
 
 def joints_lines(server) -> list[str]:
@@ -444,13 +445,17 @@ def test_progress_shows_a_reply_being_waited_for_only_on_a_terminal():
 def test_fileplayer_script_runs_as_a_process(server, connect):
     args = [PLAYER_SCRIPT, "commands/motoman.txt", "--port", str(server.port), "--speed", "1000"]
     done = subprocess.run(
-        [sys.executable, *args], cwd=ROOT, capture_output=True, text=True, timeout=30
+        [sys.executable, *args], cwd=ROOT, capture_output=True, text=True, timeout=30, env=env()
     )
     assert done.returncode == 0, done.stderr
     assert "[16/16] move 0,1 -90,-90 -> ok" in done.stdout
     assert where_degrees(server, connect) == SEED_END
     bad = subprocess.run(
-        [sys.executable, *args[:1], "nonesuch.txt"], capture_output=True, text=True, timeout=30
+        [sys.executable, *args[:1], "nonesuch.txt"],
+        capture_output=True,
+        text=True,
+        timeout=30,
+        env=env(),
     )
     assert bad.returncode == 2 and "Traceback" not in bad.stderr
 
@@ -490,15 +495,24 @@ def test_piped_repl_exits_1_when_a_line_got_an_error(server, connect):
     """`c2rviz-cli < script` fails like the player, but still runs every line."""
     args = [sys.executable, REPL_SCRIPT, "--port", str(server.port)]
     clean = subprocess.run(
-        args, input="degrees\nmove 0 10\nwhere\n", capture_output=True, text=True, timeout=30
+        args,
+        input="degrees\nmove 0 10\nwhere\n",
+        capture_output=True,
+        text=True,
+        timeout=30,
+        env=env(),
     )
     assert clean.returncode == 0, clean.stderr
     script = "degrees\nmove 1 500\nmove 0 20\nwhere\n"
-    failed = subprocess.run(args, input=script, capture_output=True, text=True, timeout=30)
+    failed = subprocess.run(
+        args, input=script, capture_output=True, text=True, timeout=30, env=env()
+    )
     assert failed.returncode == 1, failed.stderr
     assert "error: joint_l (index 1) = 500 deg is outside its limits" in failed.stdout
     assert where_degrees(server, connect) == "ok 20,0,0,0,0,0,0"  # the lines after it ran
-    local = subprocess.run(args, input="goto 1\n", capture_output=True, text=True, timeout=30)
+    local = subprocess.run(
+        args, input="goto 1\n", capture_output=True, text=True, timeout=30, env=env()
+    )
     assert local.returncode == 1  # an error from a local command counts too
     assert "error: goto: joints needs 7 values, got 1" in local.stdout
 
@@ -646,7 +660,7 @@ def test_repl_waits_for_a_server_that_starts_late(c2rviz_process):
     assert repl_proc.returncode == 0, err
     assert f"no server at 127.0.0.1:{port} yet" in err and "retrying" in err
     assert "Socket Connected" in err
-    assert "6  joint_t  0" in out
+    assert out == "ok 0,0,0,0,0,0,0\n"  # piped: the server's own reply
 
 
 def test_repl_gives_up_with_a_clear_message():

@@ -1,0 +1,149 @@
+"""The clocks: ``--clock`` forms, scaled time, and virtual time's holds and jumps.
+
+The virtual clock is driven on a real asyncio loop: timers fire in clock order, time
+stands still while a hold is taken, a reply that waits on the clock releases its
+client's hold and takes it back the instant it is settled.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import time
+
+import pytest
+
+from c2rviz.errors import ConfigError
+from c2rviz.world.clock import NO_HOLD, Clock, ScaledClock
+from c2rviz.world.clocks import CLOCK_FORMS, parse_clock
+from c2rviz.world.virtual_clock import VirtualClock
+
+
+@pytest.mark.parametrize(
+    ("text", "kind", "described"),
+    [
+        ("real", Clock, "real"),
+        ("REAL", Clock, "real"),
+        ("scaled:10", ScaledClock, "scaled:10"),
+        ("scaled:0.5", ScaledClock, "scaled:0.5"),
+        ("virtual", VirtualClock, "virtual"),
+    ],
+    ids=["real", "upper-case", "scaled-10", "scaled-half", "virtual"],
+)
+def test_good_clock_forms(text, kind, described):
+    clock = parse_clock(text)
+    assert type(clock) is kind and clock.describe() == described
+
+
+@pytest.mark.parametrize(
+    "text",
+    ["scaled:0", "scaled:-2", "scaled:nan", "scaled:inf", "scaled:", "scaled:x", "fast", ""],
+    ids=["zero", "negative", "nan", "inf", "empty-factor", "word-factor", "unknown", "empty"],
+)
+def test_bad_clock_forms_name_the_valid_ones(text):
+    with pytest.raises(ConfigError) as caught:
+        parse_clock(text)
+    assert all(form in str(caught.value) for form in CLOCK_FORMS)
+
+
+def test_scaled_time_runs_faster():
+    clock = ScaledClock(50.0)
+    start_real, start = time.monotonic(), clock.now()
+
+    async def sleep_one_clock_second() -> float:
+        loop = asyncio.get_running_loop()
+        done = loop.create_future()
+        clock.call_later(1.0, done.set_result, None)
+        await done
+        return clock.now() - start
+
+    clock_s = asyncio.run(sleep_one_clock_second())
+    assert clock_s >= 1.0 - 1e-6
+    assert time.monotonic() - start_real < 1.0  # 1 s of the clock is 20 ms of real time
+
+
+def test_real_and_scaled_clocks_hold_nothing():
+    assert Clock().hold() is NO_HOLD and ScaledClock(2).hold() is NO_HOLD
+
+
+def test_virtual_time_jumps_through_timers_in_order():
+    clock = VirtualClock()
+    fired: list[tuple[str, float]] = []
+
+    async def main() -> None:
+        done = asyncio.get_running_loop().create_future()
+        clock.call_at(30.0, fired.append, ("c", 30.0))
+        clock.call_at(10.0, fired.append, ("a", 10.0))
+        clock.call_at(10.0, fired.append, ("b", 10.0))  # same time: in the order set
+        cancelled = clock.call_at(20.0, fired.append, ("never", 20.0))
+        cancelled.cancel()
+        clock.call_at(3600.0, done.set_result, None)
+        await done
+
+    start = time.monotonic()
+    asyncio.run(main())
+    assert fired == [("a", 10.0), ("b", 10.0), ("c", 30.0)]
+    assert clock.now() == 3600.0
+    assert time.monotonic() - start < 30  # an hour of the clock in no time at all
+
+
+def test_a_hold_stops_time_until_released():
+    clock = VirtualClock()
+
+    async def main() -> tuple[float, float]:
+        hold = clock.hold()
+        fired = asyncio.get_running_loop().create_future()
+        clock.call_later(5.0, fired.set_result, None)
+        for _ in range(20):  # many loop turns: time stands still while the hold is taken
+            await asyncio.sleep(0)
+        held_at = clock.now()
+        hold.release()
+        await fired
+        return held_at, clock.now()
+
+    assert asyncio.run(main()) == (0.0, 5.0)
+
+
+def test_due_timers_run_while_held():
+    clock = VirtualClock()
+
+    async def main() -> bool:
+        clock.hold()  # held for good
+        done = asyncio.get_running_loop().create_future()
+        clock.call_later(0.0, done.set_result, True)
+        return await asyncio.wait_for(done, 5.0)
+
+    assert asyncio.run(main())
+
+
+def test_a_wait_releases_the_acting_hold_and_waking_takes_it_back_at_once():
+    """Two clients: A sleeps 1 s, B sleeps 2 s. When A's sleep ends, A is busy again
+    before anything else runs, so B's timer cannot fire until A says it waits again."""
+    clock = VirtualClock()
+    log: list[tuple[str, float]] = []
+
+    def sleep(hold, seconds: float) -> asyncio.Future[None]:
+        future = asyncio.get_running_loop().create_future()
+        with hold.acting():
+            clock.waiting(future)
+
+        def settle() -> None:
+            clock.woke(future)
+            future.set_result(None)
+
+        clock.call_later(seconds, settle)
+        return future
+
+    async def client(name: str, hold, seconds: float, thinking_turns: int) -> None:
+        await sleep(hold, seconds)
+        log.append((name, clock.now()))
+        for _ in range(thinking_turns):  # busy (held) for a while after waking
+            await asyncio.sleep(0)
+        log.append((name + " thought", clock.now()))
+        hold.close()
+
+    async def main() -> None:
+        a, b = clock.hold(), clock.hold()
+        await asyncio.gather(client("a", a, 1.0, 50), client("b", b, 2.0, 0))
+
+    asyncio.run(main())
+    assert log == [("a", 1.0), ("a thought", 1.0), ("b", 2.0), ("b thought", 2.0)]
