@@ -11,6 +11,7 @@ memory) and gives each line as text (``lines``) or as a ``State``/``Event`` reco
 
 from __future__ import annotations
 
+import contextlib
 import socket
 from collections import deque
 from collections.abc import Iterator
@@ -135,7 +136,14 @@ class WatchStream:
             if record is not None:
                 yield record
 
+    def send(self, line: str) -> None:
+        """Send a command on the watching connection (its reply comes among the stream's
+        lines: everything the stream wrote before it comes first)."""
+        self._sock.sendall(line.encode() + b"\n")
+
     def close(self) -> None:
+        with contextlib.suppress(OSError):  # wakes a thread blocked reading it
+            self._sock.shutdown(socket.SHUT_RDWR)
         self._sock.close()
 
     def __enter__(self) -> WatchStream:
