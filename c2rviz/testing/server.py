@@ -13,9 +13,10 @@ the next one.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import dataclasses
 import threading
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -27,6 +28,7 @@ from ..observers.recorder import Recorded
 from ..session.services import Services
 from ..session.session import Session
 from ..transports.tcp_text import CommandServer
+from ..world.clock import Hold
 from ..world.clocks import parse_clock
 from ..world.effects import NullScene, Scene
 from ..world.state import RobotState
@@ -93,6 +95,7 @@ class TestServer:
         self._loop: asyncio.AbstractEventLoop | None = None
         self._stop: asyncio.Event | None = None
         self._keep_page = False
+        self._servers: list[CommandServer] = []
         self._thread = threading.Thread(target=self._run, name="c2rviz-test-server", daemon=True)
 
     @property
@@ -134,7 +137,8 @@ class TestServer:
 
     def run(self, line: str, robot: str | None = None) -> str:
         """Run one command line as a session of its own (source ``test``); return its reply
-        text (``error: ...`` too), awaited if it waits."""
+        text (``error: ...`` too), awaited if it waits (meanwhile the test's idle clients
+        wait for nothing: ``idle_clients``)."""
 
         async def ask() -> str:
             session = Session(self.services, "test", robot)
@@ -145,7 +149,36 @@ class TestServer:
                 return f"error: {exc}"
 
         assert self._loop is not None
-        return asyncio.run_coroutine_threadsafe(ask(), self._loop).result(_START_TIMEOUT_S)
+        with self.idle_clients():
+            return asyncio.run_coroutine_threadsafe(ask(), self._loop).result(_START_TIMEOUT_S)
+
+    @contextlib.contextmanager
+    def idle_clients(self) -> Iterator[None]:
+        """Inside, the clients connected now that have no command running wait for nothing.
+
+        A virtual clock stands still while any client is busy, and a connected client with
+        nothing to wait for counts as busy (it may be about to send). A test thread that
+        drives two clients blocks on one while the other sits idle: wrap that in this, e.g.
+        ``with c2rviz_server.idle_clients(): other.stop()``. A client that sends a line
+        inside is busy again as usual.
+        """
+        released = self.call(self._release_idle)
+        try:
+            yield
+        finally:
+            self.call(self._take_back, released)
+
+    def _take_back(self, released: list[Hold]) -> None:
+        still = {id(c.hold) for server in self._servers for c in server.connections}
+        for hold in released:
+            if id(hold) in still:
+                hold.take()
+
+    def _release_idle(self) -> list[Hold]:
+        idle = [c.hold for server in self._servers for c in server.connections if not c.waiting]
+        for hold in idle:
+            hold.release()
+        return idle
 
     def keep_page(self, keep: bool) -> None:
         """Whether a recording stopped from now on also writes its page (NAME.html)."""
@@ -200,7 +233,7 @@ class TestServer:
         )
         for member in self.members:
             furnish(world, member)
-        servers: list[CommandServer] = []
+        servers = self._servers
         doors: Sequence[Opened] = []
         scene: Scene = NullScene()
         try:

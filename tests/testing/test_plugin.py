@@ -73,12 +73,22 @@ def test_assert_arrives_tells_a_late_arrival(c2rviz):
         assert_arrives(c2rviz, within=0.01)
 
 
-@pytest.mark.c2rviz(motion="follow", speed=10)
+@pytest.mark.c2rviz(clock="virtual", motion="follow", speed=10)
 def test_assert_arrives_tells_a_stop(c2rviz, c2rviz_server):
     c2rviz.joints([1, 0, 0, 0, 0, 0, 0])
-    c2rviz_server.run("stop")  # another source stops the arm (real time: see docs/testing.md)
+    c2rviz_server.run("stop")  # another source stops the arm
     with pytest.raises(AssertionError, match="arrived at .*, not at 1,0,0,0,0,0,0"):
         assert_arrives(c2rviz, within=60, at=[1, 0, 0, 0, 0, 0, 0])
+
+
+@pytest.mark.c2rviz(clock="virtual", motion="follow", speed=10)
+def test_a_second_client_stops_the_first_ones_move(c2rviz, c2rviz_server):
+    c2rviz.joints([1, 0, 0, 0, 0, 0, 0])
+    c2rviz.sleep(1)  # the arm moves for a second of the clock (none passes between lines)
+    with Client(c2rviz_server.host, c2rviz_server.port) as other:
+        with c2rviz_server.idle_clients():  # c2rviz waits for nothing meanwhile
+            other.stop()
+    assert not c2rviz.status().moving and 0 < c2rviz.where()[0] < 1
 
 
 @pytest.mark.c2rviz(clock="virtual", motion="on")
@@ -148,7 +158,7 @@ def sample(tmp_path: Path) -> Path:
 def test_the_plugin_in_a_users_pytest_run(sample):
     done = run_pytest(sample, "-p", "c2rviz.testing.plugin", "-rA")
     out = done.stdout + done.stderr
-    assert counts(out) == {"passed": 13, "failed": 1}, out
+    assert counts(out) == {"passed": 14, "failed": 1}, out
     assert "FAILED test_controller.py::test_this_one_fails_and_its_run_is_kept" in out
     assert "AssertionError: on purpose" in out
     kept = sample / "c2rviz-recordings"
