@@ -16,9 +16,13 @@ from test_run_bench import quick_table  # noqa: E402
 ROWS = [
     "1 where: raw socket",
     "1 where: Client",
+    "1 where: client CPU, raw",
+    "1 where: client CPU, Client",
     "1 where: Client/raw",
     "1 joints: raw socket",
     "1 joints: Client",
+    "1 joints: client CPU, raw",
+    "1 joints: client CPU, Client",
     "1 joints: Client/raw",
     "2 virtual: 1 robot moving",
     "2 virtual: 1 robot moving: server CPU",
