@@ -11,8 +11,11 @@ import asyncio
 import time
 
 import pytest
+from support import ROOT, Client, ServerThread, load_robot
 
+from c2rviz.app.config import load_settings
 from c2rviz.errors import ConfigError
+from c2rviz.session import ServerLimits
 from c2rviz.world.clock import NO_HOLD, Clock, ScaledClock
 from c2rviz.world.clocks import CLOCK_FORMS, parse_clock
 from c2rviz.world.virtual_clock import VirtualClock
@@ -147,3 +150,38 @@ def test_a_wait_releases_the_acting_hold_and_waking_takes_it_back_at_once():
 
     asyncio.run(main())
     assert log == [("a", 1.0), ("a thought", 1.0), ("b", 2.0), ("b thought", 2.0)]
+
+
+def test_the_ini_names_the_clock_and_a_bad_one_names_the_key(tmp_path):
+    urdf = {"urdf": ROOT / "robots" / "kuka_lwr" / "robot.urdf"}
+    good = tmp_path / "good.ini"
+    good.write_text("[options]\nclock = virtual\n")
+    assert load_settings(good, urdf).clock == "virtual"
+    assert load_settings(good, {**urdf, "clock": "scaled:3"}).clock == "scaled:3"  # flag wins
+    bad = tmp_path / "bad.ini"
+    bad.write_text("[options]\nclock = scaled:-1\n")
+    with pytest.raises(ConfigError, match=r"\[options\] clock scaled:-1: the factor"):
+        load_settings(bad, urdf)
+
+
+def test_a_scaled_clock_runs_motion_faster_and_the_world_stamps_its_time():
+    """What the page and every observer are told follows the clock: a move of some
+    seconds of the clock is shown over that many clock seconds, in a twentieth of them."""
+    server = ServerThread(load_robot(), ServerLimits(), clock=ScaledClock(20.0)).start()
+    try:
+        client = Client(server.host, server.port)
+        assert client.ask("motion on") == "ok"
+        assert client.ask("speed 20") == "ok"
+        start = time.monotonic()
+        assert client.ask("joints 1,0.5,0,-0.5,0,0.5,0") == "ok"  # on arrival
+        wall = time.monotonic() - start
+        client.close()
+        times = server.scene.times
+        shown = times[-1] - times[0]
+        assert shown > 5.0  # the move takes seconds of the clock...
+        assert wall < shown  # ...and a fraction of that of the wall's (1/20)
+        # Frames come as often as the loop's timers allow (about 1 ms of the wall: 1/50 s
+        # of this clock), not every 1/100 s of the clock as in real time.
+        assert len(times) > shown * 20
+    finally:
+        server.stop()
