@@ -52,16 +52,7 @@ __all__ = [
 from .version import __version__
 
 _HOME = {
-    "AsyncClient": "clients.async_client",
     "C2rvizError": "errors",
-    "Client": "clients.client",
-    "CommandError": "clients.errors",
-    "ConnectionLost": "clients.errors",
-    "Event": "clients.records",
-    "JointLimit": "clients.records",
-    "Pose": "clients.records",
-    "ServerUnavailable": "clients.connect",
-    "State": "clients.records",
     "CommandServer": "transports.tcp_text",
     "Marker": "world.effects",
     "RecordingScene": "world.effects",
@@ -71,6 +62,21 @@ _HOME = {
     "World": "world.world",
     "parse_line": "protocol.grammar",
 }
+
+
+_HOME.update(  # a controller's side: the clients (no Pinocchio, no viser)
+    {
+        "AsyncClient": "clients.async_client",
+        "Client": "clients.client",
+        "CommandError": "clients.errors",
+        "ConnectionLost": "clients.errors",
+        "Event": "clients.records",
+        "JointLimit": "clients.records",
+        "Pose": "clients.records",
+        "ServerUnavailable": "clients.connect",
+        "State": "clients.records",
+    }
+)
 
 
 def __getattr__(name: str) -> Any:

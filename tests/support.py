@@ -22,7 +22,6 @@ from c2rviz.app.program import write_page
 from c2rviz.robot.model import Robot
 from c2rviz.session import ServerLimits, Services
 from c2rviz.transports.tcp_text import CommandServer
-from c2rviz.world.clock import Clock
 from c2rviz.world.effects import RecordingScene
 from c2rviz.world.world import World
 
@@ -62,7 +61,7 @@ class ServerThread:
     quit: threading.Event = field(default_factory=threading.Event)
     host: str = "127.0.0.1"
     port: int = 0
-    clock: Clock | None = None
+    clock: Any = None  # a world.clock.Clock (default: real time)
     hz: float = 100.0
     record_dir: Path | None = None
 

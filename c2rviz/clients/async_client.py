@@ -34,6 +34,7 @@ from .calls import Call, count_problem, read_call, speaks
 from .errors import CommandError
 from .records import (
     JointLimit,
+    MotionLimit,
     MotionStatus,
     Pose,
     RecordingResult,
@@ -139,10 +140,15 @@ class AsyncClient(AsyncLineClient):
         return await self.call(calls.POSE)
 
     @speaks("limits")
-    async def limits(self, motion: bool = False) -> list[JointLimit]:
-        """Each chain joint's limits [rad, or deg; m]; ``motion``: with its velocity,
-        acceleration and jerk limits [per s, s^2, s^3]."""
-        return await self.call(calls.limits(motion))
+    async def limits(self) -> list[JointLimit]:
+        """Each chain joint's range [rad, or deg; m] and unit, in index order."""
+        return await self.call(calls.LIMITS)
+
+    @speaks("limits")
+    async def motion_limits(self) -> list[MotionLimit]:
+        """Each chain joint's velocity, acceleration and jerk limits [rad, or deg; m per s,
+        s^2, s^3] (``limits all``)."""
+        return await self.call(calls.MOTION_LIMITS)
 
     @speaks("names")
     async def names(self) -> RobotNames:

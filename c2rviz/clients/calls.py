@@ -50,6 +50,11 @@ class Call(Generic[T]):
     track: object = None
     joint_count: tuple[str, str, int] | None = None
     highest_index: tuple[str, str, int] | None = None
+    data: bytes = b""
+    """The line as sent: encoded, with its newline."""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "data", self.line.encode() + b"\n")
 
 
 def with_value(value: T) -> Callable[[str], T]:
@@ -152,10 +157,8 @@ def marker(shape: object) -> Call[None]:
     return Call(f"marker {check.choice('marker', 'shape', shape, MARKER_SHAPES)}", OK_ONLY)
 
 
-def limits(motion: bool) -> Call[list[read.JointLimit]]:
-    return fixed(
-        "limits all" if check.flag("limits", "motion", motion) else "limits", read.read_limits
-    )
+LIMITS = fixed("limits", read.read_limits)
+MOTION_LIMITS = fixed("limits all", read.read_motion_limits)
 
 
 def sleep(seconds: object) -> Call[None]:

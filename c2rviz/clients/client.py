@@ -33,6 +33,7 @@ from .lines import LineClient
 from .options import COMMANDS_DIR, add_connection_args, default_address, find_script, server_address
 from .records import (
     JointLimit,
+    MotionLimit,
     MotionStatus,
     Pose,
     RecordingResult,
@@ -89,7 +90,7 @@ class Client(LineClient):
         if call.joint_count is not None or call.highest_index is not None:
             names = self.joint_names()
             count_problem(call, self.robot_name or "the robot", names)
-        self._post(call.line, call.track)
+        self._post(call.line, call.track, call.data)
         return read_call(call, self.read_reply())
 
     def send(self, line: str) -> str:
@@ -167,10 +168,15 @@ class Client(LineClient):
         return self.call(calls.POSE)
 
     @speaks("limits")
-    def limits(self, motion: bool = False) -> list[JointLimit]:
-        """Each chain joint's limits [rad, or deg; m]; ``motion``: with its velocity,
-        acceleration and jerk limits [per s, s^2, s^3]."""
-        return self.call(calls.limits(motion))
+    def limits(self) -> list[JointLimit]:
+        """Each chain joint's range [rad, or deg; m] and unit, in index order."""
+        return self.call(calls.LIMITS)
+
+    @speaks("limits")
+    def motion_limits(self) -> list[MotionLimit]:
+        """Each chain joint's velocity, acceleration and jerk limits [rad, or deg; m per s,
+        s^2, s^3] (``limits all``)."""
+        return self.call(calls.MOTION_LIMITS)
 
     @speaks("names")
     def names(self) -> RobotNames:

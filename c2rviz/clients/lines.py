@@ -183,12 +183,14 @@ class LineClient:
         self._post(line.rstrip("\r\n"), command)
         return True
 
-    def _post(self, line: str, tracked: object) -> None:
-        """Send ``line`` (one command, no newline), remembering ``tracked`` for its reply."""
-        self.open()
+    def _post(self, line: str, tracked: object, data: bytes | None = None) -> None:
+        """Send ``line`` (one command, no newline; ``data``: it encoded, with its newline),
+        remembering ``tracked`` for its reply."""
+        if self._sock is None:
+            self.open()
         assert self._sock is not None
         try:
-            self._sock.sendall(line.encode() + b"\n")
+            self._sock.sendall(data or line.encode() + b"\n")
         except OSError:
             self.close()
             raise ConnectionLost(self.host, self.port, line) from None
@@ -251,6 +253,19 @@ class LineClient:
         loses nothing: what has arrived stays in the framer."""
         lines = self._lines
         framer = self._framer
+        if not lines and not framer.buffer:  # the usual case: a reply is one chunk
+            assert self._sock is not None
+            chunk = self._sock.recv(_CHUNK)
+            if not chunk:
+                return None
+            if (
+                chunk[-1:] == b"\n"
+                and chunk.count(b"\n") == 1
+                and len(chunk) <= self.max_reply
+                and chunk.isascii()
+            ):
+                return chunk[:-1].decode("ascii")  # as the framer would: one line, in bounds
+            framer.feed(chunk)
         while not lines:
             batch = framer.take()
             if batch is not None:

@@ -15,6 +15,7 @@ from typing import NamedTuple
 __all__ = [
     "Event",
     "JointLimit",
+    "MotionLimit",
     "MotionStatus",
     "Pose",
     "RecordingResult",
@@ -39,21 +40,21 @@ class Pose(NamedTuple):
 
 
 class JointLimit(NamedTuple):
-    """One chain joint's limits, in the connection's units.
-
-    Attributes:
-        lower, upper: The range [rad, deg or m].
-        unit: ``rad``, ``deg`` or ``m``.
-        velocity, acceleration, jerk: The motion limits [unit/s, /s^2, /s^3]; None unless
-            asked (``limits(motion=True)``).
-    """
+    """One chain joint's range, in the connection's units: ``lower``, ``upper`` [rad, deg
+    or m] and the ``unit`` (``rad``, ``deg`` or ``m``)."""
 
     lower: float
     upper: float
     unit: str
-    velocity: float | None = None
-    acceleration: float | None = None
-    jerk: float | None = None
+
+
+class MotionLimit(NamedTuple):
+    """One chain joint's motion limits, in the connection's units: ``velocity`` [unit/s],
+    ``acceleration`` [unit/s^2], ``jerk`` [unit/s^3]."""
+
+    velocity: float
+    acceleration: float
+    jerk: float
 
 
 class RobotNames(NamedTuple):
@@ -165,16 +166,21 @@ def read_word(reply: str) -> str:
 
 
 def read_limits(reply: str) -> list[JointLimit]:
+    """``ok -1.5..1.5 rad,...`` (``limits``; the motion limits of ``limits all`` ignored)."""
     limits = []
     for item in _payload(reply).split(","):
-        span, unit, *rates = item.split(" ")
+        span, unit, *_ = item.split(" ")
         lower, upper = span.split("..")
-        motion = {key: float(value) for key, _, value in (rate.partition("=") for rate in rates)}
-        limits.append(
-            JointLimit(
-                float(lower), float(upper), unit, motion.get("v"), motion.get("a"), motion.get("j")
-            )
-        )
+        limits.append(JointLimit(float(lower), float(upper), unit))
+    return limits
+
+
+def read_motion_limits(reply: str) -> list[MotionLimit]:
+    """``ok -1.5..1.5 rad v=2 a=4 j=20,...`` (``limits all``)."""
+    limits = []
+    for item in _payload(reply).split(","):
+        rates = dict(rate.split("=") for rate in item.split(" ")[2:])
+        limits.append(MotionLimit(float(rates["v"]), float(rates["a"]), float(rates["j"])))
     return limits
 
 

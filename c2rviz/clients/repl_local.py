@@ -29,10 +29,7 @@ from .watch import watch_lines
 __all__ = ["DEFAULT_STEP_DEG", "LOCAL_USAGE", "LocalCommands"]
 
 LOCAL_USAGE = {
-    "file": (
-        "file NAME [speed=X]",
-        "play a command file (here, else the recording folder, else commands/); X divides sleeps",
-    ),
+    "file": ("file NAME [speed=X]", "play a command file (here, else commands/); X divides sleeps"),
     "sleep": ("sleep S", "wait S seconds here"),
     "where": (
         "where",

@@ -29,7 +29,6 @@ from ..protocol.grammar import ForeignProtocol, parse_line
 from ..protocol.registry import VERBS
 from ..session.services import Services
 from ..session.session import Session
-from ..world.clock import NO_HOLD
 
 __all__ = ["CommandServer", "Connection"]
 
@@ -60,7 +59,9 @@ class Connection(asyncio.Protocol):
         self.eof = False
         self.closed = asyncio.get_running_loop().create_future()
         self.stream = server.services.watch.open(self.session, self)  # idle until `watch`
-        self.hold = server.world.clock.hold()  # a virtual clock waits while this client is busy
+        clock = server.services.world.clock
+        self.virtual = clock.virtual
+        self.hold = clock.hold()  # a virtual clock waits while this client is busy
 
     @property
     def waiting(self) -> bool:
@@ -156,7 +157,7 @@ class Connection(asyncio.Protocol):
         (``Clock.hold``): its replies that wait on the clock release it while they wait, and
         a client whose last line was ``watch`` only listens (released until it speaks)."""
         hold = self.hold
-        if hold is NO_HOLD:
+        if not self.virtual:  # real or scaled time: holds are no-ops, skip them
             self._run_lines(lines)
             return
         with hold.acting():

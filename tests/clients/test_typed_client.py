@@ -82,9 +82,10 @@ def test_questions_come_back_typed(robot):
     assert isinstance(pose, Pose) and pose.z > 1.0
     limits = robot.limits()
     assert all(isinstance(limit, JointLimit) and limit.unit == "rad" for limit in limits)
-    assert limits[0].velocity is None
-    rates = robot.limits(motion=True)
-    assert rates[0].lower == limits[0].lower and rates[0].velocity > 0 and rates[0].jerk > 0
+    lower, upper, unit = limits[0]  # a (lower, upper, unit) triple, as before
+    assert lower < 0 < upper and unit == "rad"
+    rates = robot.motion_limits()
+    assert len(rates) == 7 and all(0 < r.velocity < r.acceleration < r.jerk for r in rates)
     version = robot.version()
     assert version.robot_file == "robot.urdf" and len(version.sha256) == 12
     assert "where" in robot.help() and "joints|j v0,...,vn-1" in robot.help()
