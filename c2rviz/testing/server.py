@@ -20,6 +20,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypeVar
 
+from .. import CommandServer  # the package's lazy name follows the text door's home
 from ..app.config import Settings, find_ini, load_settings
 from ..app.doors import Opened, close_doors, open_doors
 from ..app.members import Member, furnish, members
@@ -27,7 +28,6 @@ from ..app.program import write_page
 from ..observers.recorder import Recorded
 from ..session.services import Services
 from ..session.session import Session
-from ..transports.tcp_text import CommandServer
 from ..world.clock import Hold
 from ..world.clocks import parse_clock
 from ..world.effects import NullScene, Scene
