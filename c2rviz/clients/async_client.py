@@ -23,13 +23,13 @@ several commands waiting at once (each is a connection, a session of its own).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from pathlib import Path
 from typing import TypeVar
 
 from ..errors import C2rvizError
 from ..protocol.grammar import parse_line
 from . import calls, records
 from .aio_lines import AsyncLineClient, AsyncWatchStream
+from .aio_scene_verbs import AsyncSceneVerbs
 from .calls import Call, count_problem, read_call, speaks
 from .errors import CommandError
 from .records import (
@@ -37,10 +37,7 @@ from .records import (
     MotionLimit,
     MotionStatus,
     Pose,
-    RecordingResult,
-    RecordingStatus,
     RobotNames,
-    TrailStatus,
     VersionInfo,
 )
 
@@ -49,7 +46,7 @@ __all__ = ["AsyncClient"]
 T = TypeVar("T")
 
 
-class AsyncClient(AsyncLineClient):
+class AsyncClient(AsyncLineClient, AsyncSceneVerbs):
     """An asyncio connection with a coroutine per verb; arguments as ``Client``'s.
 
     It connects when entering ``async with`` or at the first call; after a lost
@@ -184,32 +181,6 @@ class AsyncClient(AsyncLineClient):
         await self.call(calls.QUIT)
         await self.close()
 
-    @speaks("mark")
-    async def mark(self, pose: Sequence[float] | None = None, *, world: bool = False) -> None:
-        """Drop a marker at ``pose`` (x, y, z [m], roll, pitch, yaw [rad, or deg]) in the
-        base frame (``world``: the world frame), or at the tool point without one."""
-        return await self.call(calls.mark(pose, world))
-
-    @speaks("color")
-    async def color(self, r: float, g: float, b: float) -> None:
-        """Colour of this connection's next markers, each channel [0..1]."""
-        return await self.call(calls.color("color", (r, g, b)))
-
-    @speaks("rgb")
-    async def rgb(self, r: float, g: float, b: float) -> None:
-        """Colour of this connection's next markers, each channel [0..255]."""
-        return await self.call(calls.color("rgb", (r, g, b)))
-
-    @speaks("marker")
-    async def marker(self, shape: str) -> None:
-        """Shape of this connection's next markers: sphere, cube, arrow or cylinder."""
-        return await self.call(calls.marker(shape))
-
-    @speaks("clear")
-    async def clear(self) -> None:
-        """Home, and remove every marker."""
-        return await self.call(calls.CLEAR)
-
     @speaks("tool")
     async def tool(self, pose: Sequence[float] | None = None) -> Pose:
         """Set the tool point relative to the end-effector link (x, y, z [m], roll, pitch,
@@ -284,64 +255,3 @@ class AsyncClient(AsyncLineClient):
     async def robots(self) -> dict[str, int | None]:
         """The cell's robots and their command ports."""
         return await self.call(calls.ROBOTS)
-
-    @speaks("unwatch")
-    async def unwatch(self) -> None:
-        """Stop a ``watch`` stream this connection asked with ``send('watch')``."""
-        return await self.call(calls.UNWATCH)
-
-    @speaks("trail")
-    async def trail(self, action: str) -> None:
-        """The tool's trail: ``on`` (a fresh one), ``off`` or ``clear``."""
-        return await self.call(calls.trail(action))
-
-    async def trail_status(self) -> TrailStatus:
-        """Whether the trail is on, and its points."""
-        return await self.call(calls.TRAIL_STATUS)
-
-    @speaks("record")
-    async def record(self, name: str, overwrite: bool = False) -> Path:
-        """Record this connection's robot as ``name`` (.txt, .csv, .html); return the
-        server's recording folder."""
-        return await self.call(calls.record(name, overwrite))
-
-    async def record_stop(self) -> RecordingResult:
-        """End the recording; returns when its files are complete."""
-        return await self.call(calls.RECORD_STOP)
-
-    async def recording(self) -> RecordingStatus | None:
-        """The recording running (None: none)."""
-        return await self.call(calls.RECORDING)
-
-    @speaks("object")
-    async def add_object(
-        self, name: str, shape: str, size: float | Sequence[float], pose: Sequence[float]
-    ) -> None:
-        """Add or replace a workcell object in the base frame: a ``box`` (size sx, sy, sz
-        [m]), ``sphere`` (radius [m]) or ``cylinder`` (radius, length [m], along its z);
-        ``pose`` x, y, z [m], roll, pitch, yaw [rad, or deg] (a sphere: x, y, z)."""
-        return await self.call(calls.add_object(name, shape, size, pose))
-
-    async def remove_object(self, name: str) -> None:
-        """Remove workcell object ``name``."""
-        return await self.call(calls.remove_object(name))
-
-    async def remove_objects(self) -> None:
-        """Remove every workcell object."""
-        return await self.call(calls.REMOVE_OBJECTS)
-
-    @speaks("objects")
-    async def objects(self) -> list[str]:
-        """The workcell objects' names."""
-        return await self.call(calls.OBJECTS)
-
-    @speaks("collisions")
-    async def collisions(self) -> list[tuple[str, str]]:
-        """The colliding pairs now (link or object names)."""
-        return await self.call(calls.COLLISIONS)
-
-    @speaks("guard")
-    async def guard(self, on: bool | None = None) -> bool:
-        """Refuse this connection's commands whose target or path collides (``True``);
-        return whether the guard is on."""
-        return await self.call(calls.guard(on))
