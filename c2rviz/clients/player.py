@@ -117,7 +117,7 @@ def play(
     done = errors = 0
     mode = motion or "off"
     ahead: deque[ScriptLine] = deque()  # sent, reply not read yet
-    lines = script.lines()
+    lines = script.stream()
     sending = True
     last = 0  # the line number a stop is reported at
     try:

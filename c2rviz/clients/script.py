@@ -6,7 +6,7 @@
 still where it was. It keeps only a summary (the command count, the joint counts of
 ``joints`` lines, the highest ``move`` index, the ``# robot:`` header, the last
 ``motion`` mode), so a 59 MB recording costs a few kilobytes. ``check_robot`` then
-checks that summary against the server's robot; ``Script.lines()`` reads the file
+checks that summary against the server's robot; ``Script.stream()`` reads the file
 again, one line at a time, for playing. ``waits_for_the_arm`` and ``motion_after``
 say which lines are answered on arrival. No sockets, nothing printed.
 """
@@ -104,7 +104,12 @@ class Script:
         more = [f"{self.name}: ... and {self.more_problems} more"] if self.more_problems else []
         return [*self.problems, *more]
 
-    def lines(self) -> Generator[ScriptLine, None, None]:
+    @property
+    def lines(self) -> list[ScriptLine]:
+        """Every command line, read into a list: for a short file (a player streams them)."""
+        return list(self.stream())
+
+    def stream(self) -> Generator[ScriptLine, None, None]:
         """The command lines, read from the file again one by one (for playing).
 
         Raises:

@@ -276,7 +276,7 @@ def test_the_player_checks_and_streams_a_long_recording_in_flat_memory(server, t
     assert peak < base + 20, f"checking 62 MB took {peak:.0f} MB, a small file {base:.0f} MB"
     # And playing: the first lines of the big file go out before it is read again whole.
     script = load_script(big)
-    lines = script.lines()
+    lines = script.stream()
     first = next(lines)
     assert first.number == 2 and first.wire == "radians"
     lines.close()

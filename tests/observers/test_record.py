@@ -95,7 +95,7 @@ def test_a_recorded_session_replays_to_the_same_states(
     assert all(source in head[3] for source in sources), head[3]
     script = player.load_script(txt)
     assert script.problems == [] and script.robot == "motoman_sia20d"
-    verbs = [line.wire.split()[0] for line in script.lines()]
+    verbs = [line.wire.split()[0] for line in script.lines]
     assert verbs[:3] == ["radians", "motion", "clear"]
     assert verbs.count("mark") == 4 and verbs.count("marker") == 1 and verbs.count("color") == 1
 
@@ -103,7 +103,7 @@ def test_a_recorded_session_replays_to_the_same_states(
     header, frames = read_frames(table)
     names = load_robot().joint_names
     assert header == ["time", *names, "x", "y", "z", "roll", "pitch", "yaw"]
-    joints_lines = [line.wire for line in script.lines() if line.wire.startswith("joints")]
+    joints_lines = [line.wire for line in script.lines if line.wire.startswith("joints")]
     assert len(frames) == len(joints_lines) > 100  # the moves took over a second each
     robot = load_robot()
     for line, row in zip(joints_lines, frames):  # the file exact, the table to 10 digits
