@@ -247,10 +247,10 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
     if "guard" in given:
         given["guard"] = given["guard"] == "on"
     values.update(given)
-    if "clock" in values:  # a bad clock stops the program here, naming the forms
-        parse_clock(values["clock"], "--clock" if "clock" in given else "[options] clock")
     if "record_dir" in values:
         values["record_dir"] = Path(values["record_dir"])
+    if "clock" in values:  # a bad clock stops the program here, naming the forms
+        parse_clock(values["clock"], "--clock" if "clock" in given else "[options] clock")
     for key in ("package_paths", "xacro_args", "viewer_origins"):
         values[key] = tuple(values.get(key, ()))
     limit_values = {k: values.pop(k) for k in list(values) if k in _LIMIT_FIELDS}

@@ -25,7 +25,6 @@ from ..protocol.grammar import numbers_batch, parse_line
 from ..protocol.registry import HANDLERS, Reply
 from ..robot.frames import pose_se3, se3_pose
 from ..tolerance import within_limit
-from ..world.clock import Clock
 from ..world.moves import Travel
 from ..world.state import RobotState
 from .services import Services
@@ -175,8 +174,8 @@ class Session:
         now = clock.now()
         start = self._pause_end if 0.0 <= now - self._pause_end <= _CADENCE_S else now
         self._pause_end = start + seconds
-        future: asyncio.Future[str] = clock.waiting(asyncio.get_running_loop().create_future())
-        timer = clock.call_at(self._pause_end, _settle, clock, future, reply)
+        future: asyncio.Future[str] = clock.future()  # a reply that waits on the clock
+        timer = clock.call_at(self._pause_end, _settle, future, reply)
         future.add_done_callback(lambda _: timer.cancel())
         return future
 
@@ -220,7 +219,6 @@ class Session:
         return [v / s for v, s in zip(values, self.table.scale)]
 
 
-def _settle(clock: Clock, future: asyncio.Future[str], reply: str) -> None:
+def _settle(future: asyncio.Future[str], reply: str) -> None:
     if not future.done():
-        clock.woke(future)
         future.set_result(reply)

@@ -27,9 +27,9 @@ client would then act later, on the clock, than it would in real time. So:
 - The door runs the client's commands inside ``with hold.acting():`` (for the
   coroutine of a reply that waits, create its task inside the block too). A reply
   that waits on the clock (``sleep``'s end, an arrival, rest after ``stop``/``wait``:
-  ``Session.after`` and ``world.moves.Travels`` make these, through ``waiting``)
-  then releases the hold until it is settled; the hold is taken again the instant it
-  is (``woke``), so the client is busy again before anything else can happen.
+  ``Session.after`` and ``world.moves.Travels`` make these with ``clock.future()``)
+  then releases the hold until it is settled; settling it takes the hold back at
+  once, so the client is busy again before anything else can happen.
 - A door whose client only listens (a ``watch`` stream, a subscription) and sends
   nothing may ``hold.release()`` until it sends again (``hold.take()``).
 - ``with clock.busy():`` holds time for one piece of work that is not a client's.
@@ -47,7 +47,7 @@ import math
 import time
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
-from typing import Any, Protocol, TypeVar
+from typing import Any, Protocol
 
 __all__ = [
     "ACTING",
@@ -57,8 +57,6 @@ __all__ = [
     "ScaledClock",
     "Timer",
 ]
-
-T = TypeVar("T")
 
 
 class Timer(Protocol):
@@ -84,7 +82,7 @@ class Hold:
         """The holder is gone: it holds nothing from now on (``take`` does nothing)."""
 
     def wait_began(self) -> None:
-        """A reply of this holder began waiting on the clock (``Clock.waiting``)."""
+        """A reply of this holder began waiting on the clock (``Clock.future``)."""
 
     def wait_ended(self) -> None:
         """That reply is settled: the holder is busy again."""
@@ -146,13 +144,11 @@ class Clock:
         finally:
             hold.close()
 
-    def waiting(self, future: asyncio.Future[T]) -> asyncio.Future[T]:
-        """``future`` is a reply that waits on this clock (a sleep's end, an arrival): the
-        acting hold (``ACTING``) is released until ``woke(future)``. Returns ``future``."""
-        return future
-
-    def woke(self, future: asyncio.Future[Any]) -> None:
-        """``future`` (from ``waiting``) is about to be settled: its holder is busy again."""
+    def future(self) -> asyncio.Future[Any]:
+        """A reply that waits on this clock (a sleep's end, an arrival, rest), on the running
+        loop. With a virtual clock it releases the acting hold (``ACTING``) until it is
+        settled, and settling it takes the hold back at once."""
+        return asyncio.get_running_loop().create_future()
 
 
 class ScaledClock(Clock):

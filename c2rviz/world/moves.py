@@ -92,7 +92,7 @@ class Travels:
         travel.active = False
         travel.synced = False
         travel.path = None
-        self._settle(travel.rests, replies.OK)
+        _settle(travel.rests, replies.OK)
 
     def go(
         self, state: RobotState, q: Sequence[float], speed: float, source: str, wait: bool
@@ -120,10 +120,10 @@ class Travels:
         self._run(travel)
         if not wait:
             return None
-        arrival = self._waiting()
+        arrival: asyncio.Future[str] = self.clock.future()  # settled, its client is busy
         travel.arrivals.append(arrival)
         if not travel.active:  # already there: nothing to wait for
-            self._settle(travel.arrivals, replies.OK)
+            _settle(travel.arrivals, replies.OK)
         return arrival
 
     def play(
@@ -143,7 +143,7 @@ class Travels:
         self._run(travel)
         if not wait:
             return None
-        arrival = self._waiting()
+        arrival: asyncio.Future[str] = self.clock.future()  # settled, its client is busy
         travel.arrivals.append(arrival)
         return arrival
 
@@ -167,7 +167,7 @@ class Travels:
         travel = self.by_robot[state.name]
         if not travel.active:
             return None
-        future = self._waiting()
+        future: asyncio.Future[str] = self.clock.future()
         travel.rests.append(future)
         return future
 
@@ -227,28 +227,24 @@ class Travels:
                 due = min(due, t + self.frame_s, end)
             else:
                 self.rested(travel.state, travel.stopping)
-                self._settle(travel.arrivals, replies.OK)
-                self._settle(travel.rests, replies.OK)
+                _settle(travel.arrivals, replies.OK)
+                _settle(travel.rests, replies.OK)
         if due < math.inf:
             self._timer = self.clock.call_at(max(due, self.clock.now()), self._tick)
 
-    def _waiting(self) -> asyncio.Future[str]:
-        """A reply that waits for the arm (on the clock: see ``Clock.waiting``)."""
-        return self.clock.waiting(asyncio.get_running_loop().create_future())
-
-    def _interrupt(self, travel: Travel, why: str) -> None:
+    @staticmethod
+    def _interrupt(travel: Travel, why: str) -> None:
         """The running move ends (a new one, or a stop, follows): its waiters hear ``why``."""
         travel.stopping = False
         waiting, travel.arrivals = travel.arrivals, []
         for future in waiting:
             if not future.done():
-                self.clock.woke(future)
                 future.set_exception(MotionInterrupted(why))
 
-    def _settle(self, futures: list[asyncio.Future[str]], reply: str) -> None:
-        waiting = list(futures)
-        futures.clear()
-        for future in waiting:
-            if not future.done():
-                self.clock.woke(future)
-                future.set_result(reply)
+
+def _settle(futures: list[asyncio.Future[str]], reply: str) -> None:
+    waiting = list(futures)
+    futures.clear()
+    for future in waiting:
+        if not future.done():
+            future.set_result(reply)

@@ -22,13 +22,11 @@ import asyncio
 import contextlib
 import heapq
 from collections.abc import Callable
-from typing import Any, TypeVar
+from typing import Any
 
 from .clock import ACTING, Clock, Hold, Timer
 
-__all__ = ["VirtualClock", "VirtualHold"]
-
-T = TypeVar("T")
+__all__ = ["TimedFuture", "VirtualClock", "VirtualHold"]
 
 
 class VirtualHold(Hold):
@@ -83,6 +81,36 @@ class VirtualHold(Hold):
                 clock.poke()
 
 
+class TimedFuture(asyncio.Future[Any]):
+    """A reply that waits on the virtual clock: its client's hold is released while it
+    waits, and taken back the instant it is settled (before any callback runs)."""
+
+    def __init__(self, hold: VirtualHold, *, loop: asyncio.AbstractEventLoop) -> None:
+        super().__init__(loop=loop)
+        self._hold: VirtualHold | None = hold
+        hold.wait_began()
+
+    def _woke(self) -> None:
+        hold, self._hold = self._hold, None
+        if hold is not None:
+            hold.wait_ended()
+
+    def set_result(self, result: Any) -> None:
+        if not self.done():
+            self._woke()
+        super().set_result(result)
+
+    def set_exception(self, exception: type | BaseException) -> None:
+        if not self.done():
+            self._woke()
+        super().set_exception(exception)
+
+    def cancel(self, msg: Any | None = None) -> bool:
+        if not self.done():
+            self._woke()
+        return super().cancel(msg)
+
+
 class _Timer:
     """A timer on the virtual clock (cancelled lazily: it stays in the heap, skipped)."""
 
@@ -118,7 +146,6 @@ class VirtualClock(Clock):
         self._seq = 0
         self._loop: asyncio.AbstractEventLoop | None = None
         self._poked = False
-        self._waits: dict[asyncio.Future[Any], Hold] = {}
         self.busy_count = 0
         self.jumps = 0
 
@@ -147,23 +174,12 @@ class VirtualClock(Clock):
                 self._loop = asyncio.get_running_loop()
         return VirtualHold(self)
 
-    def waiting(self, future: asyncio.Future[T]) -> asyncio.Future[T]:
+    def future(self) -> asyncio.Future[Any]:
+        loop = self._loop = asyncio.get_running_loop()
         hold = ACTING.get()
-        if hold is None or not isinstance(hold, VirtualHold) or future.done():
-            return future
-        self._waits[future] = hold
-        hold.wait_began()
-        future.add_done_callback(self._forget)
-        return future
-
-    def woke(self, future: asyncio.Future[Any]) -> None:
-        hold = self._waits.pop(future, None)
-        if hold is not None:
-            hold.wait_ended()
-
-    def _forget(self, future: asyncio.Future[Any]) -> None:
-        """Settled without ``woke`` (cancelled: its client left): the wait is over."""
-        self.woke(future)
+        if not isinstance(hold, VirtualHold):
+            return loop.create_future()  # nobody's reply (a door without holds): nothing held
+        return TimedFuture(hold, loop=loop)
 
     # Jumping.
 

@@ -118,22 +118,16 @@ def test_due_timers_run_while_held():
     assert asyncio.run(main())
 
 
-def test_a_wait_releases_the_acting_hold_and_waking_takes_it_back_at_once():
+def test_a_wait_releases_the_acting_hold_and_settling_takes_it_back_at_once():
     """Two clients: A sleeps 1 s, B sleeps 2 s. When A's sleep ends, A is busy again
     before anything else runs, so B's timer cannot fire until A says it waits again."""
     clock = VirtualClock()
     log: list[tuple[str, float]] = []
 
     def sleep(hold, seconds: float) -> asyncio.Future[None]:
-        future = asyncio.get_running_loop().create_future()
         with hold.acting():
-            clock.waiting(future)
-
-        def settle() -> None:
-            clock.woke(future)
-            future.set_result(None)
-
-        clock.call_later(seconds, settle)
+            future = clock.future()  # releases `hold` until it is settled
+        clock.call_later(seconds, future.set_result, None)
         return future
 
     async def client(name: str, hold, seconds: float, thinking_turns: int) -> None:
@@ -185,3 +179,18 @@ def test_a_scaled_clock_runs_motion_faster_and_the_world_stamps_its_time():
         assert len(times) > shown * 20
     finally:
         server.stop()
+
+
+def test_a_timed_future_outside_any_hold_is_a_plain_one_and_cancelling_one_ends_its_wait():
+    clock = VirtualClock()
+
+    async def main() -> tuple[bool, int]:
+        plain = clock.future()  # no acting hold: nobody's reply
+        hold = clock.hold()
+        with hold.acting():
+            waiting = clock.future()
+        released = clock.busy_count
+        waiting.cancel()  # its client left
+        return type(plain) is asyncio.Future and released == 0, clock.busy_count
+
+    assert asyncio.run(main()) == (True, 1)
