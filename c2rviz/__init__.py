@@ -2,7 +2,9 @@
 
 A ROS-free re-creation of NIST's "text based command and control of a ROS RViz
 visualization": clients send one-line commands over TCP (port 31000) and the
-arm moves in a viser page. The parts, each usable alone:
+arm moves in a viser page. A controller talks to it with ``Client`` (blocking) or
+``AsyncClient`` (asyncio): one typed method per verb (docs/testing.md). The parts, each
+usable alone:
 
 - ``commands``: the pure parser (line -> frozen command);
 - ``robot`` / ``sources``: the Pinocchio model and its serial chain, and where
@@ -17,17 +19,35 @@ parts (Pinocchio, viser) load when first named.
 """
 
 from importlib import import_module
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # what type checkers see of the lazy names below
+    from .clients.async_client import AsyncClient
+    from .clients.client import Client
+    from .clients.connect import ServerUnavailable
+    from .clients.errors import CommandError, ConnectionLost
+    from .clients.plan_verbs import PlanSummary
+    from .clients.records import Event, JointLimit, Pose, State
 
 __all__ = [
     "__version__",
+    "AsyncClient",
     "C2rvizError",
+    "Client",
+    "CommandError",
+    "ConnectionLost",
     "CommandServer",
+    "Event",
+    "JointLimit",
     "Marker",
+    "PlanSummary",
+    "Pose",
     "RecordingScene",
     "Robot",
     "Scene",
+    "ServerUnavailable",
     "Session",
+    "State",
     "World",
     "parse_line",
 ]
@@ -44,6 +64,22 @@ _HOME = {
     "World": "world.world",
     "parse_line": "protocol.grammar",
 }
+
+
+_HOME.update(  # a controller's side: the clients (no Pinocchio, no viser)
+    {
+        "AsyncClient": "clients.async_client",
+        "Client": "clients.client",
+        "CommandError": "clients.errors",
+        "ConnectionLost": "clients.errors",
+        "Event": "clients.records",
+        "JointLimit": "clients.records",
+        "Pose": "clients.records",
+        "PlanSummary": "clients.plan_verbs",
+        "ServerUnavailable": "clients.connect",
+        "State": "clients.records",
+    }
+)
 
 
 def __getattr__(name: str) -> Any:

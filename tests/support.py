@@ -61,11 +61,15 @@ class ServerThread:
     quit: threading.Event = field(default_factory=threading.Event)
     host: str = "127.0.0.1"
     port: int = 0
+    clock: Any = None  # a world.clock.Clock (default: real time)
+    hz: float = 100.0
+    record_dir: Path | None = None
 
     def start(self) -> ServerThread:
         self.loop = asyncio.new_event_loop()
-        self.world = World(self.robot, self.scene)
-        self.services = Services(self.world, limits=self.limits, exporters=(write_page,))
+        self.world = World(self.robot, self.scene, clock=self.clock, hz=self.hz)
+        folder = {} if self.record_dir is None else {"record_dir": self.record_dir}
+        self.services = Services(self.world, limits=self.limits, exporters=(write_page,), **folder)
         self.server = CommandServer(self.services, on_quit=self.quit.set)
         self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
         self.thread.start()

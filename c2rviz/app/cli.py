@@ -123,6 +123,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add("--hz", type=float, help="most scene updates per second (default 100)")
     add(
+        "--clock",
+        metavar="real|scaled:N|virtual",
+        help="the world's time: real (the default); scaled:N runs N times faster; virtual "
+        "jumps ahead whenever every client waits on the clock (sleep, wait, an arrival), "
+        "so a program runs as fast as the CPU allows (docs/testing.md)",
+    )
+    add(
         "--motion",
         choices=("off", "on", "follow"),
         help="how new connections' moves are shown: off (at once, the default), on (travel, "

@@ -23,6 +23,7 @@ from ..ini import INI_NAME, PROJECT_DIR, find_ini, number, read_ini
 from ..robot.catalogue import catalogue, find_robot
 from ..robot.sources import split_package_path
 from ..session.settings import ServerLimits, SessionDefaults
+from ..world.clocks import parse_clock
 
 __all__ = [
     "INI_NAME",
@@ -127,6 +128,9 @@ class Settings:
     """Serve the robots of this cell (``--cell``): an ini section's name, or an ini file."""
     motion_flags: tuple[tuple[str, str], ...] = ()
     """``--max-velocity`` and the like as given, (key, text), over every robot's ini ones."""
+    clock: str = "real"
+    """The world's clock (``--clock``): ``real``, ``scaled:N`` or ``virtual``
+    (``world.clock.parse_clock``)."""
     robot_flag: bool = False
     """``--robot`` was given."""
     port_flag: bool = False
@@ -175,6 +179,7 @@ _TEXT_OPTIONS = (
     "record_dir",
     "viewer_token",
     "viewer_origins",
+    "clock",
 )
 _CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on", "plan")}
 MOTION_FLAGS = ("max_velocity", "max_acceleration", "max_jerk")
@@ -313,6 +318,8 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
             values[name] = to_si(values.pop(key))
     if "record_dir" in values:
         values["record_dir"] = Path(values["record_dir"])
+    if "clock" in values:  # a bad clock stops the program here, naming the forms
+        parse_clock(values["clock"], "--clock" if "clock" in given else "[options] clock")
     for key in ("package_paths", "xacro_args", "viewer_origins"):
         values[key] = tuple(values.get(key, ()))
     limit_values = {k: values.pop(k) for k in list(values) if k in _LIMIT_FIELDS}

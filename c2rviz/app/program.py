@@ -23,6 +23,7 @@ from ..protocol.verbs.record import Record
 from ..session.services import Services
 from ..transports.tcp_server import CommandServer
 from ..world.clock import Clock
+from ..world.clocks import parse_clock
 from ..world.effects import NullScene, Scene
 from ..world.state import RobotState
 from ..world.world import World
@@ -47,6 +48,10 @@ def _is_loopback(host: str) -> bool:
 
 
 _STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+_CLOCK_NOTES = {
+    False: "motion, sleep, watch stamps and recordings run on it",
+    True: "time jumps ahead whenever every client waits on it: sleep, wait, an arrival",
+}
 
 
 def write_page(recorded: Recorded, state: RobotState) -> Path:
@@ -109,6 +114,8 @@ async def serve(
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
     srdf = read_srdf(settings.srdf) if settings.srdf is not None else None
+    if clock is None:
+        clock = parse_clock(settings.clock)
     world = World(
         {m.name: m.robot for m in members},
         clock=clock,
@@ -186,6 +193,8 @@ async def serve(
         _banner(member, settings.host, world.state(member.name).port, cell is not None)
     for entry in doors:
         print(f"c2rviz: {entry.banner}", flush=True)
+    if clock.describe() != "real":
+        print(f"c2rviz: clock {clock.describe()} ({_CLOCK_NOTES[clock.virtual]})", flush=True)
     if scene.url:
         print(f"c2rviz: viewer at {scene.url}", flush=True)
     if not _is_loopback(settings.host):

@@ -109,7 +109,7 @@ def stream(client: Client, lines: Iterable[str], window: int, err: TextIO, name:
         return False
 
     for line in lines:
-        client.send(line)
+        client.post(line)
         sent.append(line)
         if len(sent) >= window and not settle():
             while sent:  # what was sent ahead has run: read its replies
@@ -134,7 +134,7 @@ def _plan(args: argparse.Namespace, client: Client | None) -> tuple[BagSpan, lis
         else:
             assert client is not None
             chain = client.joint_names()
-            robot = client.robot
+            robot = client.robot_name
             limits = client.limits()
         span = BagSpan(bag, chain, args.start, args.duration, args.speed)
         warnings = check_span(span, limits)
@@ -238,7 +238,7 @@ def play_in_repl(client: Client, path: str, rate: float, out: TextIO) -> int:
     except C2rvizError as exc:
         print(f"{exc}; nothing was sent", file=out, flush=True)
         return 1
-    degrees, motion = client.degrees, client.motion()
+    degrees, motion = client.in_degrees, client.motion()
     with contextlib.closing(span.bag):
         for warning in warnings:
             print(f"warning: {path}: {warning}", file=out, flush=True)

@@ -1,29 +1,46 @@
-"""The controller side of the wire, shared by the REPL and the player.
+"""``Client``: a controller's blocking connection to c2rviz, one typed method per verb.
 
-A ``Client`` is one TCP connection to the command server: it connects with
-retries (``dial``: the server may not be up yet, or may be restarting), sends
-one line and reads its one reply, and remembers the connection's unit mode and
-chosen robot so that they are restored after a reconnect. It imports the parser and the settings
-reader only: never Pinocchio or viser, so the clients start in a blink.
-Where the server is (flags, ini) and where command files are found is in
-``client_options``, re-exported here.
+::
+
+    from c2rviz import Client
+
+    with Client(port=31000) as robot:
+        robot.motion("on")
+        robot.joints([0.5, 0, 0, 0, 0, 0, 0])   # [rad]; returns when the arm arrives
+        print(robot.where(), robot.pose())
+
+Every verb of the command language (``protocol.registry.VERBS``) has a method here
+(``speaks`` tags it; a test fails when a verb has none) taking typed arguments and
+returning a typed result (``records``). Angles are radians, lengths metres, unless the
+connection chose degrees (``degrees()`` or ``Client(degrees=True)``): then angles are
+degrees, both ways. Arguments are checked before anything is sent (``calls``); an
+``error:`` reply raises ``CommandError`` with the server's message; a server gone
+mid-call raises ``ConnectionLost`` (a ``ConnectionError``) naming the command.
+``send(line)`` sends any line as typed. The REPL and the player use this client too.
 """
 
 from __future__ import annotations
 
-import select
-import socket
-from collections import deque
-from collections.abc import Callable
+from collections.abc import Sequence
+from typing import TypeVar
 
-from ..errors import C2rvizError
-from ..protocol.grammar import parse_line
-from ..protocol.verbs.cell import RobotChoice
-from ..protocol.verbs.joints import Units
-from ..protocol.verbs.motion import MOTION_MODES
-from ..protocol.verbs.queries import Where
-from .connect import ServerUnavailable, dial
+from . import calls, records
+from .calls import Call, count_problem, read_call, speaks
+from .connect import ServerUnavailable
+from .errors import CommandError, ConnectionLost
+from .lines import LineClient
 from .options import COMMANDS_DIR, add_connection_args, default_address, find_script, server_address
+from .plan_verbs import PlanVerbs
+from .records import (
+    JointLimit,
+    MotionLimit,
+    MotionStatus,
+    Pose,
+    RobotNames,
+    VersionInfo,
+)
+from .scene_verbs import SceneVerbs
+from .stream import WatchStream
 
 __all__ = [
     "COMMANDS_DIR",
@@ -33,277 +50,241 @@ __all__ = [
     "add_connection_args",
     "default_address",
     "find_script",
-    "motion_of",
     "server_address",
 ]
 
-_FIRST_DELAY_S = 0.05
-_UNKNOWN_COMMAND = "error: unknown command"
-_MAX_DELAY_S = 1.0
+T = TypeVar("T")
 
 
-class ConnectionLost(C2rvizError):
-    """The server closed the connection (it stopped, restarted or dropped us)."""
+class Client(LineClient, SceneVerbs, PlanVerbs):
+    """A blocking connection with a method per verb; see the module docstring.
 
-    def __init__(self, host: str, port: int) -> None:
-        self.host = host
-        self.port = port
-        super().__init__(f"connection to {host}:{port} lost (the server stopped or restarted)")
+    Args (all but host and port by keyword):
+        host, port: The command server (default 127.0.0.1:31000).
+        timeout: Longest wait for one reply [s]; None (the default): no limit, as a reply
+            may follow a long move. Past it ``ReplyTimeout`` (a ``TimeoutError``).
+        retry_s: How long to keep retrying a refused connection [s] (default 10).
+        degrees: Speak degrees from the start.
+        robot: Drive this robot of a cell.
+        max_reply: Longest reply line [bytes] (default 1 MiB).
+        notify: Called with a short message when retrying to connect begins.
 
-
-def motion_of(reply: str) -> str | None:
-    """The connection's motion mode from the reply to a bare ``motion``.
-
-    Args:
-        reply: The server's reply: ``ok off|on|follow``, or an older server's
-            ``error: unknown command 'motion' ...``.
-
-    Returns:
-        ``off``, ``on`` or ``follow``; None when the server has no motion.
-
-    Raises:
-        C2rvizError: any other reply.
-    """
-    if reply.startswith("ok "):
-        mode = reply[3:].strip()
-        if mode in MOTION_MODES:
-            return mode
-    elif reply.startswith(_UNKNOWN_COMMAND):
-        return None
-    raise C2rvizError(f"unexpected reply to 'motion': {reply!r}")
-
-
-class Client:
-    """One connection to the command server: a line out, a reply line back, in order.
-
-    The connection opens lazily (``open`` or the first ``send``). Replies are
-    matched to lines by order, so several lines may be sent before their
-    replies are read (pipelining). An interrupted read or write leaves the
-    stream out of step, so the connection is closed; the next ``send``
-    reconnects and restores the unit mode and the robot chosen.
-
-    Attributes:
-        degrees: The connection's angle unit as last confirmed by the server.
-        chosen_robot: The robot a ``robot NAME`` line chose (the server said ``ok``);
-            None: the port's own robot.
-        robot, joint_names: From ``names``, once ``joint_names()`` has asked (asked
-            again after ``robot NAME``).
+    It connects when entering ``with`` or at the first call; after a lost connection the
+    next call reconnects (restoring the units and the robot).
     """
 
-    def __init__(
-        self,
-        host: str,
-        port: int,
-        *,
-        retry_s: float = 10.0,
-        notify: Callable[[str], None] | None = None,
-    ) -> None:
-        """Args:
-        host, port: The command server.
-        retry_s: How long to keep retrying a refused connection [s].
-        notify: Called with a short message when retrying begins.
-        """
-        self.host = host
-        self.port = port
-        self.retry_s = retry_s
-        self.notify = notify
-        self.degrees = False
-        self.chosen_robot: str | None = None
-        self.robot: str | None = None
-        self._names: tuple[str, ...] | None = None
-        self._sock: socket.socket | None = None
-        self._received = bytearray()  # read from the socket, not yet a whole reply
-        self._sent: deque[Units | RobotChoice | None] = deque()  # one per reply to read
-
-    @property
-    def is_open(self) -> bool:
-        return self._sock is not None
-
-    @property
-    def pending(self) -> int:
-        """Lines sent whose replies have not been read yet."""
-        return len(self._sent)
-
-    def open(self) -> None:
-        """Connect (retrying with backoff up to ``retry_s``) and restore the unit mode.
-
-        Raises:
-            ServerUnavailable: nothing accepted the connection in time.
-        """
-        if self._sock is not None:
-            return
-        sock = dial(self.host, self.port, self.retry_s, self.notify)
-        self._sock = sock
-        self._received.clear()
-        self._sent.clear()
-        self._names = None
-        if self.chosen_robot is not None:
-            reply = self.ask(f"robot {self.chosen_robot}")
-            if not reply.startswith("ok"):  # the restarted server has no such robot
-                self.chosen_robot = None
-        if self.degrees:
-            reply = self.ask("degrees")
-            if not reply.startswith("ok"):  # pragma: no cover - the server always accepts it
-                self.degrees = False
-
-    def alive(self) -> bool:
-        """False when the server has closed this idle connection (the socket reads EOF).
-
-        Checks without blocking; a closed connection is closed here too, so the
-        next ``send`` reconnects. Only meaningful with no replies pending.
-        """
-        sock = self._sock
-        if sock is None or self._sent:
-            return sock is not None
-        try:
-            readable, _, _ = select.select([sock], [], [], 0)
-            if not readable or sock.recv(1, socket.MSG_PEEK):
-                return True
-        except OSError:
-            pass
-        self.close()
-        return False
-
-    def close(self) -> None:
-        """Close the connection (a later ``send`` reconnects)."""
-        sock, self._sock = self._sock, None
-        self._sent.clear()
-        self._received.clear()
-        if sock is not None:
-            sock.close()
-
-    def send(self, line: str) -> bool:
-        """Send one command line; return False (sending nothing) for a blank/comment line.
-
-        Raises:
-            ConnectionLost: the server is gone.
-            ServerUnavailable: reconnecting failed.
-        """
-        try:
-            command = parse_line(line)
-        except C2rvizError:
-            command = Where()  # the server will answer with an error: one reply all the same
-        if command is None:
-            return False
+    def __enter__(self) -> Client:
         self.open()
-        assert self._sock is not None
-        try:
-            self._sock.sendall(line.rstrip("\r\n").encode() + b"\n")
-        except OSError:
-            self.close()
-            raise ConnectionLost(self.host, self.port) from None
-        except BaseException:  # interrupted mid-line: the stream is out of step
-            self.close()
-            raise
-        self._sent.append(command if isinstance(command, (Units, RobotChoice)) else None)
-        return True
+        return self
 
-    def read_reply(self, *, interruptible: bool = False) -> str:
-        """The reply to the oldest unanswered line, without its newline.
-
-        Args:
-            interruptible: Ctrl-C while waiting leaves the connection open and the
-                reply still due (the caller reads it later, e.g. after sending
-                ``stop`` on another connection). By default the connection is
-                closed, since the reply would otherwise arrive late.
+    def call(self, call: Call[T]) -> T:
+        """Send ``call``'s line and read its reply (every earlier reply must be read).
 
         Raises:
-            ConnectionLost: the server closed the connection first.
+            CommandError, ConnectionLost, ServerUnavailable, UnexpectedReply, ArgumentError.
         """
-        if not self._sent or self._sock is None:
-            raise RuntimeError("read_reply() with no line waiting for its reply")
-        try:
-            raw = self._read_line()
-        except OSError:
-            raw = b""
-        except BaseException:  # Ctrl-C while waiting: what arrived stays in the buffer
-            if not interruptible:
-                self.close()
-            raise
-        if not raw.endswith(b"\n"):
-            self.close()
-            raise ConnectionLost(self.host, self.port)
-        tracked = self._sent.popleft()
-        reply = raw.decode("utf-8", "replace").rstrip("\r\n")
-        if reply.startswith("ok"):
-            if isinstance(tracked, Units):
-                self.degrees = tracked.degrees
-            elif isinstance(tracked, RobotChoice) and tracked.name is not None:
-                self.chosen_robot = tracked.name
-                self._names = None  # another robot: other joints
+        if self.pending:
+            raise RuntimeError(f"a call with {self.pending} replies unread")
+        if call.joint_count is not None or call.highest_index is not None:
+            names = self.joint_names()
+            count_problem(call, self.robot_name or "the robot", names)
+        self._post(call.line, call.track, call.data)
+        return read_call(call, self.read_reply())
+
+    def send(self, line: str) -> str:
+        """Send one line as typed; return its ``ok`` reply (the whole line).
+
+        Raises:
+            CommandError: the reply is ``error: ...``.
+            ValueError: the line is blank or only a comment (nothing would answer).
+        """
+        reply = self.ask(line)
+        if reply.startswith("error"):
+            raise CommandError(line.strip(), reply)
         return reply
 
-    def _read_line(self) -> bytes:
-        """The next line from the server with its newline; at EOF what came (maybe b"").
+    @speaks("watch")
+    def watch(self, hz: float | None = None) -> WatchStream:
+        """The ``watch`` stream, on a connection of its own (this one's robot and units):
+        iterate it for ``State`` and ``Event`` records; ``close()`` it (or use ``with``).
 
-        An interrupted wait loses nothing: what has arrived stays in the buffer.
+        Args:
+            hz: Most ``state`` lines a second [1/s] (None: the server's frame rate).
         """
-        assert self._sock is not None
-        received = self._received
-        searched = 0
-        while (end := received.find(b"\n", searched)) < 0:
-            searched = len(received)
-            chunk = self._sock.recv(65536)
-            if not chunk:
-                line = bytes(received)
-                received.clear()
-                return line
-            received += chunk
-        line = bytes(received[: end + 1])
-        del received[: end + 1]
-        return line
+        return WatchStream(
+            self.host,
+            self.port,
+            hz,
+            degrees=self.in_degrees,
+            robot=self.chosen_robot,
+            max_line=self.max_reply,
+        )
 
-    def ask(self, line: str) -> str:
-        """Send ``line`` and return its reply (every earlier reply must have been read)."""
-        if self.pending:
-            raise RuntimeError(f"ask() with {self.pending} replies unread")
-        if not self.send(line):
-            raise ValueError(f"{line!r} is not a command: the server would not answer")
-        return self.read_reply()
+    # The joints.
 
-    def joint_names(self) -> tuple[str, ...]:
-        """The chain's joint names, in index order (asked once per connection).
+    @speaks("joints")
+    def joints(self, values: Sequence[float]) -> None:
+        """Set all chain joints [rad, or deg; m for a prismatic joint]: at once (``motion
+        off``), or travelling (``on``: returns on arrival; ``follow``: at once)."""
+        return self.call(calls.joints(values))
 
-        Raises:
-            C2rvizError: the server answered ``names`` with an error.
-        """
-        self.open()
-        if self._names is None:
-            reply = self.ask("names")
-            robot, _, names = reply[3:].rpartition(" ")
-            if not reply.startswith("ok ") or not robot:
-                raise C2rvizError(f"unexpected reply to 'names': {reply!r}")
-            self.robot = robot
-            self._names = tuple(names.split(","))
-        return self._names
+    @speaks("move")
+    def move(self, indices: Sequence[int] | int, values: Sequence[float]) -> None:
+        """Set the joints at ``indices`` to ``values`` [rad, or deg; m], the rest stay."""
+        return self.call(calls.move(indices, values))
 
-    def limits(self) -> list[tuple[float, float, str]]:
-        """Each chain joint's (lower, upper, unit), in the connection's units."""
-        reply = self.ask("limits")
-        try:
-            if not reply.startswith("ok "):
-                raise ValueError(reply)
-            out = []
-            for item in reply[3:].split(","):
-                span, unit = item.split(" ")
-                lower, upper = span.split("..")
-                out.append((float(lower), float(upper), unit))
-            return out
-        except ValueError:
-            raise C2rvizError(f"unexpected reply to 'limits': {reply!r}") from None
+    @speaks("home")
+    def home(self) -> None:
+        """Every chain joint to 0 (or its nearest limit)."""
+        return self.call(calls.HOME)
 
-    def where(self) -> list[float]:
-        """The joint values in the connection's units."""
-        reply = self.ask("where")
-        if not reply.startswith("ok "):
-            raise C2rvizError(f"unexpected reply to 'where': {reply!r}")
-        return [float(v) for v in reply[3:].split(",")]
+    @speaks("rand")
+    def rand(self) -> None:
+        """Every chain joint to a random value within its limits (free, with the guard)."""
+        return self.call(calls.RAND)
 
-    def motion(self) -> str | None:
-        """The connection's motion mode (``off``, ``on``, ``follow``); None when the
-        server has no motion (it predates the ``motion`` verb).
+    @speaks("degrees")
+    def degrees(self) -> None:
+        """Angles of this connection in degrees from now on, both ways."""
+        return self.call(calls.DEGREES)
 
-        Raises:
-            C2rvizError: the server answered ``motion`` with something else.
-        """
-        return motion_of(self.ask("motion"))
+    @speaks("radians")
+    def radians(self) -> None:
+        """Angles of this connection in radians from now on (the default)."""
+        return self.call(calls.RADIANS)
+
+    # Questions.
+
+    @speaks("where")
+    def where(self) -> tuple[float, ...]:
+        """The chain's joint values now [rad, or deg; m] (mid-move too)."""
+        return self.call(calls.WHERE)
+
+    @speaks("pose")
+    def pose(self) -> Pose:
+        """The tool pose in the base frame: x, y, z [m], roll, pitch, yaw [rad, or deg]."""
+        return self.call(calls.POSE)
+
+    @speaks("limits")
+    def limits(self) -> list[JointLimit]:
+        """Each chain joint's range [rad, or deg; m] and unit, in index order."""
+        return self.call(calls.LIMITS)
+
+    @speaks("limits")
+    def motion_limits(self) -> list[MotionLimit]:
+        """Each chain joint's velocity, acceleration and jerk limits [rad, or deg; m per s,
+        s^2, s^3] (``limits all``)."""
+        return self.call(calls.MOTION_LIMITS)
+
+    @speaks("names")
+    def names(self) -> RobotNames:
+        """The robot this connection drives and its chain's joint names, in index order."""
+        names = self.call(calls.NAMES)
+        self.robot_name, self._names = names  # what a joint count is checked against
+        return names
+
+    @speaks("version")
+    def version(self) -> VersionInfo:
+        """The server's version and the robot file it loaded."""
+        return self.call(calls.VERSION)
+
+    @speaks("help")
+    def help(self) -> list[str]:
+        """Every verb's usage, as the server lists them."""
+        return self.call(calls.HELP)
+
+    # The connection.
+
+    @speaks("sleep")
+    def sleep(self, seconds: float) -> None:
+        """Pause this connection for ``seconds`` [s of the server's clock] (others go on)."""
+        return self.call(calls.sleep(seconds))
+
+    @speaks("bye")
+    def bye(self) -> None:
+        """Close this connection politely (a later call reconnects)."""
+        self.call(calls.BYE)
+        self.close()
+
+    @speaks("quit")
+    def quit(self) -> None:
+        """Stop the server (command server and viewer); this connection closes."""
+        self.call(calls.QUIT)
+        self.close()
+
+    # The tool point.
+
+    @speaks("tool")
+    def tool(self, pose: Sequence[float] | None = None) -> Pose:
+        """Set the tool point relative to the end-effector link (x, y, z [m], roll, pitch,
+        yaw [rad, or deg]) for every connection; return it (without ``pose``: as it is)."""
+        return self.call(calls.tool(pose))
+
+    @speaks("ik")
+    def ik(self, pose: Sequence[float]) -> tuple[float, ...]:
+        """Joint values [rad, or deg; m] that put the tool point at ``pose`` (x, y, z [m],
+        roll, pitch, yaw [rad, or deg]); nothing moves."""
+        return self.call(calls.ik(pose))
+
+    @speaks("moveto")
+    def moveto(self, pose: Sequence[float] | None = None, *, marker: int | None = None) -> None:
+        """Go to a tool pose (x, y, z [m], roll, pitch, yaw [rad, or deg]) through joint
+        space, or to marker N's pose (1: the oldest)."""
+        return self.call(calls.moveto(pose, marker))
+
+    @speaks("movel")
+    def movel(self, pose: Sequence[float]) -> None:
+        """The tool point travels a straight line to ``pose`` (x, y, z [m], roll, pitch,
+        yaw [rad, or deg]) at this connection's ``lspeed``."""
+        return self.call(calls.movel(pose))
+
+    @speaks("lspeed")
+    def lspeed(self, m_s: float | None = None) -> float:
+        """Set ``movel``'s tool speed [m/s] (0 < V <= 5); return it (without one: as it is)."""
+        return float(self.call(calls.setting("lspeed", "m_s", m_s, records.read_number)))
+
+    # Motion.
+
+    @speaks("motion")
+    def motion(self, mode: str | None = None) -> str:
+        """Set how this connection's moves travel: ``off`` (at once), ``on`` (the call
+        returns on arrival) or ``follow`` (travel, return at once); return the mode."""
+        return self.call(calls.motion(mode))
+
+    @speaks("speed")
+    def speed(self, percent: float | None = None) -> float:
+        """Set this connection's moves to ``percent`` [% of the joints' limits, 1..100];
+        return it (without one: as it is)."""
+        return float(self.call(calls.setting("speed", "percent", percent, records.read_number)))
+
+    @speaks("stop")
+    def stop(self) -> None:
+        """Bring the arm to rest within its limits; returns when it is."""
+        return self.call(calls.STOP)
+
+    @speaks("wait")
+    def wait(self) -> None:
+        """Return when the arm is at rest."""
+        return self.call(calls.WAIT)
+
+    @speaks("target")
+    def target(self) -> tuple[float, ...]:
+        """The joint values the arm is moving to, or stands at [rad, or deg; m]."""
+        return self.call(calls.TARGET)
+
+    @speaks("status")
+    def status(self) -> MotionStatus:
+        """Whether the arm moves, and the seconds until it is at rest [s of the server's clock]."""
+        return self.call(calls.STATUS)
+
+    # Cells.
+
+    @speaks("robot")
+    def robot(self, name: str | None = None) -> str:
+        """Drive robot ``name`` of the cell from now on; return the robot driven."""
+        return self.call(calls.robot(name))
+
+    @speaks("robots")
+    def robots(self) -> dict[str, int | None]:
+        """The cell's robots and their command ports."""
+        return self.call(calls.ROBOTS)

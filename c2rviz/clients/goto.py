@@ -1,6 +1,6 @@
 """The REPL's ``goto``: to a joint target by the server's motion, else in small steps.
 
-A server that knows ``motion`` (``Client.motion`` says which mode) plans the
+A server that knows ``motion`` (``motion_of`` reads which mode) plans the
 move itself: ``travel`` switches the connection to ``motion on``, sends one
 ``joints`` line, whose reply comes when the arm arrives, and puts the mode
 back; Ctrl-C meanwhile sends ``stop`` on a second connection (the first one's
@@ -9,7 +9,7 @@ stopped by ...``. A server from before motion answers ``error: unknown command
 'motion'``; there ``step`` sends ``joints`` lines a small step apart at a rate,
 as the first c2rviz did.
 
-Values are in the connection's units (``Client.degrees``) throughout.
+Values are in the connection's units (``Client.in_degrees``) throughout.
 """
 
 from __future__ import annotations
@@ -19,18 +19,36 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ..errors import JointCountError, JointLimitError
+from ..errors import C2rvizError, JointCountError, JointLimitError
+from ..protocol.verbs.motion import MOTION_MODES
 from ..tolerance import within_limit
 from .client import Client
 
 __all__ = [
     "Arrival",
+    "motion_of",
     "Stepped",
     "step",
     "stop_elsewhere",
     "target_problem",
     "travel",
 ]
+
+
+def motion_of(reply: str) -> str | None:
+    """The connection's motion mode from the reply to a bare ``motion``; None when the
+    server has no motion (an older server's ``error: unknown command 'motion' ...``).
+
+    Raises:
+        C2rvizError: any other reply.
+    """
+    if reply.startswith("ok "):
+        mode = reply[3:].strip()
+        if mode in MOTION_MODES:
+            return mode
+    elif reply.startswith("error: unknown command"):
+        return None
+    raise C2rvizError(f"unexpected reply to 'motion': {reply!r}")
 
 
 def target_problem(client: Client, target: Sequence[float]) -> str | None:
@@ -41,9 +59,9 @@ def target_problem(client: Client, target: Sequence[float]) -> str | None:
     names = client.joint_names()
     if len(target) != len(names):
         return str(JointCountError(len(names), len(target)))
-    for i, (value, (lower, upper, unit)) in enumerate(zip(target, client.limits())):
-        if not within_limit(value, lower, upper):
-            return str(JointLimitError(names[i], i, value, lower, upper, unit))
+    for i, (value, limit) in enumerate(zip(target, client.limits())):
+        if not within_limit(value, limit.lower, limit.upper):
+            return str(JointLimitError(names[i], i, value, limit.lower, limit.upper, limit.unit))
     return None
 
 
@@ -75,7 +93,7 @@ def travel(client: Client, target: Sequence[float], mode: str) -> Arrival:
     Args:
         client: A connection with no unread replies, to a server with motion.
         target: The joint values, in the connection's units (checked already).
-        mode: The connection's motion mode now (``Client.motion``): it is put back.
+        mode: The connection's motion mode now (``motion_of``): it is put back.
 
     Raises:
         ConnectionLost, ServerUnavailable: the server went away.
@@ -88,7 +106,7 @@ def travel(client: Client, target: Sequence[float], mode: str) -> Arrival:
     start = time.monotonic()
     interrupted = False
     try:
-        client.send(_joints(target))
+        client.post(_joints(target))
         reply = client.read_reply(interruptible=True)
     except KeyboardInterrupt:
         if not client.pending:  # before the line was out: nothing moves, nothing is due

@@ -1,4 +1,5 @@
-"""What a client takes from its flags and the ini: where the server is, where command files are.
+"""What a client takes from its flags and the ini: where the server is, where command files are
+(the working directory, then the recording folder, then the project's ``commands/``).
 
 Shared by ``c2rviz-cli`` and ``c2rviz-play`` (re-exported by ``client``). It reads
 the ini with the settings reader alone: no robot is loaded.
@@ -9,13 +10,15 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..ini import PROJECT_DIR, address, find_ini
+from ..errors import C2rvizError
+from ..ini import INI_NAME, PROJECT_DIR, address, find_ini, read_ini
 
 __all__ = [
     "COMMANDS_DIR",
     "add_connection_args",
     "default_address",
     "find_script",
+    "recording_folder",
     "server_address",
 ]
 
@@ -74,16 +77,39 @@ def server_address(
     return host or ini_host, ini_port if port is None else port
 
 
-def find_script(name: str | Path) -> Path:
-    """A command file: ``name`` relative to the working directory, else in ``commands/``.
+def recording_folder(config: str | Path | None = None) -> Path:
+    """Where the server puts recordings, as a client reads the ini: the user's ini's
+    ``[options] record_dir`` (relative to that ini), else ``./recordings`` of the working
+    directory (the project's own ini does not count: its folder is not the user's).
+
+    A bad or unreadable ini is no reason to fail a search: ``./recordings`` then.
+    """
+    here = Path.cwd() / "recordings"
+    try:
+        ini = find_ini(config)
+        if ini is None or ini.resolve() == (PROJECT_DIR / INI_NAME).resolve():
+            return here
+        folder = read_ini(ini).get("options", "record_dir", fallback=None)
+    except C2rvizError:
+        return here
+    return here if not folder else ini.parent / folder
+
+
+def find_script(name: str | Path, config: str | Path | None = None) -> Path:
+    """A command file: ``name`` as given (relative to the working directory), else in
+    the recording folder (``recording_folder``), else in the project's ``commands/``.
 
     Raises:
-        FileNotFoundError: in neither place (the message names both).
+        FileNotFoundError: in none of them (the message names each place looked in).
     """
     path = Path(name)
     if path.is_file():
         return path
-    bundled = COMMANDS_DIR / path
-    if not path.is_absolute() and bundled.is_file():
-        return bundled
-    raise FileNotFoundError(f"no command file {str(name)!r} here or in {COMMANDS_DIR}")
+    looked = [str(path if path.is_absolute() else Path.cwd() / path)]
+    if not path.is_absolute():
+        for folder in (recording_folder(config), COMMANDS_DIR):
+            candidate = folder / path
+            if candidate.is_file():
+                return candidate
+            looked.append(str(candidate))
+    raise FileNotFoundError(f"no command file {str(name)!r}: looked for {', '.join(looked)}")

@@ -1,10 +1,13 @@
 """``c2rviz-play``: check a command file with the server's own parser, then play it.
 
 The whole file is parsed with ``c2rviz.protocol.parse_line`` before anything is
-sent, so a typo on line 40 is reported as ``file:40: error: ...`` while the
-robot is still where it was. Once connected, the joint counts of ``joints``
-lines and the indices of ``move`` lines are checked against the server's
-robot (``names``), again before the first line is sent; a file that declares
+sent, so a typo on line 40 is reported as ``file:40: error: ...`` (every such
+line, up to ``script.MAX_PROBLEMS``) while the robot is still where it was; then the
+file is read again line by line as it plays, so a long recording costs no more
+memory than a short one. FILE is found as given, else in the recording folder, else
+in the project's ``commands/`` (``options.find_script``). Once connected, the joint
+counts of ``joints`` lines and the indices of ``move`` lines are checked against the
+server's robot (``names``), again before the first line is sent; a file that declares
 its robot in its opening comments (a ``# robot: NAME`` line) and finds another
 one at the server is warned about, or refused with ``--strict``. Then every command
 line is sent and its reply shown; the first ``error:`` reply stops the play
@@ -28,11 +31,13 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from collections import deque
 from collections.abc import Sequence
+from pathlib import Path
 from typing import TextIO
 
 from ..errors import C2rvizError
-from ..protocol.verbs.connection import Bye, Quit, Sleep
+from ..protocol.verbs.connection import Sleep
 from ..protocol.verbs.motion import MOTION_MODES, MotionMode
 from .bag_play import add_bag_args, is_bag
 from .bag_play import run as play_bag
@@ -44,6 +49,7 @@ from .client import (
     find_script,
     server_address,
 )
+from .goto import motion_of
 from .progress import Progress
 from .script import (
     Script,
@@ -54,6 +60,7 @@ from .script import (
     robot_mismatch,
     waits_for_the_arm,
 )
+from .text import shown
 
 __all__ = [
     "Progress",
@@ -86,11 +93,12 @@ def play(
     prefix: str = "",
     motion: str | None = None,
 ) -> int:
-    """Send every line of ``script`` and show its reply; return how many got an error.
+    """Send every line of ``script`` (read from its file as it goes) and show its reply;
+    return how many got an error.
 
     Args:
         client: An open or openable connection with no unread replies.
-        script: A script with no ``problems``.
+        script: A checked script with no ``problems``.
         show: Where lines, replies and errors go.
         speed: Sleeps are divided by this.
         keep_going: Go on after an ``error:`` reply.
@@ -104,23 +112,35 @@ def play(
     Raises:
         ConnectionLost: the server went away (already reported through ``show``).
         KeyboardInterrupt: Ctrl-C (reported through ``show``).
+        C2rvizError: the file changed since it was checked (reported through ``show``).
     """
-    lines = script.lines
-    n = len(lines)
+    n = script.count
     width = len(str(n))
-    sent = done = errors = 0
-    stop = n
+    done = errors = 0
     mode = motion or "off"
+    ahead: deque[ScriptLine] = deque()  # sent, reply not read yet
+    lines = script.stream()
+    sending = True
+    last = 0  # the line number a stop is reported at
     try:
-        while done < stop:
-            while sent < stop and sent - done < window:
-                client.send(_wire(lines[sent], speed))
-                sent += 1
-            line = lines[done]
+        while True:
+            while sending and len(ahead) < window:
+                next_line = next(lines, None)
+                if next_line is None:
+                    sending = False
+                    break
+                client.post(_wire(next_line, speed))
+                ahead.append(next_line)
+                last = next_line.number
+            if not ahead:
+                break
+            line = ahead[0]
+            last = line.number
             label = f"[{prefix}{done + 1:>{width}}/{n}]"
             if waits_for_the_arm(line.command, mode):
                 show.waiting(label, line.wire, "moving")
             reply = client.read_reply()
+            ahead.popleft()
             done += 1
             show.step(label, line.wire, reply)
             if isinstance(line.command, MotionMode) and line.command.mode and reply == "ok":
@@ -129,13 +149,18 @@ def play(
                 errors += 1
                 show.error(f"{script.name}:{line.number}: {reply}")
                 if not keep_going:
-                    stop = sent  # what is already sent has run: show its replies
+                    sending = False  # what is already sent has run: show its replies
     except ConnectionLost as exc:
-        show.error(script.problem(lines[min(done, n - 1)].number, exc))
+        show.error(script.problem(last, exc))
         raise
     except KeyboardInterrupt:
-        show.error(f"{script.name}:{lines[min(done, n - 1)].number}: interrupted")
+        show.error(f"{script.name}:{last}: interrupted")
         raise
+    except C2rvizError as exc:
+        show.error(str(exc))
+        raise
+    finally:
+        lines.close()
     show.end_line()
     return errors
 
@@ -147,7 +172,7 @@ def build_parser() -> argparse.ArgumentParser:
         "each line is sent, its reply shown; the first error stops the play.",
         epilog="Exit status: 0 all lines ok; 1 a line got an error or no server; "
         "2 the file or an option does not check, or the server refused --motion "
-        "(nothing was sent). FILE is looked for here, "
+        "(nothing was sent). FILE is looked for here, then in the recording folder, "
         "then in the project's commands/. A '# robot: NAME' line in the file's "
         "opening comments names the robot it is for.",
     )
@@ -223,29 +248,30 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("c2rviz-play: --loop must be >= 0 and --window >= 1", file=err)
         return 2
     try:
-        path = find_script(args.file)
+        path = find_script(args.file, args.config)
         script = load_script(path, args.file)
         host, port = server_address(args.host, args.port, args.config)
     except (OSError, C2rvizError) as exc:
         print(f"c2rviz-play: {exc}", file=err)
         return 2
     if script.problems:
-        return _fail(script.problems, script.name, err)
-    closes = [line for line in script.lines if isinstance(line.command, (Bye, Quit))]
-    if closes and args.loop != 1:
+        return _fail(script.all_problems(), script.name, err)
+    if path != Path(args.file):
+        print(f"c2rviz-play: playing {path}", file=err, flush=True)
+    if script.closes is not None and args.loop != 1:
         problem = script.problem(
-            closes[0].number, "cannot --loop a file that closes the connection"
+            script.closes[0], "cannot --loop a file that closes the connection"
         )
         return _fail([problem], script.name, err)
     if args.check:
-        print(f"{script.name}: {len(script.lines)} commands, all parse", file=out)
+        print(f"{script.name}: {script.count} commands, all parse", file=out)
         return 0
-    if not script.lines:
+    if not script.count:
         print(f"{script.name}: no commands", file=out)
         return 0
 
     def notify(message: str) -> None:
-        print(f"c2rviz-play: {message}", file=err, flush=True)
+        print(f"c2rviz-play: {shown(message)}", file=err, flush=True)
 
     client = Client(host, port, retry_s=args.timeout, notify=notify)
     show = Progress(out, err)
@@ -253,21 +279,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     start = time.monotonic()
     try:
         names = client.joint_names()
-        mismatch = robot_mismatch(script, client.robot or "?", names)
+        mismatch = robot_mismatch(script, client.robot_name or "?", names)
         if mismatch is not None and args.strict:
             return _fail([f"{mismatch} (--strict)"], script.name, err)
         if mismatch is not None:
             notify(f"warning: {mismatch}; playing it anyway (--strict refuses)")
-        problems = check_robot(script, client.robot or "?", names)
+        problems = check_robot(script, client.robot_name or "?", names)
         if problems:
-            return _fail(problems, f"{script.name} (robot {client.robot})", err)
+            return _fail(problems, f"{script.name} (robot {client.robot_name})", err)
         motion = args.motion
         if motion is not None:
             reply = client.ask(f"motion {motion}")
             if not reply.startswith("ok"):  # a server from before motion
                 return _fail([f"--motion {motion}: the server replied {reply!r}"], script.name, err)
         elif show.in_place:
-            motion = client.motion()  # only to show "-> moving"; None: no motion there
+            motion = motion_of(client.ask("motion"))  # to show "-> moving"; None: no motion
         loop = 0
         while args.loop == 0 or loop < args.loop:
             loop += 1
@@ -302,11 +328,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     times = f"{played} x " if played != 1 else ""
     if errors:
         s = "" if errors == 1 else "s"
-        print(f"{script.name}: {errors} error{s} ({times}{len(script.lines)} commands)", file=err)
+        print(f"{script.name}: {errors} error{s} ({times}{script.count} commands)", file=err)
         return 1
-    print(
-        f"{script.name}: {times}{len(script.lines)} commands, all ok, in {elapsed:.2f} s", file=out
-    )
+    print(f"{script.name}: {times}{script.count} commands, all ok, in {elapsed:.2f} s", file=out)
     return 0
 
 

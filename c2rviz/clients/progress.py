@@ -1,9 +1,12 @@
-"""How ``c2rviz-play`` (and the REPL's ``file``) shows each played line and its reply."""
+"""How ``c2rviz-play`` (and the REPL's ``file``) shows each played line and its reply (the
+server's text with control characters escaped: ``text.shown``)."""
 
 from __future__ import annotations
 
 import shutil
 from typing import TextIO
+
+from .text import shown
 
 __all__ = ["Progress"]
 
@@ -23,13 +26,13 @@ class Progress:
         self._dirty = False
 
     def step(self, label: str, text: str, reply: str) -> None:
-        message = f"{label} {text} -> {reply}"
+        message = f"{label} {text} -> {shown(reply)}"
         if not self.in_place:
             print(message, file=self.out, flush=True)
             return
         keep = reply not in ("ok", "ok bye") and not reply.startswith("error")
-        shown = message if keep else self._fit(message)
-        self.out.write("\r\x1b[K" + shown + ("\n" if keep else ""))
+        fitted = message if keep else self._fit(message)
+        self.out.write("\r\x1b[K" + fitted + ("\n" if keep else ""))
         self.out.flush()
         self._dirty = not keep
 
@@ -44,7 +47,7 @@ class Progress:
 
     def error(self, message: str) -> None:
         self.end_line()
-        print(message, file=self.err, flush=True)
+        print(shown(message), file=self.err, flush=True)
 
     def end_line(self) -> None:
         """Finish the in-place line so the next output starts on its own line."""

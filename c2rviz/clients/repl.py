@@ -8,8 +8,12 @@ loop that reads lines, and the program's flags). The connection's unit mode is t
 ``where`` speak the units the user chose, and a reconnect restores them.
 
 On a terminal there is a ``> `` prompt with line editing and history
-(``~/.c2rviz_history``, or ``$C2RVIZ_HISTORY``); with piped input there is no
-prompt, the replies go to stdout and the connection messages to stderr.
+(``~/.c2rviz_history``, or ``$C2RVIZ_HISTORY``), and ``where`` prints a table of
+joint names and values; with piped input there is no prompt, ``where`` gets the
+server's own reply, the replies go to stdout and the connection messages to stderr.
+The server's text is printed with control characters escaped (``text.shown``), and a
+reply longer than the client's limit closes the connection rather than fill memory
+(``lines.LineClient``).
 
 Exit status: 0 left with ``q``, ``quit``, Ctrl-D or Ctrl-C at the prompt; 1 no
 server (after retrying ``--timeout`` seconds), or, with piped input, a line got
@@ -30,6 +34,7 @@ from typing import TextIO
 from ..errors import C2rvizError
 from ..protocol.registry import usages
 from .client import Client, ServerUnavailable, add_connection_args, server_address
+from .errors import CommandError, UnexpectedReply
 from .repl_local import LOCAL_USAGE, LocalCommands
 from .watch import watch_lines, watch_main
 
@@ -49,6 +54,7 @@ class Repl(LocalCommands):
         step: float | None = None,
         rate_hz: float = 50.0,
         speed: float = 1.0,
+        config: str | None = None,
     ) -> None:
         """Args:
         client: The connection (not yet open).
@@ -58,8 +64,11 @@ class Repl(LocalCommands):
         step: Largest ``goto`` step, in the connection's units (default 2 degrees).
         rate_hz: ``goto`` steps per second.
         speed: ``file`` divides sleeps by this.
+        config: The ``--config`` ini.
         """
-        super().__init__(client, out=out, info=info, step=step, rate_hz=rate_hz, speed=speed)
+        super().__init__(
+            client, out=out, info=info, step=step, rate_hz=rate_hz, speed=speed, config=config
+        )
         self.interactive = interactive
 
     def run(self) -> int:
@@ -72,9 +81,13 @@ class Repl(LocalCommands):
         client = self.client
         self.say("Socket Created")
         try:
-            names = client.joint_names()
+            try:
+                names = client.joint_names()
+            except (UnexpectedReply, CommandError) as exc:
+                self.say(f"c2rviz-cli: {client.host}:{client.port} is not a c2rviz server: {exc}")
+                return 1
             self.say(
-                f"Socket Connected to {client.host}:{client.port}: {client.robot}, "
+                f"Socket Connected to {client.host}:{client.port}: {client.robot_name}, "
                 f"joints 0..{len(names) - 1} ('help' lists the commands)"
             )
             while True:
@@ -124,6 +137,8 @@ class Repl(LocalCommands):
                 "(the server stopped or restarted); reconnecting"
             )
         local = self.local.get(verb)
+        if verb == "where" and not self.interactive:
+            local = None  # piped: the server's reply as it is, as any client would see it
         if local is not None and (verb in ("file", "sleep", "goto", "watch") or len(words) == 1):
             return local(words[1:])
         reply = self.ask(line)
@@ -225,6 +240,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         step=args.step,
         rate_hz=args.rate,
         speed=args.speed,
+        config=args.config,
     )
     save_history = _setup_readline() if interactive else None
     try:

@@ -21,9 +21,10 @@ from ..protocol.verbs.joints import Joints
 from ..protocol.verbs.observe import Watch
 from .bag_play import is_bag, play_in_repl
 from .client import Client, ConnectionLost, find_script
-from .goto import step, target_problem, travel
+from .goto import motion_of, step, target_problem, travel
 from .player import Progress, play
 from .script import check_robot, load_script, robot_mismatch
+from .text import shown
 from .watch import watch_lines
 
 __all__ = ["DEFAULT_STEP_DEG", "LOCAL_USAGE", "LocalCommands"]
@@ -34,7 +35,11 @@ LOCAL_USAGE = {
         "play a command file (here, else commands/) or a ROS bag; X divides sleeps",
     ),
     "sleep": ("sleep S", "wait S seconds here"),
-    "where": ("where", "joint names and values, in this connection's units"),
+    "where": (
+        "where",
+        "joint names and values, in this connection's units (at a terminal; piped, the "
+        "server's reply as it is)",
+    ),
     "goto": (
         "goto v0,...,vn-1 [step=S] [rate=HZ]",
         "move there with the server's motion (ok on arrival; Ctrl-C stops the arm); "
@@ -81,6 +86,7 @@ class LocalCommands:
         step: float | None = None,
         rate_hz: float = 50.0,
         speed: float = 1.0,
+        config: str | None = None,
     ) -> None:
         """Args:
         client: The connection (not yet open).
@@ -89,8 +95,10 @@ class LocalCommands:
         step: Largest ``goto`` step, in the connection's units (default 2 degrees).
         rate_hz: ``goto`` steps per second.
         speed: ``file`` divides sleeps by this.
+        config: The ``--config`` ini (where ``file`` finds the recording folder).
         """
         self.client = client
+        self.config = config
         self.out = out
         self.info = info
         self.step = step
@@ -111,10 +119,12 @@ class LocalCommands:
         """Each local word's runner: it returns False when the REPL should end."""
 
     def say(self, message: str) -> None:
-        print(message, file=self.info, flush=True)
+        """A connection message (the server's text in it escaped: ``text.shown``)."""
+        print(shown(message), file=self.info, flush=True)
 
     def show(self, message: str) -> None:
-        print(message, file=self.out, flush=True)
+        """A reply or a result (the server's text in it escaped: ``text.shown``)."""
+        print(shown(message), file=self.out, flush=True)
 
     def ask(self, line: str) -> str:
         """Send ``line``; if the connection was lost, reconnect and send it once more."""
@@ -133,15 +143,16 @@ class LocalCommands:
             self.errors += play_in_repl(self.client, rest[0], speed, self.out)
             return True
         try:
-            script = load_script(find_script(rest[0]), rest[0])
+            script = load_script(find_script(rest[0], self.config), rest[0])
         except OSError as exc:
             raise C2rvizError(f"file: {exc}") from None
         client = self.client
         names = client.joint_names()
-        mismatch = robot_mismatch(script, client.robot or "?", names)
+        robot = client.robot_name or "?"
+        mismatch = robot_mismatch(script, robot, names)
         if mismatch is not None:
             self.say(f"warning: {mismatch}; playing it anyway")
-        problems = script.problems or check_robot(script, client.robot or "?", names)
+        problems = script.all_problems() or check_robot(script, robot, names)
         for problem in problems:
             self.show(problem)
         if problems:
@@ -156,7 +167,7 @@ class LocalCommands:
             return True  # play has said where it stopped; the next command reconnects
         self.errors += errors > 0
         if not errors:
-            self.show(f"{script.name}: {len(script.lines)} commands, all ok")
+            self.show(f"{script.name}: {script.count} commands, all ok")
         return True
 
     def _sleep(self, words: list[str]) -> bool:
@@ -168,8 +179,8 @@ class LocalCommands:
     def _where(self, words: list[str]) -> bool:
         names = self.client.joint_names()
         values = self.client.where()
-        unit = "degrees" if self.client.degrees else "radians"
-        self.show(f"{self.client.robot} ({unit}):")
+        unit = "degrees" if self.client.in_degrees else "radians"
+        self.show(f"{self.client.robot_name} ({unit}):")
         width = max(map(len, names))
         for i, (name, value) in enumerate(zip(names, values)):
             self.show(f"  {i}  {name:<{width}}  {value:.10g}")
@@ -188,7 +199,7 @@ class LocalCommands:
         problem = target_problem(client, target)  # refuse before anything moves
         if problem is not None:
             raise BadArguments("goto", problem, usage)
-        mode = client.motion()
+        mode = motion_of(client.ask("motion"))
         if mode is None:  # a server from before motion: step there
             return self._step(target, options)
         arrival = travel(client, target, mode)
@@ -207,7 +218,7 @@ class LocalCommands:
     def _step(self, target: list[float], options: dict[str, float]) -> bool:
         """``goto`` on a server without motion: ``joints`` lines a step apart."""
         client = self.client
-        default_step = DEFAULT_STEP_DEG if client.degrees else math.radians(DEFAULT_STEP_DEG)
+        default_step = DEFAULT_STEP_DEG if client.in_degrees else math.radians(DEFAULT_STEP_DEG)
         step_size = options.get("step", self.step or default_step)
         period_s = 1.0 / options.get("rate", self.rate_hz)
         stepped = step(client, client.where(), target, step_size, period_s)
@@ -224,7 +235,10 @@ class LocalCommands:
         assert isinstance(command, Watch)
         client = self.client
         try:
-            for line in watch_lines(client.host, client.port, command.hz, client.degrees):
+            lines = watch_lines(
+                client.host, client.port, command.hz, client.in_degrees, client.chosen_robot
+            )
+            for line in lines:
                 self.show(line)
         except KeyboardInterrupt:
             return True

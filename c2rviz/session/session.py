@@ -245,7 +245,7 @@ class Session:
         now = clock.now()
         start = self._pause_end if 0.0 <= now - self._pause_end <= _CADENCE_S else now
         self._pause_end = start + seconds
-        future: asyncio.Future[str] = asyncio.get_running_loop().create_future()
+        future: asyncio.Future[str] = clock.future()  # a reply that waits on the clock
         timer = clock.call_at(self._pause_end, _settle, future, reply)
         future.add_done_callback(lambda _: timer.cancel())
         return future

@@ -77,6 +77,9 @@ class Connection(asyncio.Protocol):
         self.eof = False
         self.closed = asyncio.get_running_loop().create_future()
         self.stream = server.services.watch.open(self.session, self)  # idle until `watch`
+        clock = server.services.world.clock
+        self.virtual = clock.virtual
+        self.hold = clock.hold()  # a virtual clock waits while this client is busy
 
     @property
     def waiting(self) -> bool:
@@ -94,9 +97,11 @@ class Connection(asyncio.Protocol):
         server = self.server
         server.open.add(self)
         if server.stopping:
+            self.hold.close()
             self._close_with(replies.SHUTTING_DOWN)
         elif len(server.connections) >= self.limits.max_clients:
             log.warning("refused %s: %d clients already", self.peer, len(server.connections))
+            self.hold.close()
             self._close_with(replies.too_many_clients(self.limits.max_clients))
         else:
             server.connections.add(self)
@@ -106,6 +111,7 @@ class Connection(asyncio.Protocol):
     def connection_lost(self, exc: Exception | None) -> None:
         self._cancel_timers()
         self.closing = True
+        self.hold.close()
         self.server.services.watch.close(self.session)
         if self.pending is not None:
             self.pending.cancel()
@@ -121,6 +127,7 @@ class Connection(asyncio.Protocol):
     def data_received(self, data: bytes) -> None:
         if self.closing:
             return
+        self.hold.take()  # it speaks: busy (it may have only listened since `watch`)
         self.framer.feed(data)
         if not self.waiting:  # else reading is paused; the wake-up goes on from here
             self._consume()
@@ -164,6 +171,22 @@ class Connection(asyncio.Protocol):
             )
 
     def _run(self, lines: Sequence[Line]) -> None:
+        """Answer ``lines`` (``_run_lines``); with a virtual clock, as this client's hold
+        (``Clock.hold``): its replies that wait on the clock release it while they wait, and
+        a client whose last line was ``watch`` only listens (released until it speaks)."""
+        hold = self.hold
+        if not self.virtual:  # real or scaled time: holds are no-ops, skip them
+            self._run_lines(lines)
+            return
+        with hold.acting():
+            self._run_lines(lines)
+        said = next(
+            (line for line in reversed(lines) if isinstance(line, str) and line.strip()), ""
+        )
+        if said and said.split()[0].lower() == "watch" and not (self.waiting or self.closing):
+            hold.release()
+
+    def _run_lines(self, lines: Sequence[Line]) -> None:
         """Answer ``lines`` in order, stopping at a reply that waits, bye, quit or a fatal line,
         or after ``TURN_S`` of work (the rest runs after the other clients' turns)."""
         out: list[str] = []

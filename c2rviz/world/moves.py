@@ -130,7 +130,7 @@ class Travels:
         self._planned(travel)
         if not wait:
             return None
-        arrival: asyncio.Future[str] = asyncio.get_running_loop().create_future()
+        arrival: asyncio.Future[str] = self.clock.future()  # settled, its client is busy
         travel.arrivals.append(arrival)
         if not travel.active:  # already there: nothing to wait for
             _settle(travel.arrivals, replies.OK)
@@ -154,7 +154,7 @@ class Travels:
         self._planned(travel)
         if not wait:
             return None
-        arrival: asyncio.Future[str] = asyncio.get_running_loop().create_future()
+        arrival: asyncio.Future[str] = self.clock.future()  # settled, its client is busy
         travel.arrivals.append(arrival)
         return arrival
 
@@ -184,7 +184,7 @@ class Travels:
         travel = self.by_robot[state.name]
         if not travel.active:
             return None
-        future: asyncio.Future[str] = asyncio.get_running_loop().create_future()
+        future: asyncio.Future[str] = self.clock.future()
         travel.rests.append(future)
         return future
 

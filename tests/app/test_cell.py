@@ -196,7 +196,7 @@ def test_the_seeds_command_line_client_drives_the_second_robot(cell: CellThread)
         cwd=ROOT,
     )
     assert done.returncode == 0, done.stderr
-    assert "  1  joint_2  30\n" in done.stdout  # the REPL's `where`, a row per joint
+    assert "ok 0,30,0,0,0,0\n" in done.stdout  # piped: the server's own reply (issue 30.9)
     assert "ok right joint_1," in done.stdout
     assert cell.call(lambda: cell.world.state("right").q)[1] == pytest.approx(math.radians(30))
     assert cell.call(lambda: cell.world.state("left").q) == (0.0,) * 7

@@ -1,0 +1,110 @@
+"""``AsyncClient``'s methods for the scene: markers, trails, recordings, workcell objects."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TypeVar
+
+from . import calls
+from .calls import Call, speaks
+from .records import RecordingResult, RecordingStatus, TrailStatus
+
+__all__ = ["AsyncSceneVerbs"]
+
+T = TypeVar("T")
+
+
+class AsyncSceneVerbs:
+    """The verbs of what the cell holds besides the arm: markers, trails, recordings and
+    workcell objects (a part of the async client; its ``call`` sends)."""
+
+    async def call(self, call: Call[T]) -> T:
+        raise NotImplementedError  # the client's
+
+    @speaks("mark")
+    async def mark(self, pose: Sequence[float] | None = None, *, world: bool = False) -> None:
+        """Drop a marker at ``pose`` (x, y, z [m], roll, pitch, yaw [rad, or deg]) in the
+        base frame (``world``: the world frame), or at the tool point without one."""
+        return await self.call(calls.mark(pose, world))
+
+    @speaks("color")
+    async def color(self, r: float, g: float, b: float) -> None:
+        """Colour of this connection's next markers, each channel [0..1]."""
+        return await self.call(calls.color("color", (r, g, b)))
+
+    @speaks("rgb")
+    async def rgb(self, r: float, g: float, b: float) -> None:
+        """Colour of this connection's next markers, each channel [0..255]."""
+        return await self.call(calls.color("rgb", (r, g, b)))
+
+    @speaks("marker")
+    async def marker(self, shape: str) -> None:
+        """Shape of this connection's next markers: sphere, cube, arrow or cylinder."""
+        return await self.call(calls.marker(shape))
+
+    @speaks("clear")
+    async def clear(self) -> None:
+        """Home, and remove every marker."""
+        return await self.call(calls.CLEAR)
+
+    @speaks("unwatch")
+    async def unwatch(self) -> None:
+        """Stop a ``watch`` stream this connection asked with ``send('watch')``."""
+        return await self.call(calls.UNWATCH)
+
+    @speaks("trail")
+    async def trail(self, action: str) -> None:
+        """The tool's trail: ``on`` (a fresh one), ``off`` or ``clear``."""
+        return await self.call(calls.trail(action))
+
+    async def trail_status(self) -> TrailStatus:
+        """Whether the trail is on, and its points."""
+        return await self.call(calls.TRAIL_STATUS)
+
+    @speaks("record")
+    async def record(self, name: str, overwrite: bool = False) -> Path:
+        """Record this connection's robot as ``name`` (.txt, .csv, .html); return the
+        server's recording folder."""
+        return await self.call(calls.record(name, overwrite))
+
+    async def record_stop(self) -> RecordingResult:
+        """End the recording; returns when its files are complete."""
+        return await self.call(calls.RECORD_STOP)
+
+    async def recording(self) -> RecordingStatus | None:
+        """The recording running (None: none)."""
+        return await self.call(calls.RECORDING)
+
+    @speaks("object")
+    async def add_object(
+        self, name: str, shape: str, size: float | Sequence[float], pose: Sequence[float]
+    ) -> None:
+        """Add or replace a workcell object in the base frame: a ``box`` (size sx, sy, sz
+        [m]), ``sphere`` (radius [m]) or ``cylinder`` (radius, length [m], along its z);
+        ``pose`` x, y, z [m], roll, pitch, yaw [rad, or deg] (a sphere: x, y, z)."""
+        return await self.call(calls.add_object(name, shape, size, pose))
+
+    async def remove_object(self, name: str) -> None:
+        """Remove workcell object ``name``."""
+        return await self.call(calls.remove_object(name))
+
+    async def remove_objects(self) -> None:
+        """Remove every workcell object."""
+        return await self.call(calls.REMOVE_OBJECTS)
+
+    @speaks("objects")
+    async def objects(self) -> list[str]:
+        """The workcell objects' names."""
+        return await self.call(calls.OBJECTS)
+
+    @speaks("collisions")
+    async def collisions(self) -> list[tuple[str, str]]:
+        """The colliding pairs now (link or object names)."""
+        return await self.call(calls.COLLISIONS)
+
+    @speaks("guard")
+    async def guard(self, on: bool | None = None) -> bool:
+        """Refuse this connection's commands whose target or path collides (``True``);
+        return whether the guard is on."""
+        return await self.call(calls.guard(on))

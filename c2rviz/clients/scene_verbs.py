@@ -1,0 +1,116 @@
+"""``Client``'s methods for the scene: markers, trails, recordings, workcell objects."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TypeVar
+
+from . import calls
+from .calls import Call, speaks
+from .records import RecordingResult, RecordingStatus, TrailStatus
+
+__all__ = ["SceneVerbs"]
+
+T = TypeVar("T")
+
+
+class SceneVerbs:
+    """The verbs of what the cell holds besides the arm: markers, trails, recordings and
+    workcell objects (a part of the client; its ``call`` sends)."""
+
+    def call(self, call: Call[T]) -> T:
+        raise NotImplementedError  # the client's
+
+    # Markers.
+
+    @speaks("mark")
+    def mark(self, pose: Sequence[float] | None = None, *, world: bool = False) -> None:
+        """Drop a marker at ``pose`` (x, y, z [m], roll, pitch, yaw [rad, or deg]) in the
+        base frame (``world``: the world frame), or at the tool point without one."""
+        return self.call(calls.mark(pose, world))
+
+    @speaks("color")
+    def color(self, r: float, g: float, b: float) -> None:
+        """Colour of this connection's next markers, each channel [0..1]."""
+        return self.call(calls.color("color", (r, g, b)))
+
+    @speaks("rgb")
+    def rgb(self, r: float, g: float, b: float) -> None:
+        """Colour of this connection's next markers, each channel [0..255]."""
+        return self.call(calls.color("rgb", (r, g, b)))
+
+    @speaks("marker")
+    def marker(self, shape: str) -> None:
+        """Shape of this connection's next markers: sphere, cube, arrow or cylinder."""
+        return self.call(calls.marker(shape))
+
+    @speaks("clear")
+    def clear(self) -> None:
+        """Home, and remove every marker."""
+        return self.call(calls.CLEAR)
+
+    # Watching, trails, recordings.
+
+    @speaks("unwatch")
+    def unwatch(self) -> None:
+        """Stop a ``watch`` stream this connection asked with ``send('watch')``."""
+        return self.call(calls.UNWATCH)
+
+    @speaks("trail")
+    def trail(self, action: str) -> None:
+        """The tool's trail: ``on`` (a fresh one), ``off`` or ``clear``."""
+        return self.call(calls.trail(action))
+
+    def trail_status(self) -> TrailStatus:
+        """Whether the trail is on, and its points."""
+        return self.call(calls.TRAIL_STATUS)
+
+    @speaks("record")
+    def record(self, name: str, overwrite: bool = False) -> Path:
+        """Record this connection's robot as ``name`` (.txt, .csv, .html); return the
+        server's recording folder."""
+        return self.call(calls.record(name, overwrite))
+
+    def record_stop(self) -> RecordingResult:
+        """End the recording; returns when its files are complete."""
+        return self.call(calls.RECORD_STOP)
+
+    def recording(self) -> RecordingStatus | None:
+        """The recording running (None: none)."""
+        return self.call(calls.RECORDING)
+
+    # The workcell.
+
+    @speaks("object")
+    def add_object(
+        self, name: str, shape: str, size: float | Sequence[float], pose: Sequence[float]
+    ) -> None:
+        """Add or replace a workcell object in the base frame: a ``box`` (size sx, sy, sz
+        [m]), ``sphere`` (radius [m]) or ``cylinder`` (radius, length [m], along its z);
+        ``pose`` x, y, z [m], roll, pitch, yaw [rad, or deg] (a sphere: x, y, z)."""
+        return self.call(calls.add_object(name, shape, size, pose))
+
+    def remove_object(self, name: str) -> None:
+        """Remove workcell object ``name``."""
+        return self.call(calls.remove_object(name))
+
+    def remove_objects(self) -> None:
+        """Remove every workcell object."""
+        return self.call(calls.REMOVE_OBJECTS)
+
+    @speaks("objects")
+    def objects(self) -> list[str]:
+        """The workcell objects' names."""
+        return self.call(calls.OBJECTS)
+
+    @speaks("collisions")
+    def collisions(self) -> list[tuple[str, str]]:
+        """The colliding pairs now (link or object names)."""
+        return self.call(calls.COLLISIONS)
+
+    @speaks("guard")
+    def guard(self, on: bool | None = None) -> bool:
+        """Refuse this connection's commands whose target or path collides (``True``);
+        return whether the guard is on."""
+        return self.call(calls.guard(on))

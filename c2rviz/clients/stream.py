@@ -1,0 +1,153 @@
+"""The ``watch`` stream from a client: ``state`` and ``event`` lines on a connection of its own.
+
+A watching connection receives stream lines between its replies, so a client that
+also sends commands would have to sort them apart; ``Client.watch`` and the REPL's
+``watch`` open a second connection instead (same server, robot and units), ask
+``watch [HZ]`` there and read nothing but the stream. ``WatchStream`` reads it
+line by line through the protocol's ``LineFramer`` (so a runaway line cannot grow
+memory) and gives each line as text (``lines``) or as a ``State``/``Event`` record
+(iterating).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import socket
+from collections import deque
+from collections.abc import Iterator
+
+from ..errors import LineTooLong
+from ..protocol.framing import Line, LineFramer
+from .connect import ServerUnavailable
+from .errors import CommandError, ConnectionLost, ReplyTooLong, UnexpectedReply
+from .records import Event, State, read_stream_line
+
+__all__ = ["WatchStream", "watch_request"]
+
+
+def watch_request(hz: float | None, degrees: bool, robot: str | None) -> list[str]:
+    """The lines that set up a watching connection like the client's own."""
+    asked = [f"robot {robot}"] if robot is not None else []
+    if degrees:
+        asked.append("degrees")
+    asked.append("watch" if hz is None else f"watch {hz!r}")
+    return asked
+
+
+class WatchStream:
+    """A connection that asked ``watch``: iterate for records, ``lines()`` for the text.
+
+    A context manager; ``close()`` ends the stream (the connection closes).
+
+    Attributes:
+        host, port: The server.
+    """
+
+    def __init__(
+        self,
+        host: str,
+        port: int,
+        hz: float | None = None,
+        *,
+        degrees: bool = False,
+        robot: str | None = None,
+        max_line: int = 1 << 20,
+        timeout: float | None = None,
+    ) -> None:
+        """Connect and ask for the stream.
+
+        Args:
+            host, port: The command server.
+            hz: Most ``state`` lines a second (None: the server's frame rate).
+            degrees: Values in degrees.
+            robot: Watch this robot of a cell (None: the port's own).
+            max_line: Longest line [bytes]; past it the stream closes.
+            timeout: Longest wait for a line [s] (None: no limit).
+
+        Raises:
+            ServerUnavailable: no server at ``host:port``.
+            CommandError: the server refused a line of the request (a bad robot, HZ).
+        """
+        self.host = host
+        self.port = port
+        try:
+            self._sock = socket.create_connection((host, port), timeout=5.0)
+        except OSError as exc:
+            raise ServerUnavailable(host, port, 0.0, exc.strerror or str(exc)) from None
+        self._sock.settimeout(timeout)
+        self._framer = LineFramer(max_line)
+        self._lines: deque[Line] = deque()
+        self._held: deque[str] = deque()  # stream lines that came before a reply
+        try:
+            asked = watch_request(hz, degrees, robot)
+            self._sock.sendall("".join(f"{line}\n" for line in asked).encode())
+            for line in asked:
+                reply = self._reply(line)
+                if not reply.startswith("ok"):
+                    raise CommandError(line, reply)
+        except BaseException:
+            self.close()
+            raise
+
+    def _reply(self, line: str) -> str:
+        """The reply to ``line`` (stream lines before it are kept for later)."""
+        while True:
+            text = self._next(line)
+            if text is None:
+                raise ConnectionLost(self.host, self.port, line)
+            if read_stream_line(text) is None:
+                return text
+            self._held.append(text)
+
+    def _next(self, asked: str) -> str | None:
+        """The next line (None: the server closed the connection)."""
+        while not self._lines:
+            batch = self._framer.take()
+            if batch is not None:
+                self._lines.extend(batch)
+                break
+            if self._framer.too_long:
+                raise ReplyTooLong(asked, self._framer.max_line)
+            try:
+                chunk = self._sock.recv(65536)
+            except OSError:
+                chunk = b""
+            if not chunk:
+                return None
+            self._framer.feed(chunk)
+        line = self._lines.popleft()
+        if isinstance(line, LineTooLong):
+            raise ReplyTooLong(asked, self._framer.max_line)
+        if not isinstance(line, str):
+            raise UnexpectedReply(asked, "", "a line that is not UTF-8 text")
+        return line.removesuffix("\r")
+
+    def lines(self) -> Iterator[str]:
+        """Each stream line as text, until the server closes the connection."""
+        while self._held:
+            yield self._held.popleft()
+        while (line := self._next("watch")) is not None:
+            yield line
+
+    def __iter__(self) -> Iterator[State | Event]:
+        """Each stream line as a record (other lines, if any, are skipped)."""
+        for line in self.lines():
+            record = read_stream_line(line)
+            if record is not None:
+                yield record
+
+    def send(self, line: str) -> None:
+        """Send a command on the watching connection (its reply comes among the stream's
+        lines: everything the stream wrote before it comes first)."""
+        self._sock.sendall(line.encode() + b"\n")
+
+    def close(self) -> None:
+        with contextlib.suppress(OSError):  # wakes a thread blocked reading it
+            self._sock.shutdown(socket.SHUT_RDWR)
+        self._sock.close()
+
+    def __enter__(self) -> WatchStream:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

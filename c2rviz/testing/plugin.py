@@ -1,0 +1,174 @@
+"""The pytest plugin (entry point ``pytest11``: loaded by any pytest where c2rviz is installed;
+else ``pytest -p c2rviz.testing.plugin``).
+
+Fixtures:
+
+- ``c2rviz_server``: a real server in the test process (``server.TestServer``) on free
+  ports, without a page unless asked; a fresh one for every test, so a test that leaves
+  the arm moving (or anything else) cannot reach the next.
+- ``c2rviz``: a ``c2rviz.Client`` connected to it (radians, the first robot).
+
+Options, from the nearest ``@pytest.mark.c2rviz(...)`` marks (class and module marks too,
+the nearest winning) and then a fixture parameter (``indirect=True``, a dict): any flag of
+``c2rviz`` by its name (``robot``, ``cell``, ``urdf``, ``clock``, ``motion``, ``speed``,
+``guard``, ``hz``, ``max_objects``...), ``ini`` (a cmdinterpreter.ini), ``viewer=True``
+(the page, on a free port), ``doors=True`` (the other doors too, on free ports) and
+``record=False``. ``--c2rviz-clock`` (or the ini option ``c2rviz_clock``) sets every
+test's clock, e.g. ``virtual``.
+
+Each test's run is recorded (``record NAME`` on its first robot, NAME from the test's
+id); when the test fails, NAME.txt, NAME.csv and NAME.html are kept in
+``--c2rviz-recordings`` (default ``c2rviz-recordings/`` of the rootdir) and the report
+says where; when it passes they are dropped. A test that records itself says
+``record=False`` (a robot records one recording at a time).
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import pytest
+
+if TYPE_CHECKING:  # the server side loads when a test asks for a server, not with pytest
+    from ..clients.client import Client
+    from .server import TestServer
+
+__all__ = ["c2rviz", "c2rviz_server", "recording_name"]
+
+_REPORTS = pytest.StashKey[dict[str, pytest.TestReport]]()
+_KEPT = pytest.StashKey[list[Path]]()
+_NAME_CHARS = re.compile(r"[^A-Za-z0-9_.-]+")
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    group = parser.getgroup("c2rviz", "c2rviz: test your controller")
+    group.addoption(
+        "--c2rviz-clock",
+        metavar="real|scaled:N|virtual",
+        help="the clock of every c2rviz_server (default: the ini's c2rviz_clock, else real)",
+    )
+    group.addoption(
+        "--c2rviz-recordings",
+        metavar="DIR",
+        help="where a failed test's recording is kept (default: c2rviz-recordings/ of the rootdir)",
+    )
+    parser.addini("c2rviz_clock", "the clock of every c2rviz_server (real, scaled:N, virtual)")
+    parser.addini("c2rviz_recordings", "where a failed test's recording is kept")
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers",
+        "c2rviz(**options): the c2rviz_server this test gets (robot=, cell=, ini=, clock=, "
+        "viewer=, doors=, record=, and any c2rviz flag by its name)",
+    )
+    config.stash[_KEPT] = []
+
+
+@pytest.hookimpl(wrapper=True, tryfirst=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> Any:
+    """Keep each phase's report on the item: the fixture's teardown reads whether it failed."""
+    report = yield
+    item.stash.setdefault(_REPORTS, {})[report.when] = report
+    return report
+
+
+def pytest_terminal_summary(terminalreporter: Any, config: pytest.Config) -> None:
+    kept = config.stash.get(_KEPT, [])
+    if kept:
+        terminalreporter.section("c2rviz recordings of failed tests")
+        for path in kept:
+            terminalreporter.write_line(f"{path}  (c2rviz-play {path}; open {path.stem}.html)")
+
+
+def recording_name(nodeid: str) -> str:
+    """A recording's name for a test: its id as letters, digits, ``_ . -`` (at most 100)."""
+    name = _NAME_CHARS.sub("_", nodeid.replace("::", "-")).strip("._-") or "test"
+    return name if len(name) <= 100 else f"{name[:91]}-{abs(hash(nodeid)) % 10**8:08d}"
+
+
+def _options(request: pytest.FixtureRequest) -> dict[str, Any]:
+    options: dict[str, Any] = {}
+    clock = request.config.getoption("--c2rviz-clock") or request.config.getini("c2rviz_clock")
+    if clock:
+        options["clock"] = clock
+    for mark in reversed(list(request.node.iter_markers("c2rviz"))):  # farthest first
+        if mark.args:
+            raise pytest.UsageError("@pytest.mark.c2rviz takes options by name only")
+        options.update(mark.kwargs)
+    param = getattr(request, "param", None)
+    if param is not None:
+        if not isinstance(param, dict):
+            raise pytest.UsageError("a c2rviz_server parameter is a dict of options")
+        options.update(param)
+    return options
+
+
+def _kept_folder(config: pytest.Config) -> Path:
+    given = config.getoption("--c2rviz-recordings") or config.getini("c2rviz_recordings")
+    return Path(given) if given else Path(config.rootpath) / "c2rviz-recordings"
+
+
+@pytest.fixture
+def c2rviz_server(
+    request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
+) -> Iterator[TestServer]:
+    """A real c2rviz server for this test (see the module docstring for its options)."""
+    from .server import TestServer
+
+    options = _options(request)
+    record = options.pop("record", True)
+    folder = tmp_path_factory.mktemp("c2rviz-recording")
+    options.setdefault("record_dir", str(folder))
+    server = TestServer(options).start()
+    name = recording_name(request.node.nodeid)
+    if record:
+        reply = server.run(f"record {name} overwrite", server.robot)
+        if not reply.startswith("ok"):
+            server.stop()
+            raise RuntimeError(f"c2rviz_server could not record {name}: {reply}")
+    try:
+        yield server
+    finally:
+        reports = request.node.stash.get(_REPORTS, {})
+        failed = any(report.failed for report in reports.values())
+        if record and not server.quit_requested.is_set():
+            server.keep_page(failed)
+            server.run("record stop", server.robot)
+        server.stop()
+        if record and failed:
+            _keep(request, Path(options["record_dir"]), name)
+
+
+def _keep(request: pytest.FixtureRequest, folder: Path, name: str) -> None:
+    """Move a failed test's recording where the user looks, and say where."""
+    kept = _kept_folder(request.config)
+    kept.mkdir(parents=True, exist_ok=True)
+    moved = []
+    for path in sorted(folder.glob(f"{name}*")):
+        target = kept / path.name
+        if target.is_dir():
+            shutil.rmtree(target)
+        shutil.move(str(path), target)
+        moved.append(target)
+    txt = kept / f"{name}.txt"
+    if moved:
+        request.config.stash[_KEPT].append(txt)
+        request.node.add_report_section(
+            "teardown",
+            "c2rviz recording",
+            f"{txt} (play it: c2rviz-play {txt}; the page: {kept / f'{name}.html'})",
+        )
+
+
+@pytest.fixture
+def c2rviz(c2rviz_server: TestServer) -> Iterator[Client]:
+    """A ``c2rviz.Client`` connected to this test's server (its first robot, radians)."""
+    from ..clients.client import Client
+
+    with Client(c2rviz_server.host, c2rviz_server.port, retry_s=0) as client:
+        yield client

@@ -1,0 +1,121 @@
+"""``--clock virtual``: a program of a minute of motion and sleeps runs in a small fraction
+of that, with the same replies and a recording whose stamps equal a real-time run's.
+
+Both runs are the program (``python -m c2rviz``) played by ``c2rviz-play``. What a real-time
+run adds is the machine's lateness: its loop wakes a little after a timer is due (on a
+busy machine, tens of milliseconds), and the recorder writes an arm come to rest at the
+end of the frame it rested in. So virtual time is held to the program's own schedule
+exactly, and the real run to the virtual one move by move: each move leaves when the
+virtual one did plus the real loop's lateness (never earlier), lasts as long within one
+frame (and the lateness of the timers that stamp its first and last frames), and ends at
+the same pose.
+"""
+
+from __future__ import annotations
+
+import csv
+import time
+from pathlib import Path
+
+import pytest
+
+from c2rviz.clients import player
+
+PROGRAM = """# robot: motoman_sia20d
+# A minute of motion and sleeps, recorded. Each move goes with `motion follow` and the
+# sleeps keep the cadence, so neither run waits on the other's round trips.
+radians
+record {name}
+motion follow
+speed 20
+joints 1,0.5,0,-0.5,0,0.5,0
+sleep 8
+joints -1,0.3,0.4,-1,0.5,0,1
+sleep 12
+home
+sleep 10
+joints 0.5,0.5,0.5,0.5,0.5,0.5,0.5
+sleep 10
+speed 50
+joints 0,-0.5,0,0.5,0,-0.5,0
+sleep 10
+speed 20
+joints -1,0,0,0,0,0,0
+sleep 1.5
+stop
+sleep 4
+record stop
+"""
+HZ = 20.0
+FRAME_S = 1.0 / HZ
+"""A frame [s]: the recorder writes at most one row per frame, and an arm come to rest at
+the frame's end, so a stamp is known to a frame in either run."""
+
+
+def play(c2rviz_process, tmp_path: Path, clock: str, capsys) -> tuple[float, list[str], Path]:
+    """Run the program under ``clock``; the wall time, the player's lines and the CSV."""
+    folder = tmp_path / clock
+    process = c2rviz_process(
+        "--no-viewer", "--clock", clock, "--hz", str(HZ), "--record-dir", str(folder)
+    )
+    program = tmp_path / f"{clock}.txt"
+    program.write_text(PROGRAM.format(name="take"))
+    start = time.monotonic()
+    status = player.main([str(program), "--port", str(process.port)])
+    wall = time.monotonic() - start
+    out = capsys.readouterr().out
+    assert status == 0, out
+    return wall, out.splitlines()[:-1], folder / "take.csv"  # the last line has the time
+
+
+def moves(path: Path) -> list[tuple[float, float, tuple[float, ...]]]:
+    """Each move of a recording: when it left, when it arrived [s], and where.
+
+    Frames come every 10 ms while the arm moves and none while it rests, so a move is a
+    run of rows without a long gap (the first move begins with the recording's first row).
+    """
+    with path.open() as file:
+        rows = [(float(row[0]), tuple(map(float, row[1:8]))) for row in list(csv.reader(file))[1:]]
+    found = [[rows[0]]]
+    for before, row in zip(rows, rows[1:]):
+        if row[0] - before[0] > 0.5:
+            found.append([])
+        found[-1].append(row)
+    return [(move[0][0], move[-1][0], move[-1][1]) for move in found]
+
+
+SCHEDULE = (0.0, 8.0, 20.0, 30.0, 40.0, 50.0)
+"""When each move of ``PROGRAM`` leaves [s from the recording's start]: its sleeps."""
+LATENESS_S = 1.0
+"""Most a busy machine's loop may be late for a timer in the real run [s]: a bound that
+says the loop was slow, not that time went wrong (which is seconds, or early)."""
+
+
+@pytest.mark.timeout(300)
+def test_a_minute_of_motion_runs_in_a_fraction_with_the_same_stamps(
+    c2rviz_process, tmp_path, capsys
+):
+    virtual_s, virtual_out, virtual_csv = play(c2rviz_process, tmp_path, "virtual", capsys)
+    real_s, real_out, real_csv = play(c2rviz_process, tmp_path, "real", capsys)
+    # The same replies, in the same order (the recording's own say where and how long).
+    assert [line for line in virtual_out if " record " not in line] == [
+        line for line in real_out if " record " not in line
+    ]
+    virtual, real = moves(virtual_csv), moves(real_csv)
+    assert [left for left, _, _ in virtual] == pytest.approx(SCHEDULE, abs=1e-6)
+    assert len(real) == len(SCHEDULE)
+    simulated = virtual[-1][1]
+    assert simulated > 51.5  # the last move leaves at 50 s, is stopped 1.5 s in, and brakes
+    assert real_s > simulated
+    assert virtual_s < real_s / 5, f"virtual time took {virtual_s:.1f} s, real {real_s:.1f} s"
+    for (v_left, v_came, _), (r_left, r_came, _) in zip(virtual, real):
+        late = r_left - v_left
+        assert 0 <= late < LATENESS_S  # real time left when virtual time did, or later
+        # As long, within a frame: and the lateness of the two timers that stamp it (the
+        # move's first frame, and the one that ends it).
+        duration = (r_came - r_left) - (v_came - v_left)
+        assert abs(duration) < FRAME_S + LATENESS_S
+    for (_, _, v_q), (_, _, r_q) in zip(virtual[:-1], real[:-1]):
+        assert r_q == pytest.approx(v_q, abs=1e-9)  # to the same pose
+    # The last move is stopped 1.5 s in: where it stops depends on when `stop` came.
+    assert -0.9 < virtual[-1][2][0] < 0 and -0.9 < real[-1][2][0] < 0
