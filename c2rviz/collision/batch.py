@@ -219,6 +219,17 @@ class BatchCheck:
                 return [float(x) for x in qs[int(np.argmin(hits))]]
         return None
 
+    def lasting(self, rng: np.random.Generator, looks: int = 50) -> list[Pair]:
+        """The pairs colliding in each of ``looks`` random configurations: contacts no
+        joint can undo (an object through the robot's base), sorted."""
+        always: set[Pair] | None = None
+        for _ in range(looks):
+            pairs = set(self.colliding(self.robot.random(rng)))
+            always = pairs if always is None else always & pairs
+            if not always:
+                break
+        return sorted(always or ())
+
 
 def copy_requests(source: pin.GeometryData, target: pin.GeometryData) -> None:
     """Make ``target``'s requests answer as ``source``'s: exact as they are, and free of

@@ -73,13 +73,22 @@ _Checks = tuple[pin.GeometryModel, pin.GeometryData, list[Pair]]
 class NoFreeConfiguration(CollisionError):
     """No collision-free configuration in the bounded number of random draws."""
 
-    def __init__(self, robot: str, tries: int) -> None:
+    def __init__(self, robot: str, tries: int, always: Sequence[Pair] = ()) -> None:
         self.robot = robot
         self.tries = tries
-        super().__init__(
-            f"no collision-free configuration of {robot} found in {tries} random draws "
-            "(the workcell may fill its reach; remove objects or turn the guard off)"
-        )
+        self.always = tuple(always)
+        """Pairs touching in every draw looked at: a contact no joint can undo."""
+        found = f"no collision-free configuration of {robot} found in {tries} random draws"
+        if self.always:
+            first, second = self.always[0]
+            super().__init__(
+                f"{found}: {first} touches {second} in every pose tried, a contact no "
+                f"joint undoes (an object through the robot's base? move or remove it)"
+            )
+        else:
+            super().__init__(
+                f"{found} (the workcell may fill its reach; remove objects or turn the guard off)"
+            )
 
 
 def segment(

@@ -227,9 +227,10 @@ async def guarded_rand(session: GuardedSession) -> str:
     name = session.state.robot.name
 
     def draw() -> list[float]:
-        found = checker.checker(asked).batch.random_free(rng, DRAWS)
+        batch = checker.checker(asked).batch
+        found = batch.random_free(rng, DRAWS)
         if found is None:
-            raise NoFreeConfiguration(name, DRAWS)
+            raise NoFreeConfiguration(name, DRAWS, batch.lasting(rng))
         return found
 
     q = await worker.run(draw, key=("move", id(session)))

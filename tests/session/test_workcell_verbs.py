@@ -123,6 +123,24 @@ def test_rand_under_guard_draws_only_free_configurations(server: ServerThread, c
         assert watcher.ask("collisions") == "ok none"
 
 
+def test_rand_blames_an_object_through_the_base_not_the_workcell(server, connect):
+    # issue 30.6: a table that cuts link_s wherever the joints go
+    client = connect(server)
+    assert client.ask("object table box 1.2,0.8,0.05 0.6,0,0.3,0,0,0") == "ok"
+    assert client.ask("collisions") == "ok link_s~table"
+    assert client.ask("guard on") == "ok"
+    before = client.ask("where")
+    assert client.ask("rand") == (
+        "error: no collision-free configuration of motoman_sia20d found in 1000 random "
+        "draws: link_s touches table in every pose tried, a contact no joint undoes "
+        "(an object through the robot's base? move or remove it)"
+    )
+    assert client.ask("where") == before
+    assert client.ask("object table box 0.6,0.8,0.05 0.8,0,0.4,0,0,0") == "ok"  # the README's
+    assert client.ask("collisions") == "ok none"
+    assert client.ask("rand") == "ok"
+
+
 @pytest.mark.parametrize(
     ("line", "error"),
     [
