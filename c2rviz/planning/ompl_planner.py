@@ -29,6 +29,7 @@ time in a process (a lock); OMPL's log is silenced meanwhile.
 
 from __future__ import annotations
 
+import logging
 import secrets
 import threading
 import time
@@ -51,6 +52,8 @@ from .errors import (
     checked_setting,
 )
 from .validity import ValidityChecker
+
+log = logging.getLogger("c2rviz.planning")
 
 __all__ = ["MAX_TIMEOUT_S", "SEEDS", "EdgeCheck", "PlannedPath", "plan_for", "plan_path"]
 
@@ -216,9 +219,12 @@ def plan_path(
         if found is None:  # raised here, so that no OMPL object lives on in its traceback
             raise NoPathFound(timeout, checks.count)
         waypoints = _shorten(found, checks)
-        for k in range(len(waypoints) - 1):
-            if not checks.edge(waypoints[k], waypoints[k + 1]):
-                raise PathCheckFailed(k)
+        failed = _first_failed_edge(waypoints, checks)
+        if failed is not None and _first_failed_edge(found, checks) is None:
+            log.warning("planning: the shortened path's edge %d failed its check", failed)
+            waypoints = found  # OMPL's own path passes: take it, longer but checked
+        elif failed is not None:
+            raise PathCheckFailed(failed)
     length = float(np.sum(np.linalg.norm(np.diff(waypoints, axis=0), axis=1)))
     return PlannedPath(waypoints, length, checks.count, time.perf_counter() - began, chosen)
 
@@ -272,6 +278,14 @@ def _rrt_connect(
     waypoints = np.clip(np.array(rows, dtype=float), lower, upper)  # a zero-width joint
     waypoints[0], waypoints[-1] = start, goal  # exact ends, not OMPL's copies
     return waypoints
+
+
+def _first_failed_edge(waypoints: np.ndarray, checks: _Counted) -> int | None:
+    """The index of the first edge of ``waypoints`` that fails its check, or None."""
+    for k in range(len(waypoints) - 1):
+        if not checks.edge(waypoints[k], waypoints[k + 1]):
+            return k
+    return None
 
 
 def _shorten(waypoints: np.ndarray, checks: _Counted) -> np.ndarray:
