@@ -62,12 +62,15 @@ def connect() -> Iterator[Callable[[ServerThread], Client]]:
 @pytest.fixture
 def c2rviz_process() -> Iterator[Callable[..., Process]]:
     """Factory: start ``python -m c2rviz --port 0 ARGS`` (``--no-rosbridge`` too, unless ARGS
-    name ``--rosbridge-port``); waits until it listens."""
+    name ``--rosbridge-port``, and ``--crcl-port 0`` unless they name CRCL's); waits until
+    it listens."""
     procs: list[Process] = []
 
     def start(*args: str, timeout: float = 120.0) -> Process:
         # No rosbridge door (port 9090) unless the test names its port: tests stay apart.
         door = () if any(a.startswith("--rosbridge-port") for a in args) else ("--no-rosbridge",)
+        if not any(a.startswith(("--crcl-port", "--no-crcl")) for a in args):
+            door += ("--crcl-port", "0")  # a free port: not 64444, which may be taken
         popen = subprocess.Popen(
             [sys.executable, "-m", "c2rviz", "--port", "0", *door, *args],
             cwd=ROOT,
