@@ -89,7 +89,7 @@ class Instruments:
             objects = self._objects_now(name)
             self.histories[name] = RobotHistory(state, world.frame_s, origin, objects)
             with panels[name].folder:
-                self.readouts[name] = RobotReadout(server.gui, state.robot)
+                self.readouts[name] = RobotReadout(server.gui, state.robot, len(world.robots))
                 self.plots[name] = RobotPlots(
                     server.gui, state.robot, origin, velocities, len(world.robots)
                 )

@@ -34,7 +34,8 @@ class SendScheduler:
     Attributes:
         period_s: Shortest time between two sends' starts [s].
         sends: How many sends have run to their end.
-        work_s: The last send's time at work, its slices summed [s].
+        work_s: The last send's time at work, its slices summed [s of this thread's CPU
+            time: a wait for the GIL while viser's thread encodes is not work].
     """
 
     def __init__(self, period_s: float, send: Callable[[], bool]) -> None:
@@ -86,12 +87,12 @@ class SendScheduler:
         if not self._slicing:
             self._last_s = loop.time()
             self._work = 0.0
-        began = time.perf_counter()
+        began = time.thread_time()
         more = False
         try:
             more = self._send()
         finally:
-            self._work += time.perf_counter() - began
+            self._work += time.thread_time() - began
             if more and not self._stopped:
                 self._slicing = True
                 self._timer = loop.call_soon(self._run)

@@ -329,8 +329,11 @@ class ViserScene(Scene):
                         self._objects.update(objects_now)
                         self._dirty.update(world.robots)
                     self._drawing, self._dirty = list(self._dirty), set()
-                if self._draw_robots(began + SLICE_S) or time.perf_counter() > began + SLICE_S / 2:
-                    self.server.flush()  # robots left, or the rest gets a slice of its own
+                drew = bool(self._drawing)
+                if self._draw_robots(began + SLICE_S):
+                    return True  # robots left for the next slice
+                if drew and time.perf_counter() > began + SLICE_S / 2:
+                    self._drawing = []  # all drawn: the rest gets a slice of its own
                     return True
                 self.markers.draw()
             else:
