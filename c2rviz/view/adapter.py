@@ -277,6 +277,11 @@ class PoseBatch:
     moves by any amount is sent, so the last pose of a stopped robot always is).
 
     Only this batch may pose its nodes (it keeps what it sent).
+
+    Attributes:
+        handles: The nodes, in row order.
+        states: Their viser states (what ``handle.position``/``wxyz`` read).
+        sent: The poses last sent, one row per node (position, then w x y z).
     """
 
     def __init__(self, handles: Sequence[Any]) -> None:
