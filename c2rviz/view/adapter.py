@@ -9,9 +9,11 @@ inside viser, and no other module does:
   ``websockets.asyncio.server.serve`` through with a ``door.Door`` in front:
   origin and token checks, a frame and a client limit, a screen on every frame
   (``accept_input`` registers the inputs the page may set).
-* fast sends (``queue_pose``, ``set_gui_value``): a pose or a slider value
-  without viser's ``np.allclose`` per setter and without calling the input's
-  own update callbacks (~0.23 ms a send instead of 1-1.9 ms).
+* fast sends (``queue_pose``, ``PoseBatch``, ``set_gui_value``, ``set_chart_data``): a pose, a
+  slider value or a chart's data without viser's ``np.allclose`` per setter,
+  without its per-array casts through typing hints and without calling the
+  input's own update callbacks (~0.23 ms a send instead of 1-1.9 ms; a chart's
+  data in ~0.05 ms instead of ~0.4 ms).
 * a purge of removal records (``purge_removed``): viser keeps a record of each
   removed scene node until a new tab connects.
 * a stop in bounded time (``stop``), even with a tab that never reads.
@@ -52,6 +54,7 @@ from .ws_guard import Door, GrabCallback, GuardedConnection, HandleCallback, Inp
 
 __all__ = [
     "INTERNALS",
+    "PoseBatch",
     "WRITTEN_FOR",
     "ViserInternalsError",
     "accept_click",
@@ -63,6 +66,7 @@ __all__ = [
     "missing_internals",
     "purge_removed",
     "queue_pose",
+    "set_chart_data",
     "set_gui_value",
     "start",
     "stop",
@@ -84,6 +88,8 @@ INTERNALS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("viser._scene_handles._SceneNodeHandleState", ("name", "api", "position", "wxyz")),
     ("viser._scene_api.SceneApi", ("_queue_scene_message",)),
     ("viser._gui_handles._GuiHandleState", ("uuid", "gui_api", "value", "update_timestamp")),
+    ("viser._gui_handles._GuiHandleState", ("props", "removed")),
+    ("viser._messages.GuiUplotProps", ("data",)),
     ("viser.infra._async_message_buffer.AsyncMessageBuffer", ("message_from_id",)),
     ("viser.infra._async_message_buffer.AsyncMessageBuffer", ("message_counter",)),
     ("viser.infra._async_message_buffer.AsyncMessageBuffer", ("generator_cursors",)),
@@ -264,6 +270,57 @@ def queue_pose(handle: Any, position: np.ndarray, wxyz: np.ndarray, force: bool 
         )
 
 
+class PoseBatch:
+    """Scene nodes posed together (a robot's link frames): ``queue_pose`` for all of them
+    at once, comparing every pose with the one last sent in one array operation and
+    sending only the positions and orientations that changed (exactly; a pose that
+    moves by any amount is sent, so the last pose of a stopped robot always is).
+
+    Only this batch may pose its nodes (it keeps what it sent).
+
+    Attributes:
+        handles: The nodes, in row order.
+        states: Their viser states (what ``handle.position``/``wxyz`` read).
+        sent: The poses last sent, one row per node (position, then w x y z).
+    """
+
+    def __init__(self, handles: Sequence[Any]) -> None:
+        """``handles``: viser scene node handles, in the order of ``queue``'s rows."""
+        self.handles = list(handles)
+        self.states = [handle._impl for handle in self.handles]
+        self.sent = np.array(
+            [[*state.position, *state.wxyz] for state in self.states], dtype=float
+        ).reshape(len(self.states), 7)
+
+    def queue(self, poses: np.ndarray) -> int:
+        """Pose node ``k`` at ``poses[k]``: its position [m] (3 values) then its unit
+        quaternion (w, x, y, z), in its parent's frame.
+
+        Returns:
+            How many messages were queued.
+        """
+        changed = poses != self.sent
+        sent = 0
+        for k in np.flatnonzero(changed[:, :3].any(axis=1)).tolist():
+            state = self.states[k]
+            position = poses[k, :3]
+            state.position[:] = position
+            state.api._queue_scene_message(
+                _messages.SetPositionMessage(state.name, tuple(position.tolist()))
+            )
+            sent += 1
+        for k in np.flatnonzero(changed[:, 3:].any(axis=1)).tolist():
+            state = self.states[k]
+            wxyz = poses[k, 3:]
+            state.wxyz[:] = wxyz
+            state.api._queue_scene_message(
+                _messages.SetOrientationMessage(state.name, tuple(wxyz.tolist()))
+            )
+            sent += 1
+        self.sent[:] = poses
+        return sent
+
+
 def set_gui_value(
     handle: Any, value: float | bool | str, exclude_client: int | None = None, force: bool = False
 ) -> bool:
@@ -290,6 +347,28 @@ def set_gui_value(
     state.value = value
     state.update_timestamp = time.time()
     return True
+
+
+def set_chart_data(handle: Any, data: Sequence[np.ndarray]) -> None:
+    """``handle.data = data`` for a uPlot chart (``gui.add_uplot``), cheaply.
+
+    viser's setter casts each array through the prop's typing hints (some 20 µs an
+    array) and compares it with the one held; this sends the arrays as they are,
+    once cast to float64. The arrays are the chart's from now on: the caller
+    must not change them afterwards (a new array for each update).
+
+    Args:
+        handle: A viser uPlot handle.
+        data: The x values, then one array per series, all of one length.
+    """
+    state = handle._impl
+    if state.removed:
+        raise RuntimeError(f"Cannot assign to 'data' on a removed {type(handle).__name__}.")
+    arrays = tuple(np.asarray(column, dtype=np.float64) for column in data)
+    state.props.data = arrays
+    state.gui_api._websock_interface.queue_message(
+        _messages.GuiUpdateMessage(state.uuid, {"data": arrays})
+    )
 
 
 def buffered_messages(server: viser.ViserServer) -> int:

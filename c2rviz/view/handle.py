@@ -127,8 +127,11 @@ class ToolHandles:
                 client = None
         return client is not None or self._handoff.waiting(name) or name in self._running
 
-    def draw(self, state: RobotState) -> None:
-        """Put the robot's handle at its tool point, unless a drag of it is under way."""
+    def draw(self, state: RobotState, ee: pin.SE3 | None = None) -> None:
+        """Put the robot's handle at its tool point, unless a drag of it is under way.
+
+        ``ee`` is the end effector's placement in the base frame at ``state.q`` if known
+        (the view's FK of this frame), else it is computed."""
         name = state.name
         if self.busy(name):
             return
@@ -136,7 +139,9 @@ class ToolHandles:
         self._stale.discard(name)
         self._due.discard(name)
         robot = state.robot
-        tool = state.origin * robot.base_placement * robot.ee_pose(state.q) * state.tool
+        if ee is None:
+            ee = robot.ee_pose(state.q)
+        tool = state.origin * robot.base_placement * ee * state.tool
         adapter.queue_pose(self.nodes[name], tool.translation, wxyz(tool.rotation), force)
 
     def due(self) -> set[str]:

@@ -5,7 +5,10 @@ effects (each only records, in O(1)) and, in each send, asks it what time the
 page shows (``shown``: None for now) and to draw what it owns:
 
 * live, each robot's target ghost and path line while it travels (``ghost``),
-  and, at most ``PLOT_HZ``/``READOUT_HZ`` a second, its plots and readout;
+  and, at most ``PLOT_HZ``/``READOUT_HZ`` a second, its plots and its readout
+  (with the panel's pose text: text changing at every frame is unreadable and
+  costs a message a frame); with many robots the plots of all together go out
+  at most ``PLOTS_PER_S`` a second (each robot's in turn);
 * looking back (the timeline at a time of the history), every robot as it was
   then: its links, markers and workcell objects from its ``RobotHistory``, its
   plots ending at that time, no ghost; the world goes on unseen, and its
@@ -86,8 +89,10 @@ class Instruments:
             objects = self._objects_now(name)
             self.histories[name] = RobotHistory(state, world.frame_s, origin, objects)
             with panels[name].folder:
-                self.readouts[name] = RobotReadout(server.gui, state.robot)
-                self.plots[name] = RobotPlots(server.gui, state.robot, origin, velocities)
+                self.readouts[name] = RobotReadout(server.gui, state.robot, len(world.robots))
+                self.plots[name] = RobotPlots(
+                    server.gui, state.robot, origin, velocities, len(world.robots)
+                )
             self.ghosts[name] = RobotGhost(server, views[name])
         self.timeline = timeline
         timeline.follow(self._span)
@@ -100,6 +105,8 @@ class Instruments:
         self._past: float | None = None  # the time drawn while looking back
         self._marker_keys: dict[str, tuple[int, int]] = {}
         self._objects_shown: dict[str, list[WorkcellObject]] = {}
+        self._names = list(self.histories)  # the order draw() takes them in, from _turn
+        self._turn = 0
 
     def bind(self, page_input: PageInput) -> None:
         """Let the page's controls set the plots and the timeline."""
@@ -205,12 +212,24 @@ class Instruments:
         self._reread.update(self.histories)
         return {name: self._objects_now(name) for name in self.histories}
 
-    def draw(self, shown: float | None) -> None:
+    def draw(self, shown: float | None, deadline: float = math.inf) -> None:
         """The plots, readouts, refused targets and the timeline, each when due; then wake
-        the scene for what is due later."""
+        the scene for what is due later.
+
+        Past ``deadline`` [s of ``time.perf_counter``] the robots left wait for the next
+        send (they go first then), so a send of many robots' plots and readouts comes in
+        turns."""
         now = _now()
         wait = math.inf
-        for name, history in self.histories.items():
+        names = self._names
+        first = self._turn % len(names)
+        for k in range(len(names)):
+            name = names[(first + k) % len(names)]
+            if k and time.perf_counter() > deadline:
+                self._turn = first + k
+                wait = 0.0
+                break
+            history = self.histories[name]
             state = self.world.robots[name]
             wait = min(wait, self.ghosts[name].expire(now, state.ghost and shown is None))
             plots = self.plots[name]
@@ -252,8 +271,10 @@ class Instruments:
         else:
             q = self.histories[name].at(shown)
             motion, at = "(looking back)", f"{shown - self.origin_s:.2f} s"
-        tool = state.robot.ee_pose(q) * state.tool
-        self.readouts[name].show(q, tool, motion, at, now)
+        ee = self.views[name].ee_pose(tuple(q))
+        if shown is None:  # the panel's pose goes at the readout's pace too
+            self.panels[name].show_pose(ee)
+        self.readouts[name].show(q, ee * state.tool, motion, at, now)
 
     def _span(self) -> tuple[float, float]:
         """The times every robot's history covers: its latest start, and now [s]."""

@@ -179,12 +179,13 @@ class RobotPanel:
         # round() then + 0.0: no "-0.0" in the readout
         x, y, z = (round(float(v), 3) + 0.0 for v in ee.translation)
         roll, pitch, yaw = (round(float(v), 1) + 0.0 for v in np.degrees(se3_pose(ee)[3:]))
-        self.pose.value = (
-            f"x {x:+.3f}  y {y:+.3f}  z {z:+.3f} m\nR {roll:+.1f}  P {pitch:+.1f}  Y {yaw:+.1f} deg"
-        )
+        text = f"x {x:+.3f}  y {y:+.3f}  z {z:+.3f} m\n"
+        text += f"R {roll:+.1f}  P {pitch:+.1f}  Y {yaw:+.1f} deg"
+        adapter.set_gui_value(self.pose, text)
 
     def show_motion(self, moving: bool, seconds_left: float) -> None:
-        self.motion.value = f"moving, {seconds_left:.1f} s left" if moving else "idle"
+        text = f"moving, {seconds_left:.1f} s left" if moving else "idle"
+        adapter.set_gui_value(self.motion, text)
 
     def show_collisions(self, pairs: Sequence[tuple[str, str]]) -> None:
         """The colliding pairs, ``a~b, c~d``; ``none`` when there are none."""

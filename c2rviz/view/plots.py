@@ -12,8 +12,9 @@ colour (none for a continuous joint). The joints plotted are chosen by checkbox;
 velocity chart (on by default when moves take time).
 
 Plots cost the server a chart update (three arrays per joint) per draw, so the
-page draws them at most ``PLOT_HZ`` a second; a change after a quiet spell goes
-out with the frame that shows it (``due``). The charts are the page's, like
+page draws them at most ``PLOT_HZ`` a second, and at most ``PLOTS_PER_S`` a
+second over all robots; a change after a quiet spell goes out with the frame
+that shows it (``due``). The charts are the page's, like
 every control: all tabs show the same ones, and a late tab is sent their state.
 """
 
@@ -28,6 +29,7 @@ import viser
 import viser.uplot as uplot
 
 from ..robot.model import Robot
+from . import adapter
 from .history import RobotHistory
 from .page_values import within
 from .panel import short_label
@@ -36,6 +38,7 @@ __all__ = [
     "COLORS",
     "DEFAULT_WINDOW_S",
     "PLOT_HZ",
+    "PLOTS_PER_S",
     "PLOT_POINTS",
     "WINDOW_RANGE_S",
     "RobotPlots",
@@ -49,6 +52,10 @@ PLOT_POINTS = 200
 """Points per line at most (a chart in the side panel is about 300 pixels wide)."""
 PLOT_HZ = 10.0
 """Chart updates a second at most, per robot."""
+PLOTS_PER_S = 80.0
+"""Chart updates a second at most, all robots together: in a cell of more than
+``PLOTS_PER_S / PLOT_HZ`` robots each robot's charts go out less often (64 robots: every
+0.8 s), which bounds what the plots cost the server and the page."""
 COLORS = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf")
 _X = uplot.Series(label="t [s]")
 _SCALES = {"x": uplot.Scale(time=False)}
@@ -84,14 +91,24 @@ class RobotPlots:
         positions: The joint chart [deg or m].
         speeds: The velocity chart [deg/s or m/s].
         tool_speed: The tool point's speed chart [m/s].
+        period_s: Shortest time between two updates [s of real time].
         drawn_s: The time the charts last ended at [s of the clock], None before the first.
         draws: Chart updates so far.
     """
 
-    def __init__(self, gui: viser.GuiApi, robot: Robot, origin_s: float, velocities: bool):
+    def __init__(
+        self,
+        gui: viser.GuiApi,
+        robot: Robot,
+        origin_s: float,
+        velocities: bool,
+        robots: int = 1,
+    ) -> None:
         """Add the charts to the folder open in ``gui``; times are plotted in seconds from
-        ``origin_s`` (the server's start, as ``watch``) [s of the clock]."""
+        ``origin_s`` (the server's start, as ``watch``) [s of the clock]; ``robots`` is how
+        many robots' charts share ``PLOTS_PER_S``."""
         self.robot = robot
+        self.period_s = max(1.0 / PLOT_HZ, robots / PLOTS_PER_S)
         self.origin_s = origin_s
         self._scale = np.array([1.0 if j.prismatic else 180.0 / math.pi for j in robot.joints])
         self._units = ["m" if j.prismatic else "deg" for j in robot.joints]
@@ -147,6 +164,7 @@ class RobotPlots:
                 aspect=2.4,
             )
         self._chosen: tuple[int, ...] | None = None  # the series are set at the first draw
+        self._limits: tuple[tuple[tuple[int, ...], int], list[np.ndarray]] | None = None
         self._last_draw = -math.inf
         self.drawn_s: float | None = None
         self.draws = 0
@@ -168,16 +186,16 @@ class RobotPlots:
     # drawing
 
     def due(self, now_s: float) -> bool:
-        """Whether a draw may go out now (``PLOT_HZ``), if the charts are on and not paused.
+        """Whether a draw may go out now (``period_s``), if the charts are on and not paused.
 
         ``now_s`` is real time [s] (the loop's), which bounds the server's cost."""
         if not self.shown.value or self.pause.value:
             return False
-        return now_s - self._last_draw >= 1.0 / PLOT_HZ
+        return now_s - self._last_draw >= self.period_s
 
     def wait_s(self, now_s: float) -> float:
         """How long until a draw may go out [s of real time]."""
-        return max(self._last_draw + 1.0 / PLOT_HZ - now_s, 0.0)
+        return max(self._last_draw + self.period_s - now_s, 0.0)
 
     def draw(self, history: RobotHistory, end_s: float, now_s: float) -> None:
         """Update the charts to the window ending at clock time ``end_s`` [s]."""
@@ -200,14 +218,15 @@ class RobotPlots:
         dt[dt <= 0.0] = np.inf  # the first sample: no velocity known, show 0
         if columns:
             values = window.qs[picked][:, columns] * self._scale[columns]
-            self.positions.data = (x, *values.T, *self._limit_values(chosen, len(x)))
+            limits = self._limit_values(chosen, len(x))
+            adapter.set_chart_data(self.positions, (x, *values.T, *limits))
             if self.velocities.value:
                 rates = (window.qs[picked] - window.qs[previous])[:, columns] / dt[:, None]
-                self.speeds.data = (x, *(rates * self._scale[columns]).T)
-        self.positions.visible = bool(columns)
-        self.speeds.visible = bool(self.velocities.value) and bool(columns)
+                adapter.set_chart_data(self.speeds, (x, *(rates * self._scale[columns]).T))
+        _show(self.positions, bool(columns))
+        _show(self.speeds, bool(self.velocities.value) and bool(columns))
         moved = np.linalg.norm(window.tool[picked] - window.tool[previous], axis=1)
-        self.tool_speed.data = (x, moved / dt)
+        adapter.set_chart_data(self.tool_speed, (x, moved / dt))
 
     def _unit_text(self) -> str:
         return "/".join(sorted(set(self._units), key=self._units.index))
@@ -238,6 +257,11 @@ class RobotPlots:
         ]
 
     def _limit_values(self, chosen: tuple[int, ...], count: int) -> list[np.ndarray]:
+        """The dashed limit lines' values, ``count`` points each (kept while the joints
+        chosen and the count stay the same; never changed once sent)."""
+        key = (chosen, count)
+        if self._limits is not None and self._limits[0] == key:
+            return self._limits[1]
         out = []
         for i in chosen:
             joint = self.robot.joints[i]
@@ -245,4 +269,11 @@ class RobotPlots:
                 continue
             for value in (joint.lower, joint.upper):
                 out.append(np.full(count, value * self._scale[i]))
+        self._limits = (key, out)
         return out
+
+
+def _show(chart: Any, visible: bool) -> None:
+    """``chart.visible = visible``, without viser's cast when it is already so."""
+    if chart.visible != visible:
+        chart.visible = visible

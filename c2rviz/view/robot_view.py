@@ -32,6 +32,7 @@ __all__ = ["GHOST_OPACITY", "RobotView", "node_name", "wxyz"]
 
 GHOST_OPACITY = 0.3
 GHOST_GREY = (0.7, 0.7, 0.72)  # for a mesh that brings colours of its own
+_WXYZ_ORDER = [0, 1, 2, 6, 3, 4, 5]  # pin.SE3ToXYZQUAT's x y z qx qy qz qw as x y z w x y z
 
 
 def wxyz(rotation: np.ndarray) -> np.ndarray:
@@ -57,6 +58,7 @@ class RobotView:
         target_frames: The ghost's link frames, by link name.
         collision_nodes: The collision geometry (hidden until asked for).
         sent_q: The chain values [rad or m] drawn last.
+        sent_ee: The end effector's placement in the base frame drawn last.
         sent_target: The target [rad or m] the ghost shows (None: hidden).
     """
 
@@ -83,6 +85,7 @@ class RobotView:
         self.robot = robot
         self.origin = origin
         self._data = robot.model.createData()  # the world's robot.data is not ours
+        self._probe = robot.model.createData()  # FK of poses not drawn (keeps _data's)
         self._scene = server.scene
         self.prefix = f"/robots/{segment}"
         self.root = self._scene.add_frame(
@@ -100,6 +103,7 @@ class RobotView:
         self.link_frames: dict[str, Any] = {}
         self.target_frames: dict[str, Any] = {}
         self._frames: list[tuple[int, Any]] = []
+        self._batches: dict[int, tuple[list[tuple[int, Any]], adapter.PoseBatch]] = {}
         self._target_frames: list[tuple[int, Any]] = []
         self.target_root: Any = None  # the ghost is built at the first move
         self._geometry = geometry
@@ -122,6 +126,7 @@ class RobotView:
             f"{self.prefix}/links/{node_name(robot.eelink)}/ee", axes_length=0.12, axes_radius=0.005
         )
         self.sent_q: tuple[float, ...] | None = None
+        self.sent_ee: pin.SE3 | None = None
         self.sent_target: tuple[float, ...] | None = None
 
     def draw(self, q: tuple[float, ...], opening: float | None = None) -> pin.SE3:
@@ -134,7 +139,19 @@ class RobotView:
         data = self._data
         self._pose(self._frames, q, opening)
         self.sent_q = q
-        return self.robot.base_placement.actInv(data.oMf[self.robot.ee_frame])
+        self.sent_ee = self.robot.base_placement.actInv(data.oMf[self.robot.ee_frame])
+        return self.sent_ee
+
+    def ee_pose(self, q: tuple[float, ...]) -> pin.SE3:
+        """The end effector's placement in the base frame for chain values ``q`` [rad or
+        m]: the one drawn last if ``q`` is what it was drawn for (no second FK)."""
+        if q == self.sent_q and self.sent_ee is not None:
+            return self.sent_ee
+        model, data = self.robot.model, self._probe
+        pin.forwardKinematics(model, data, self.robot.configuration(q))
+        return self.robot.base_placement.actInv(
+            pin.updateFramePlacement(model, data, self.robot.ee_frame)
+        )
 
     def show_target(self, target: tuple[float, ...] | None) -> None:
         """Stand the ghost at ``target`` [rad or m]; None hides it."""
@@ -208,9 +225,12 @@ class RobotView:
         model, data = self.robot.model, self._data
         pin.forwardKinematics(model, data, self.robot.configuration(q, opening))
         pin.updateFramePlacements(model, data)
-        for frame_id, handle in frames:
-            placement = data.oMf[frame_id]
-            adapter.queue_pose(handle, placement.translation, wxyz(placement.rotation))
+        held = self._batches.get(id(frames))
+        if held is None:  # the list is kept with its batch: its id stays its own
+            held = self._batches[id(frames)] = (frames, adapter.PoseBatch([h for _, h in frames]))
+        oMf = data.oMf
+        xyzquat = np.array([pin.SE3ToXYZQUAT(oMf[frame_id]) for frame_id, _ in frames])
+        held[1].queue(xyzquat[:, _WXYZ_ORDER])
 
     def _add_shape(self, name: str, shape: Shape, visible: bool, ghost: bool = False) -> Any:
         scene = self._scene

@@ -13,8 +13,10 @@ thousands of times a second; each call only records what changed and asks
 for a send. A send, at most one per frame (``1/hz``), draws the latest state:
 each changed robot's links (Pinocchio FK), its target ghost and path while it
 moves, its panel, the markers, the workcell objects and collisions, the trails
-(``workcell_layer``), the plots and readouts when due, in one atomic batch; or,
-while the timeline looks back, every robot as it was at that time.
+(``workcell_layer``), the plots and readouts when due; or, while the timeline
+looks back, every robot as it was at that time. A send of many robots comes in
+slices of ``SLICE_S`` (each an atomic batch), the loop taking a turn between
+them, and the scheduler paces sends by their cost (docs/page.md, "Many robots").
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import socket
+import time
 from collections import deque
 from collections.abc import Sequence
 
@@ -51,6 +54,9 @@ __all__ = ["RECENT_COMMANDS", "STOP_TIMEOUT_S", "ViserScene"]
 log = logging.getLogger("c2rviz.view")
 
 STOP_TIMEOUT_S = 0.5  # longest wait for viser to stop [s]; it goes on stopping after
+SLICE_S = 0.002
+"""Longest run of drawing robots before the loop gets a turn [s] (a send of many robots
+comes in slices, so a client's line never waits behind a whole frame)."""
 
 
 class ViserScene(Scene):
@@ -115,6 +121,7 @@ class ViserScene(Scene):
         self._stopped = False
         self._loop: asyncio.AbstractEventLoop | None = None
         self._dirty: set[str] = set(world.robots)
+        self._drawing: list[str] | None = None  # the robots the send under way has left
         self._commands: deque[tuple[str, bool]] = deque(maxlen=RECENT_COMMANDS)  # newest first
         self._client_count = services.client_count
         self._state_dirty = True
@@ -303,41 +310,74 @@ class ViserScene(Scene):
 
     # sending
 
-    def _send(self) -> None:
-        """Draw whatever changed since the last send, in one atomic batch."""
+    def _send(self) -> bool:
+        """Draw whatever changed since the last send, in one atomic batch per slice.
+
+        A send draws each robot changed at its start once; after ``SLICE_S`` of drawing
+        robots it returns True, the robots left for its next slice (the scheduler runs
+        it at the loop's next turn). The last slice draws the rest: markers, workcells,
+        instruments, the state panel.
+        """
         if self._stopped:
-            return
-        world, busy, instruments = self.world, self.page_input.busy, self.instruments
+            return False
+        world, instruments = self.world, self.instruments
+        began = time.perf_counter()
         with self.server.atomic():
             shown = instruments.shown()  # None: now; else the time the page looks back at
             if shown is None:
-                objects_now = instruments.back_to_live()
-                if objects_now is not None:  # back from looking back: everything, as it is now
-                    self._objects.update(objects_now)
-                    self._dirty.update(world.robots)
-                for name in self._dirty:
-                    state = world.robots.get(name)
-                    if state is None:
-                        continue
-                    view, panel = self.views[name], self.panels[name]
-                    panel.show_pose(view.draw(state.q, state.opening))
-                    instruments.draw_live(name)
-                    panel.show_joints(state.target, busy)
-                    panel.show_motion(world.moving(name), world.travels.seconds_left(state))
+                if self._drawing is None:  # a new send: the robots changed by now
+                    objects_now = instruments.back_to_live()
+                    if objects_now is not None:  # back from looking back: all, as it is now
+                        self._objects.update(objects_now)
+                        self._dirty.update(world.robots)
+                    self._drawing, self._dirty = list(self._dirty), set()
+                drew = bool(self._drawing)
+                if self._draw_robots(began + SLICE_S):
+                    return True  # robots left for the next slice
+                if drew and time.perf_counter() > began + SLICE_S / 2:
+                    self._drawing = []  # all drawn: the rest gets a slice of its own
+                    return True
                 self.markers.draw()
             else:
+                if self._drawing:  # looked back mid-send: those robots wait for live
+                    self._dirty.update(self._drawing)
                 instruments.draw_past(shown)
-            for name in self.handles.due() | (self._dirty if shown is None else set()):
+            self._drawing = None
+            for name in self.handles.due():
                 if name in world.robots:
                     self.handles.draw(world.robots[name])
-            if shown is None:
-                self._dirty.clear()
             self._draw_workcells(shown is None)
-            instruments.draw(shown)
+            instruments.draw(shown, time.perf_counter() + SLICE_S)
             if self._state_dirty:
                 self._state_dirty = False
                 self.state_panel.show(self._client_count, self._commands)
         self.server.flush()
+        return False
+
+    def _draw_robots(self, deadline: float) -> bool:
+        """Draw the robots of this send until ``deadline`` [s of ``time.perf_counter``],
+        at least one.
+
+        Returns:
+            Whether robots are left for the next slice.
+        """
+        drawing = self._drawing
+        assert drawing is not None
+        world, busy, instruments = self.world, self.page_input.busy, self.instruments
+        while drawing:
+            state = world.robots.get(drawing.pop())
+            if state is None:
+                continue
+            name = state.name
+            view, panel = self.views[name], self.panels[name]
+            ee = view.draw(state.q, state.opening)
+            instruments.draw_live(name)
+            panel.show_joints(state.target, busy)
+            panel.show_motion(world.moving(name), world.travels.seconds_left(state))
+            self.handles.draw(state, ee)
+            if drawing and time.perf_counter() >= deadline:
+                return True
+        return False
 
     def _draw_workcells(self, live: bool) -> None:
         """The objects (``live``: looking back draws its own) and collisions that changed,
