@@ -63,3 +63,42 @@ def test_the_five_minute_tour_replies_as_shown(c2rviz_process) -> None:
     assert script[0] == ".venv/bin/c2rviz-cli <<'EOF'" and script[-1] == "EOF"
     done = run_cli(proc.port, "\n".join(script[1:-1]) + "\n")
     assert done.stdout.splitlines() == block_after("\nEOF\n```"), done.stderr
+
+
+def test_a_recording_and_its_bag_played_back(c2rviz_process, tmp_path) -> None:
+    proc = c2rviz_process("--no-viewer", "--no-crcl", "--record-dir", str(tmp_path))
+    marker = "Record a session; the recording is a command file, a CSV, a page and a ROS bag:"
+    (line,) = block_after(marker)
+    lines = re.fullmatch(r"printf '(.*)' \| \.venv/bin/c2rviz-cli", line)
+    assert lines is not None, line
+    done = run_cli(proc.port, lines.group(1).encode().decode("unicode_escape"))
+
+    def shape(text: str, folder: str) -> str:  # the folder and the figures vary
+        return re.sub(r"\d+(\.\d+)?", "#", text.replace(folder, "FOLDER"))
+
+    shown = block_after(line + "\n```")
+    assert [shape(s, str(tmp_path)) for s in done.stdout.splitlines()] == [
+        shape(s, "/home/you/c2rviz/recordings") for s in shown
+    ]
+    assert (tmp_path / "demo" / "demo.mcap").is_file()
+    play = Path(sys.executable).with_name("c2rviz-play")
+    played = subprocess.run(
+        [str(play), str(tmp_path / "demo"), "--port", str(proc.port)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert played.returncode == 0 and "/joint_states, all ok" in played.stdout, played
+
+
+def test_the_pytest_example_passes_with_the_plugin(tmp_path) -> None:
+    snippet = block_after("test from the plugin installed with c2rviz:")
+    (tmp_path / "test_readme.py").write_text("\n".join(snippet) + "\n")
+    done = subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "test_readme.py"],  # the entry point loads it,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0 and "1 passed" in done.stdout, done.stdout + done.stderr
