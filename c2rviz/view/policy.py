@@ -16,10 +16,10 @@ from dataclasses import dataclass
 from urllib.parse import parse_qs, quote, urlsplit
 
 from ..errors import C2rvizError, shown
+from ..origins import LOOPBACK_HOSTS, normalize_origin
 
 __all__ = ["LOOPBACK_HOSTS", "DoorPolicy", "DoorPolicyError", "normalize_origin"]
 
-LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "[::1]")
 WILDCARD_HOSTS = ("", "0.0.0.0", "::", "[::]")
 
 
@@ -29,29 +29,6 @@ class DoorPolicyError(C2rvizError):
     def __init__(self, name: str, value: object, expected: str) -> None:
         self.name, self.value = name, value
         super().__init__(f"viewer {name} {shown(str(value))} is not {expected}")
-
-
-def normalize_origin(origin: str) -> str | None:
-    """``scheme://host:port`` in lower case with the port spelled out, or None.
-
-    None for anything but an ``http``/``https`` origin (``null``, a path, ...).
-    """
-    try:
-        parts = urlsplit(origin.strip())
-        port = parts.port
-    except ValueError:
-        return None
-    if (
-        parts.scheme not in ("http", "https")
-        or not parts.hostname
-        or parts.path not in ("", "/")
-        or parts.query
-        or parts.fragment
-        or "@" in parts.netloc
-    ):
-        return None
-    host = f"[{parts.hostname}]" if ":" in parts.hostname else parts.hostname
-    return f"{parts.scheme}://{host}:{port or (443 if parts.scheme == 'https' else 80)}"
 
 
 @dataclass(frozen=True)

@@ -95,7 +95,7 @@ def test_the_pytest_example_passes_with_the_plugin(tmp_path) -> None:
     snippet = block_after("test from the plugin installed with c2rviz:")
     (tmp_path / "test_readme.py").write_text("\n".join(snippet) + "\n")
     done = subprocess.run(
-        [sys.executable, "-m", "pytest", "-q", "test_readme.py"],  # the entry point loads the plugin
+        [sys.executable, "-m", "pytest", "-q", "test_readme.py"],  # the plugin: by entry point
         cwd=tmp_path,
         capture_output=True,
         text=True,

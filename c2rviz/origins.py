@@ -1,0 +1,39 @@
+"""Browser origins, as the doors that browsers reach check them (pure, standard library).
+
+Browsers send ``Origin`` with every websocket they open and do not hold websockets to the
+same-origin rule, so the page's door (``view.policy``) and rosbridge's
+(``transports.rosbridge.policy``) both compare it with the origins they allow, spelled
+one way by ``normalize_origin``. A host name that resolves to 127.0.0.1 is not enough
+(DNS rebinding): the loopback names are fixed.
+"""
+
+from __future__ import annotations
+
+from urllib.parse import urlsplit
+
+__all__ = ["LOOPBACK_HOSTS", "normalize_origin"]
+
+LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "[::1]")
+
+
+def normalize_origin(origin: str) -> str | None:
+    """``scheme://host:port`` in lower case with the port spelled out, or None.
+
+    None for anything but an ``http``/``https`` origin (``null``, a path, ...).
+    """
+    try:
+        parts = urlsplit(origin.strip())
+        port = parts.port
+    except ValueError:
+        return None
+    if (
+        parts.scheme not in ("http", "https")
+        or not parts.hostname
+        or parts.path not in ("", "/")
+        or parts.query
+        or parts.fragment
+        or "@" in parts.netloc
+    ):
+        return None
+    host = f"[{parts.hostname}]" if ":" in parts.hostname else parts.hostname
+    return f"{parts.scheme}://{host}:{port or (443 if parts.scheme == 'https' else 80)}"
