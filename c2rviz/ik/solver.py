@@ -32,7 +32,6 @@ import pinocchio as pin
 
 from ..robot.model import Robot
 from .chain import IkChain
-from .closest import ClosestPose
 from .newton import Descent, NewtonDescent
 from .reach import ReachBound
 from .seeds import SeedPool
@@ -126,6 +125,8 @@ class IkSolver:
         )
         self.reach = ReachBound(self.chain)
         self.seeds = SeedPool(self.chain, s.seed_pool, s.seed, s.orientation_cost)
+        from .closest import ClosestPose  # pink (and scipy) load on the first solver: start fast
+
         self._closest = ClosestPose(self.chain, s.orientation_cost, s.posture_cost)
 
     # --- public -----------------------------------------------------------------------
