@@ -67,17 +67,22 @@ def page_shows(h: Harness, tab: Tab, qs: dict[str, Any], tol: float = 1e-9) -> b
         robot = h.world.robots[name].robot
         data = robot.model.createData()
         pin.framesForwardKinematics(robot.model, data, robot.configuration(q))
-        prefix = h.scene.views[name].prefix
+        prefix = f"{h.scene.views[name].prefix}/links"
         for link in robot.link_names():
             expected = data.oMf[robot.model.getFrameId(link, pin.BODY)]
-            position, wxyz = poses.get(
-                f"{prefix}/links/{link}", (np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
-            )
-            w, x, y, z = wxyz
-            rotation = pin.Quaternion(w, x, y, z).toRotationMatrix()
+            node = h.scene.views[name].link_nodes[link]
+            got = pin.SE3.Identity()  # the nested frames' poses, composed down the path
+            segments = node[len(prefix) + 1 :].split("/")
+            for k in range(len(segments)):
+                position, wxyz = poses.get(
+                    "/".join([prefix, *segments[: k + 1]]),
+                    (np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])),
+                )
+                w, x, y, z = wxyz
+                got = got * pin.SE3(pin.Quaternion(w, x, y, z).toRotationMatrix(), position)
             if not (
-                np.allclose(position, expected.translation, atol=tol)
-                and np.allclose(rotation, expected.rotation, atol=tol)
+                np.allclose(got.translation, expected.translation, atol=tol)
+                and np.allclose(got.rotation, expected.rotation, atol=tol)
             ):
                 return False
     return True
