@@ -42,6 +42,8 @@ sys.path.insert(0, str(ROOT))  # this tree's c2rviz, not an installed one
 from c2rviz.motion.limits import motion_limits  # noqa: E402
 from c2rviz.motion.planner import Motion  # noqa: E402
 from c2rviz.robot.model import Robot  # noqa: E402
+from c2rviz.view.link_tree import LinkTree  # noqa: E402
+from c2rviz.view.robot_view import node_name  # noqa: E402
 
 __all__ = ["MotionPlan", "measure_motion"]
 
@@ -60,27 +62,28 @@ class MotionPlan:
 
 
 class JointReader:
-    """Joint 0 of the chain read back from its child link's orientation in the world."""
+    """Joint 0 of the chain read back from its child link's orientation in its parent
+    link's frame (the page nests each link's frame in its parent's)."""
 
     def __init__(self, robot: Robot) -> None:
+        tree = LinkTree(robot, node_name)
         home = [0.0] * robot.n
         turned = [0.1] + home[1:]
         rotations = {}
         for q in (home, turned):
-            pin.framesForwardKinematics(robot.model, robot.data, robot.configuration(q))
+            pin.forwardKinematics(robot.model, robot.data, robot.configuration(q))
             rotations[q[0]] = {
-                name: robot.data.oMf[robot.model.getFrameId(name, pin.BODY)].rotation.copy()
-                for name in robot.link_names()
+                link.name: tree.local(link, robot.data).rotation.copy() for link in tree.links
             }
         # The first link that turns with joint 0 (its child).
-        self.link = next(
-            name
-            for name in robot.link_names()
-            if not np.allclose(rotations[0.0][name], rotations[0.1][name])
+        first = next(
+            link
+            for link in tree.links
+            if not np.allclose(rotations[0.0][link.name], rotations[0.1][link.name])
         )
-        # The viewer's node: /robots/<robot name>/links/<link> (c2rviz/view/robot_view.py).
-        safe = re.sub(r"[^A-Za-z0-9_.-]", "_", self.link)
-        self.node = f"/robots/{robot.name}/links/{safe}"
+        self.link = first.name
+        # The viewer's node (c2rviz/view/robot_view.py).
+        self.node = f"/robots/{robot.name}/links/{first.path}"
         self.home = rotations[0.0][self.link]
         self.axis = pin.log3(rotations[0.1][self.link] @ self.home.T) / 0.1
 

@@ -162,7 +162,7 @@ def live(robots: int, window_s: float) -> dict[str, tuple[float, float]]:
         )
         argv = [sys.executable, "-m", "c2rviz", "--cell", str(ini), "--viser-port", "0"]
         proc = launch(argv, viewer=True, timeout_s=120)
-        tab = Tab(proc.url or "", f"/robots/{names[0]}/links/link_s")
+        tab = Tab(proc.url or "", f"/robots/{names[0]}/links/base_link/link_s")
         mover = Mover(proc.address, names)
         try:
             time.sleep(2.0)  # every robot under way, every chart drawn once
@@ -258,7 +258,7 @@ def recording(seconds: float, folder: Path, name: str) -> dict[str, object]:
 FIRST_FRAME = "() => window.__c2rvizPlayer && window.__c2rvizPlayer.state().frame >= 0"
 SCENE_SHOWN = """() => {
   const tree = window.__viserSceneTree, m = window.__viserMutable;
-  return !!(tree && m && Object.keys(tree.getState()).some((n) => n.endsWith("/links/link_t")));
+  return !!(tree && m && Object.keys(tree.getState()).some((n) => n.endsWith("/link_t")));
 }"""
 
 

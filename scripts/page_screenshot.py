@@ -82,7 +82,7 @@ def live_page(browser: object, out: Path, record_dir: Path) -> None:
         page.goto(program.url + "/?fixedDpr=1")
         page.wait_for_function(
             "() => window.__viserSceneTree && Object.keys(window.__viserSceneTree.getState())"
-            ".some((n) => n.endsWith('/links/link_t'))",
+            ".some((n) => n.endsWith('/link_t'))",
             timeout=120_000,
         )
         ask = program.ask

@@ -32,16 +32,21 @@ JOINTS = ("joint_s", "joint_l", "joint_e", "joint_u", "joint_r", "joint_b", "joi
 DEADLINE_S = 180.0  # for any one wait; a healthy run takes a second or two per step
 
 # viser's end-to-end hooks (App.tsx puts them on window for Playwright): the one place
-# this file reads the page's internals. Robot links are /robots/ROBOT/links/LINK, their geometry
-# /robots/ROBOT/links/LINK/visual_K, markers batched in /markers/ROBOT/SHAPE (c2rviz/view/).
+# this file reads the page's internals. Robot links nest as the URDF's tree,
+# /robots/ROBOT/links/ROOT/.../LINK, each posed in its parent's frame (``in_root`` composes
+# them); their geometry /robots/ROBOT/links/.../LINK/visual_K, markers batched in
+# /markers/ROBOT/SHAPE (c2rviz/view/).
+# A link's frame node under /robots/ROBOT/links/ (not its geometry nor the tool's axes).
+LINK_NODE_JS = """(n) => /^\\/robots\\/[^/]+\\/links\\//.test(n)
+  && !/\\/((visual|collision|overlay)_\\d+|ee)$/.test(n)"""
 PAGE_STATE = """() => {
   const m = window.__viserMutable, t = window.__viserSceneTree, tp = window.__viserTestpoints;
   if (!m || !t || !tp) return null;
   const nodes = Object.keys(t.getState());
-  const visuals = nodes.filter((n) => /^\\/robots\\/[^/]+\\/links\\/[^/]+\\/visual_\\d+$/.test(n));
+  const visuals = nodes.filter((n) => /^\\/robots\\/[^/]+\\/links\\/.+\\/visual_\\d+$/.test(n));
   const poses = {};
   for (const [n, p] of Object.entries(m.nodePoseData)) {
-    if (/^\\/robots\\/[^/]+\\/links\\/[^/]+$/.test(n)) poses[n] = [...p.wxyz, ...p.position];
+    if (LINK_NODE(n)) poses[n] = [...p.wxyz, ...p.position];
   }
   let markers = 0;  // one batched node per robot and shape: count its instances
   for (const n of nodes.filter((n) => /^\\/markers\\//.test(n))) {
@@ -56,7 +61,31 @@ PAGE_STATE = """() => {
     frame: tp.rendererInfo.render.frame,
     poses,
   };
-}"""
+}""".replace("LINK_NODE", f"({LINK_NODE_JS})")
+
+
+def in_root(poses: dict[str, list[float]]) -> dict[str, np.ndarray]:
+    """Link node poses (w, x, y, z, px, py, pz, each in its parent link's frame, as the
+    page holds them) in their robot's root frame, by ``/robots/ROBOT/links/LINK``."""
+    import pinocchio as pin
+
+    def se3(p: list[float]) -> pin.SE3:
+        w, x, y, z, *position = p
+        return pin.SE3(
+            pin.Quaternion(w, x, y, z).normalized().toRotationMatrix(), np.array(position)
+        )
+
+    out = {}
+    for name in poses:
+        robot, path = name.split("/links/", 1)
+        segments = path.split("/")
+        pose = pin.SE3.Identity()
+        for k in range(len(segments)):
+            above = f"{robot}/links/" + "/".join(segments[: k + 1])
+            pose = pose * se3(poses.get(above, [1.0, 0, 0, 0, 0, 0, 0]))
+        x, y, z, w = pin.Quaternion(pose.rotation).coeffs()
+        out[f"{robot}/links/{segments[-1]}"] = np.array([w, x, y, z, *pose.translation])
+    return out
 
 
 class Tcp:

@@ -154,7 +154,9 @@ def _scene(
         view = RobotView(server, name, robot, origin, load_link_geometry(robot.source), _SEGMENT)
         first = tuple(map(float, frames.values[0, : robot.n])) if len(frames.times) else None
         view.draw(first or robot.home)
-        links = [f"{view.prefix}/links/{node_name(link)}" for link in robot.link_names()]
+        links = [view.link_nodes[link] for link in robot.link_names()]
+        row = {node: k for k, node in enumerate(links)}  # a link's parent: the node above it
+        parents = [row.get(node.rsplit("/", 1)[0], -1) for node in links]
         markers = {}
         used = {int(s) for s in commands.marks[:, 12]} if len(commands.marks) else set()
         for k in sorted(used):
@@ -184,7 +186,12 @@ def _scene(
         html = server.get_scene_serializer().as_html()
     finally:
         adapter.stop(server)
-    return html, {"linkNodes": links, "markerNodes": markers, "objectNodes": objects}
+    return html, {
+        "linkNodes": links,
+        "linkParents": parents,
+        "markerNodes": markers,
+        "objectNodes": objects,
+    }
 
 
 def _aim_camera(server: Any, view: RobotView) -> None:

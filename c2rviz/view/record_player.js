@@ -85,6 +85,10 @@
     var r = qrot(a.q, b.p);
     return { p: [a.p[0] + r[0], a.p[1] + r[1], a.p[2] + r[2]], q: qmul(a.q, b.q) };
   }
+  function relative(a, b) {  // b in a's frame: a^-1 * b
+    var c = [a.q[0], -a.q[1], -a.q[2], -a.q[3]];
+    return { p: qrot(c, [b.p[0] - a.p[0], b.p[1] - a.p[1], b.p[2] - a.p[2]]), q: qmul(c, b.q) };
+  }
   function placement(x) { return { p: [x[0], x[1], x[2]], q: [x[3], x[4], x[5], x[6]] }; }
   function exp6(tw, s) {  // exp of the twist tw = (v, w) times s
     var v = [tw[0] * s, tw[1] * s, tw[2] * s], w = [tw[3] * s, tw[4] * s, tw[5] * s];
@@ -275,8 +279,10 @@
       if (k !== st.drawnFrame) {
         st.drawnFrame = k;
         var q = Array.prototype.slice.call(data.values.subarray(k * width, k * width + n));
-        poseLinks(q).forEach(function (pose, i) {
-          var name = meta.linkNodes[i];
+        var poses = poseLinks(q);  // in the root's frame; a link's node nests in its parent's
+        poses.forEach(function (inRoot, i) {
+          var name = meta.linkNodes[i], up = meta.linkParents[i];
+          var pose = up < 0 ? inRoot : relative(poses[up], inRoot);
           messages.push({ type: "SetPositionMessage", name: name, position: pose.p, owner: "" });
           messages.push({ type: "SetOrientationMessage", name: name, wxyz: pose.q, owner: "" });
         });

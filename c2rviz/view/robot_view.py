@@ -3,10 +3,13 @@
 Like viser's ``ViserUrdf``, a ``RobotView`` is one object per robot, under a
 root node of its own (``/robots/<name>``) placed at the robot's origin in the
 world frame, so a cell of several robots, the same model twice included,
-draws in one scene. Below the root, each link's frame is posed by Pinocchio
-forward kinematics on the view's own ``Data`` (Pinocchio is the one source of
-kinematic truth): a link's pose in the world is ``origin * oMf``. Each link's
-URDF geometry hangs below its frame at its URDF origin.
+draws in one scene. Below the root, the link frames nest as the URDF's tree
+(``/robots/<name>/links/base_link/link_s/...``, ``link_tree``), each posed in its
+parent link's frame by Pinocchio forward kinematics on the view's own ``Data``
+(Pinocchio is the one source of kinematic truth): a link's pose in the world is
+``origin * oMf``, the product of the poses down its path. A joint's turn is then
+one orientation for the page. Each link's URDF geometry hangs below its frame at
+its URDF origin.
 
 While the robot travels, a translucent copy of the arm (the target ghost,
 ``/robots/<name>/target``) stands where the move ends; ``add_copy`` makes such
@@ -27,6 +30,7 @@ import viser
 from ..robot.model import Robot
 from ..robot.visuals import LinkGeometry, Shape
 from . import adapter
+from .link_tree import LinkTree
 
 __all__ = ["GHOST_OPACITY", "RobotView", "node_name", "wxyz"]
 
@@ -54,7 +58,8 @@ class RobotView:
         robot: Its model and chain.
         root: The root node, at the robot's origin in the world frame.
         link_frames: Each link's frame node (Pinocchio body frame), by link name,
-            posed in the root's frame.
+            posed in its parent link's frame (``link_pose``: in the root's).
+        link_nodes: Each link's node name, by link name.
         target_frames: The ghost's link frames, by link name.
         collision_nodes: The collision geometry (hidden until asked for).
         sent_q: The chain values [rad or m] drawn last.
@@ -101,18 +106,20 @@ class RobotView:
         )
         self.collision_nodes: list[Any] = []
         self.link_frames: dict[str, Any] = {}
+        self.link_nodes: dict[str, str] = {}
+        self._tree = LinkTree(robot, node_name)
         self.target_frames: dict[str, Any] = {}
         self._frames: list[tuple[int, Any]] = []
         self._batches: dict[int, tuple[list[tuple[int, Any]], adapter.PoseBatch]] = {}
         self._target_frames: list[tuple[int, Any]] = []
         self.target_root: Any = None  # the ghost is built at the first move
         self._geometry = geometry
-        for link in robot.link_names():
-            frame_id = robot.model.getFrameId(link, pin.BODY)
+        for tree_link in self._tree.links:
+            link = tree_link.name
             shapes = geometry.get(link)
-            node = f"{self.prefix}/links/{node_name(link)}"
+            node = self.link_nodes[link] = f"{self.prefix}/links/{tree_link.path}"
             handle = self._scene.add_frame(node, show_axes=False)
-            self._frames.append((frame_id, handle))
+            self._frames.append((tree_link.frame_id, handle))
             self.link_frames[link] = handle
             if shapes is None:
                 continue
@@ -123,7 +130,7 @@ class RobotView:
                     self._add_shape(f"{node}/collision_{k}", shape, visible=False)
                 )
         self._scene.add_frame(
-            f"{self.prefix}/links/{node_name(robot.eelink)}/ee", axes_length=0.12, axes_radius=0.005
+            f"{self.link_nodes[robot.eelink]}/ee", axes_length=0.12, axes_radius=0.005
         )
         self.sent_q: tuple[float, ...] | None = None
         self.sent_ee: pin.SE3 | None = None
@@ -136,11 +143,28 @@ class RobotView:
         Returns:
             The end effector's placement in the base frame.
         """
-        data = self._data
         self._pose(self._frames, q, opening)
         self.sent_q = q
-        self.sent_ee = self.robot.base_placement.actInv(data.oMf[self.robot.ee_frame])
+        ee = pin.updateFramePlacement(self.robot.model, self._data, self.robot.ee_frame)
+        self.sent_ee = self.robot.base_placement.actInv(ee)
         return self.sent_ee
+
+    def link_pose(self, link: str, frames: dict[str, Any] | None = None) -> pin.SE3:
+        """``link``'s pose in the root's frame as the page was last told: the product of
+        the link frames' poses down its path (``frames``: a copy's, such as
+        ``target_frames``; None: ``link_frames``)."""
+        frames = self.link_frames if frames is None else frames
+        poses: list[pin.SE3] = []
+        for tree_link in self._tree.links:
+            handle = frames[tree_link.name]
+            w, x, y, z = handle.wxyz
+            local = pin.SE3(
+                pin.Quaternion(w, x, y, z).toRotationMatrix(), np.array(handle.position)
+            )
+            poses.append(local if tree_link.parent < 0 else poses[tree_link.parent] * local)
+            if tree_link.name == link:
+                return poses[-1]
+        raise KeyError(f"{link!r} is not a link of {self.name}")
 
     def ee_pose(self, q: tuple[float, ...]) -> pin.SE3:
         """The end effector's placement in the base frame for chain values ``q`` [rad or
@@ -163,8 +187,8 @@ class RobotView:
             if self.target_root is None:
                 self.target_root, self._target_frames = self.add_copy("target")
                 self.target_frames = {
-                    link: handle
-                    for link, (_, handle) in zip(self.robot.link_names(), self._target_frames)
+                    link.name: handle
+                    for link, (_, handle) in zip(self._tree.links, self._target_frames)
                 }
             self._pose(self._target_frames, target)
             if self.sent_target is None:
@@ -182,11 +206,11 @@ class RobotView:
         """
         root = self._scene.add_frame(f"{self.prefix}/{segment}", show_axes=False, visible=False)
         frames = []
-        for link in self.robot.link_names():
-            node = f"{self.prefix}/{segment}/{node_name(link)}"
+        for tree_link in self._tree.links:
+            node = f"{self.prefix}/{segment}/{tree_link.path}"
             handle = self._scene.add_frame(node, show_axes=False)
-            frames.append((self.robot.model.getFrameId(link, pin.BODY), handle))
-            shapes = self._geometry.get(link)
+            frames.append((tree_link.frame_id, handle))
+            shapes = self._geometry.get(tree_link.name)
             for k, shape in enumerate(shapes.visual if shapes is not None else ()):
                 tinted = shape if rgba is None else dataclasses.replace(shape, rgba=rgba)
                 self._add_shape(f"{node}/visual_{k}", tinted, visible=True, ghost=rgba is None)
@@ -202,7 +226,7 @@ class RobotView:
         Returns:
             The copy's nodes (one per visual shape; none for a link without shapes).
         """
-        node = f"{self.prefix}/links/{node_name(link)}"
+        node = self.link_nodes[link]
         shapes = self._geometry.get(link)
         nodes = []
         for k, shape in enumerate(shapes.visual if shapes is not None else ()):
@@ -224,12 +248,11 @@ class RobotView:
     ) -> None:
         model, data = self.robot.model, self._data
         pin.forwardKinematics(model, data, self.robot.configuration(q, opening))
-        pin.updateFramePlacements(model, data)
         held = self._batches.get(id(frames))
         if held is None:  # the list is kept with its batch: its id stays its own
             held = self._batches[id(frames)] = (frames, adapter.PoseBatch([h for _, h in frames]))
-        oMf = data.oMf
-        xyzquat = np.array([pin.SE3ToXYZQUAT(oMf[frame_id]) for frame_id, _ in frames])
+        local = self._tree.local
+        xyzquat = np.array([pin.SE3ToXYZQUAT(local(link, data)) for link in self._tree.links])
         held[1].queue(xyzquat[:, _WXYZ_ORDER])
 
     def _add_shape(self, name: str, shape: Shape, visible: bool, ghost: bool = False) -> Any:

@@ -300,7 +300,8 @@ class ViserScene(Scene):
 
     @property
     def link_frames(self) -> dict[str, object]:
-        """The default robot's link frames, by link name (posed in its root's frame)."""
+        """The default robot's link frames, by link name (each posed in its parent link's
+        frame; ``RobotView.link_pose``: in the root's)."""
         return self.views[self.world.default].link_frames
 
     @property

@@ -22,7 +22,9 @@ from ..protocol import replies
 from .clock import Clock, Timer
 from .state import RobotState
 
-__all__ = ["Travel", "Travels"]
+__all__ = ["TICK_ROBOTS", "Travel", "Travels"]
+
+TICK_ROBOTS = 8  # robots sampled in one turn of the loop (64 robots: ~0.6 ms a turn)
 
 
 @dataclass(eq=False)
@@ -83,6 +85,8 @@ class Travels:
         self.planned = planned
         self.by_robot: dict[str, Travel] = {}
         self._timer: Timer | None = None
+        self._round: list[Travel] = []  # the frame's robots still to sample
+        self._due = math.inf  # the next frame [s], as far as this frame's robots say
 
     def add(self, state: RobotState, limits: MotionLimits) -> Travel:
         travel = self.by_robot[state.name] = Travel(state, Motion(limits, state.q))
@@ -223,12 +227,22 @@ class Travels:
             self._timer = self.clock.call_later(0.0, self._tick)
 
     def _tick(self) -> None:
-        """Sample every moving robot, publish it, settle the arrived; come back next frame."""
+        """Sample every moving robot, publish it, settle the arrived; come back next frame.
+
+        A frame's robots are sampled ``TICK_ROBOTS`` at a time, the loop taking a turn
+        between (a client's line is answered meanwhile), each at the clock's time of its
+        turn."""
+        self._timer = None
+        self._round = [travel for travel in self.by_robot.values() if travel.active]
+        self._due = math.inf
+        self._turn()
+
+    def _turn(self) -> None:
         self._timer = None
         t = self.clock.now()
-        due = math.inf
-        for travel in self.by_robot.values():
-            if not travel.active:
+        batch, self._round = self._round[:TICK_ROBOTS], self._round[TICK_ROBOTS:]
+        for travel in batch:
+            if not travel.active:  # stopped since the frame began
                 continue
             path = travel.path
             if path is not None:
@@ -245,12 +259,16 @@ class Travels:
                     travel.active = False
             self.publish(travel.state, q, t)
             if travel.active:
-                due = min(due, t + self.frame_s, end)
+                self._due = min(self._due, t + self.frame_s, end)
             else:
                 self.rested(travel.state, travel.stopping)
                 _settle(travel.arrivals, replies.OK)
                 _settle(travel.rests, replies.OK)
-        if due < math.inf:
+        if self._round:
+            self._timer = self.clock.call_later(0.0, self._turn)
+        elif any(travel.active for travel in self.by_robot.values()):
+            # (one set going since the frame began waits for the next frame)
+            due = self._due if self._due < math.inf else t + self.frame_s
             self._timer = self.clock.call_at(max(due, self.clock.now()), self._tick)
 
     @staticmethod

@@ -20,8 +20,10 @@ import pinocchio as pin
 import pytest
 from browser_support import (
     ARTIFACTS,
+    LINK_NODE_JS,
     Tcp,
     field,
+    in_root,
     page_state,
     program_page,
     slider_input,
@@ -47,12 +49,10 @@ CHARTS = """() => {
   const m = window.__viserMutable, tp = window.__viserTestpoints;
   const poses = {};
   for (const [n, p] of Object.entries(m ? m.nodePoseData : {})) {
-    if (n.startsWith(NODE) && !n.slice(NODE.length).includes("/")) {
-      poses[n] = [...p.wxyz, ...p.position];
-    }
+    if (n.startsWith(NODE) && (LINK_NODE)(n)) poses[n] = [...p.wxyz, ...p.position];
   }
   return {charts: out, poses, frame: tp ? tp.rendererInfo.render.frame : 0};
-}""".replace("NODE", repr(LINKS))
+}""".replace("LINK_NODE", LINK_NODE_JS).replace("NODE", repr(LINKS))
 VISIBILITY = """(names) => {
   const tree = window.__viserSceneTree ? window.__viserSceneTree.getState() : {};
   return names.map((n) => (tree[n] === undefined ? null : tree[n].visibility !== false));
@@ -74,6 +74,7 @@ def expected_poses(q: Any) -> dict[str, np.ndarray]:
 
 def shows(poses: dict[str, list[float]], q: Any, tol: float = 1e-5) -> bool:
     """Whether the page's link poses are those of ``q`` (a quaternion and its negative agree)."""
+    poses = in_root(poses)  # the page nests each link's frame in its parent's
     for name, want in expected_poses(q).items():
         got = np.asarray(poses.get(name, [np.nan] * 7))
         if not np.allclose(got[4:], want[4:], atol=tol):

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 import pytest
-from browser_support import ARTIFACTS, wait_until
+from browser_support import ARTIFACTS, LINK_NODE_JS, in_root, wait_until
 from support import ServerThread, load_robot
 
 pytestmark = pytest.mark.browser
@@ -26,11 +26,10 @@ STATE = "() => window.__c2rvizPlayer ? window.__c2rvizPlayer.state() : null"
 POSES = """() => {
   const m = window.__viserMutable, out = {};
   for (const [n, p] of Object.entries(m ? m.nodePoseData : {})) {
-    const link = n.startsWith(NODE) && !n.slice(NODE.length).includes("/");
-    if (link) out[n] = [...p.wxyz, ...p.position];
+    if (n.startsWith(NODE) && (LINK_NODE)(n)) out[n] = [...p.wxyz, ...p.position];
   }
   return out;
-}""".replace("NODE", repr(LINKS))
+}""".replace("LINK_NODE", LINK_NODE_JS).replace("NODE", repr(LINKS))
 MARKERS = """() => {
   const tree = window.__viserSceneTree ? window.__viserSceneTree.getState() : {};
   let count = 0;
@@ -75,6 +74,7 @@ def csv_rows(path: Path) -> np.ndarray:
 def shows(poses: dict[str, list[float]], q: Any, tol: float = 2e-5) -> bool:
     """The page's link poses are those of ``q`` [rad] (float32 frames: a few 1e-6 apart)."""
     robot = load_robot()
+    poses = in_root(poses)  # the page nests each link's frame in its parent's
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, robot.configuration(q))
     for link in robot.link_names():

@@ -54,9 +54,10 @@ def assert_drawn_at(h: Harness, name: str, q: Any) -> None:
     robot = h.world.robots[name].robot
     data = robot.model.createData()
     pin.framesForwardKinematics(robot.model, data, robot.configuration(q))
-    for link, handle in h.scene.views[name].link_frames.items():
+    view = h.scene.views[name]
+    for link in view.link_frames:
         expected = data.oMf[robot.model.getFrameId(link, pin.BODY)]
-        assert placement(handle).isApprox(expected, 1e-6), link
+        assert view.link_pose(link).isApprox(expected, 1e-6), link
 
 
 def run(h: Harness, session: Session, line: str) -> Any:

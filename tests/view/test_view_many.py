@@ -67,17 +67,22 @@ def page_shows(h: Harness, tab: Tab, qs: dict[str, Any], tol: float = 1e-9) -> b
         robot = h.world.robots[name].robot
         data = robot.model.createData()
         pin.framesForwardKinematics(robot.model, data, robot.configuration(q))
-        prefix = h.scene.views[name].prefix
+        prefix = f"{h.scene.views[name].prefix}/links"
         for link in robot.link_names():
             expected = data.oMf[robot.model.getFrameId(link, pin.BODY)]
-            position, wxyz = poses.get(
-                f"{prefix}/links/{link}", (np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
-            )
-            w, x, y, z = wxyz
-            rotation = pin.Quaternion(w, x, y, z).toRotationMatrix()
+            node = h.scene.views[name].link_nodes[link]
+            got = pin.SE3.Identity()  # the nested frames' poses, composed down the path
+            segments = node[len(prefix) + 1 :].split("/")
+            for k in range(len(segments)):
+                position, wxyz = poses.get(
+                    "/".join([prefix, *segments[: k + 1]]),
+                    (np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0])),
+                )
+                w, x, y, z = wxyz
+                got = got * pin.SE3(pin.Quaternion(w, x, y, z).toRotationMatrix(), position)
             if not (
-                np.allclose(position, expected.translation, atol=tol)
-                and np.allclose(rotation, expected.rotation, atol=tol)
+                np.allclose(got.translation, expected.translation, atol=tol)
+                and np.allclose(got.rotation, expected.rotation, atol=tol)
             ):
                 return False
     return True
@@ -180,3 +185,24 @@ def test_the_scheduler_runs_a_send_slice_by_slice_then_rests_as_long_as_it_worke
     finally:
         scheduler.stop()
         loop.close()
+
+
+def test_a_moving_arm_is_sent_orientations_only(cell: Callable[..., Harness]) -> None:
+    """The link frames nest as the URDF's tree: a revolute arm's moves turn its links'
+    frames in their parents' and move no link's position (``view.link_tree``)."""
+    h = cell(count=1, hz=1000.0)
+    tab = h.tab()
+    robot = h.world.robots["r0"].robot
+    qs = {"r0": list(robot.home)}
+    h.until(lambda: page_shows(h, tab, qs), "the arm at home")
+    links = set(h.scene.views["r0"].link_nodes.values())
+    seen = len(tab.received)
+    rng = np.random.default_rng(8)
+    for _ in range(5):
+        qs["r0"] = robot.random(rng)
+        h.call(lambda q=qs["r0"]: h.world.set_q(q, "r0"))
+        h.run(0.005)
+    h.until(lambda: page_shows(h, tab, qs), "the arm's last pose")
+    kinds = [m["type"] for m in list(tab.received)[seen:] if m.get("name") in links]
+    assert "SetOrientationMessage" in kinds
+    assert "SetPositionMessage" not in kinds

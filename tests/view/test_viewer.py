@@ -57,12 +57,12 @@ def fk(robot: Robot, q: Any) -> pin.Data:
 
 def assert_frames_match(h: Harness, q: Any, tol: float = 1e-9) -> None:
     data = fk(h.robot, q)
-    for link, handle in h.scene.link_frames.items():
+    view = h.scene.views[h.world.default]
+    for link in h.scene.link_frames:
         expected = data.oMf[h.robot.model.getFrameId(link, pin.BODY)]
-        np.testing.assert_allclose(handle.position, expected.translation, atol=tol, err_msg=link)
-        w, x, y, z = handle.wxyz
-        rotation = pin.Quaternion(w, x, y, z).toRotationMatrix()
-        np.testing.assert_allclose(rotation, expected.rotation, atol=tol, err_msg=link)
+        got = view.link_pose(link)  # composed down the nested link frames
+        np.testing.assert_allclose(got.translation, expected.translation, atol=tol, err_msg=link)
+        np.testing.assert_allclose(got.rotation, expected.rotation, atol=tol, err_msg=link)
 
 
 @pytest.mark.parametrize("name", list(ROBOTS))
@@ -115,9 +115,10 @@ def test_the_fingers_are_drawn_at_the_gripper_opening(harness: Callable[..., Har
         pin.framesForwardKinematics(robot.model, data, robot.configuration(robot.home, opening))
         for link in ("gripper_finger_left", "gripper_finger_right"):
             expected = data.oMf[robot.model.getFrameId(link, pin.BODY)].translation
-            got = h.scene.link_frames[link].position
+            got = h.scene.views[h.world.default].link_pose(link).translation
             np.testing.assert_allclose(got, expected, atol=1e-9, err_msg=link)
-    left, right = (h.scene.link_frames[f"gripper_finger_{s}"].position for s in ("left", "right"))
+    view = h.scene.views[h.world.default]
+    left, right = (view.link_pose(f"gripper_finger_{s}").translation for s in ("left", "right"))
     assert np.linalg.norm(left - right) == pytest.approx(0.002 + 0.25 * 0.06)
 
 
@@ -441,8 +442,8 @@ def test_missing_meshes_warn_and_fall_back(
     assert "arm.stl" not in text  # found next to the URDF
     nodes = h.scene.server.scene._handle_from_node_name
     assert "/robots/meshy/links/base/visual_0" in nodes  # the collision box stands in
-    assert "/robots/meshy/links/arm/visual_0" in nodes
-    assert "/robots/meshy/links/hand/visual_0" in nodes  # the placeholder
+    assert "/robots/meshy/links/base/arm/visual_0" in nodes  # nested as the URDF's tree
+    assert "/robots/meshy/links/base/arm/hand/visual_0" in nodes  # the placeholder
     arm = load_link_geometry(robot.source)["arm"].visual[0]
     assert arm.mesh is not None and arm.rgba == (0.0, 0.0, 1.0, 1.0)
     np.testing.assert_allclose(arm.mesh.extents, [0.1, 0.1, 0.3])  # scale 2 applied
