@@ -91,8 +91,22 @@ def test_a_recording_and_its_bag_played_back(c2rviz_process, tmp_path) -> None:
     assert played.returncode == 0 and "/joint_states, all ok" in played.stdout, played
 
 
+def test_the_client_example_runs_against_the_server(c2rviz_process) -> None:
+    proc = c2rviz_process("--no-viewer", "--no-crcl")
+    snippet = "\n".join(block_after("an `error:` raises `CommandError`):"))
+    assert "port=31000" in snippet
+    done = subprocess.run(
+        [sys.executable, "-c", snippet.replace("port=31000", f"port={proc.port}")],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("(0.5, 0.2, 0.0, -0.4, 0.0, 0.3, 0.0) Pose(x="), done.stdout
+
+
 def test_the_pytest_example_passes_with_the_plugin(tmp_path) -> None:
-    snippet = block_after("test from the plugin installed with c2rviz:")
+    snippet = block_after("`c2rviz --clock virtual`\nfor a whole program, or `--clock scaled:10`):")
     (tmp_path / "test_readme.py").write_text("\n".join(snippet) + "\n")
     done = subprocess.run(
         [sys.executable, "-m", "pytest", "-q", "test_readme.py"],  # the plugin: by entry point
