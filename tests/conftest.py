@@ -62,14 +62,15 @@ def connect() -> Iterator[Callable[[ServerThread], Client]]:
 @pytest.fixture
 def c2rviz_process() -> Iterator[Callable[..., Process]]:
     """Factory: start ``python -m c2rviz --port 0 ARGS`` (``--no-rosbridge`` too, unless ARGS
-    name ``--rosbridge-port``, and ``--crcl-port 0`` unless they name CRCL's); waits until
-    it listens."""
+    name ``--rosbridge-port``, and ``--crcl-port 0`` unless they name CRCL's or ask for
+    its ``default_crcl_port``); waits until it listens."""
     procs: list[Process] = []
 
-    def start(*args: str, timeout: float = 120.0) -> Process:
+    def start(*args: str, timeout: float = 120.0, default_crcl_port: bool = False) -> Process:
         # No rosbridge door (port 9090) unless the test names its port: tests stay apart.
         door = () if any(a.startswith("--rosbridge-port") for a in args) else ("--no-rosbridge",)
-        if not any(a.startswith(("--crcl-port", "--no-crcl")) for a in args):
+        named = any(a.startswith(("--crcl-port", "--no-crcl")) for a in args)
+        if not (named or default_crcl_port):
             door += ("--crcl-port", "0")  # a free port: not 64444, which may be taken
         popen = subprocess.Popen(
             [sys.executable, "-m", "c2rviz", "--port", "0", *door, *args],

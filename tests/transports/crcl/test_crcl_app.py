@@ -88,7 +88,7 @@ def test_a_taken_default_port_costs_only_the_crcl_door(c2rviz_process) -> None:
             holder.listen()
         except OSError:
             pass  # something else holds it already: as good
-        proc = c2rviz_process("--no-viewer")
+        proc = c2rviz_process("--no-viewer", default_crcl_port=True)
         said = "".join(proc.output)
         assert (
             f"c2rviz: CRCL port {DEFAULT_PORT} is in use (another c2rviz?): no CRCL door this "
