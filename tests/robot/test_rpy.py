@@ -80,4 +80,6 @@ def test_any_rotation_round_trips(roll: float, pitch: float, yaw: float) -> None
     assert angle_between(pin.rpy.rpyToMatrix(*rpy), rotation) <= 3e-6
     plain = pin.rpy.matrixToRpy(rotation)
     assert sum(map(abs, rpy)) <= sum(map(abs, plain)) + 1e-5
-    assert canonical_rpy(pin.rpy.rpyToMatrix(*rpy)) == pytest.approx(rpy, abs=1e-6)
+    # Again the same, but that an angle a hair over the snap tolerance (1e-6 rad) may come
+    # back a hair under it and snap to 0 the second time.
+    assert canonical_rpy(pin.rpy.rpyToMatrix(*rpy)) == pytest.approx(rpy, abs=2.5e-6)
