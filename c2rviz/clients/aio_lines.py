@@ -18,7 +18,6 @@ import time
 from collections import deque
 from collections.abc import AsyncIterator
 
-from ..errors import LineTooLong
 from ..protocol.framing import Line, LineFramer
 from ..protocol.verbs.cell import RobotChoice
 from ..protocol.verbs.joints import Units
@@ -26,7 +25,7 @@ from .connect import ServerUnavailable
 from .errors import CommandError, ConnectionLost, ReplyTimeout, ReplyTooLong, UnexpectedReply
 from .lines import MAX_REPLY_BYTES
 from .records import Event, State, read_stream_line
-from .stream import watch_request
+from .stream import line_text, watch_request
 
 __all__ = ["AsyncLineClient", "AsyncWatchStream", "open_stream"]
 
@@ -84,12 +83,7 @@ class _LineReader:
             if not chunk:
                 return None
             self.framer.feed(chunk)
-        line = self.lines.popleft()
-        if isinstance(line, LineTooLong):
-            raise ReplyTooLong(asked, self.framer.max_line)
-        if not isinstance(line, str):
-            raise UnexpectedReply(asked, "", "a line that is not UTF-8 text")
-        return line.removesuffix("\r")
+        return line_text(self.lines.popleft(), asked, self.framer.max_line)
 
 
 class AsyncLineClient:

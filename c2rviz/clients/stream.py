@@ -22,7 +22,21 @@ from .connect import ServerUnavailable
 from .errors import CommandError, ConnectionLost, ReplyTooLong, UnexpectedReply
 from .records import Event, State, read_stream_line
 
-__all__ = ["WatchStream", "watch_request"]
+__all__ = ["WatchStream", "line_text", "watch_request"]
+
+
+def line_text(line: Line, asked: str, max_line: int) -> str:
+    """A framed stream line as text, without a trailing CR.
+
+    Raises:
+        ReplyTooLong: the line was longer than ``max_line`` bytes.
+        UnexpectedReply: it is not UTF-8 text.
+    """
+    if isinstance(line, LineTooLong):
+        raise ReplyTooLong(asked, max_line)
+    if not isinstance(line, str):
+        raise UnexpectedReply(asked, "", "a line that is not UTF-8 text")
+    return line.removesuffix("\r")
 
 
 def watch_request(hz: float | None, degrees: bool, robot: str | None) -> list[str]:
@@ -115,12 +129,7 @@ class WatchStream:
             if not chunk:
                 return None
             self._framer.feed(chunk)
-        line = self._lines.popleft()
-        if isinstance(line, LineTooLong):
-            raise ReplyTooLong(asked, self._framer.max_line)
-        if not isinstance(line, str):
-            raise UnexpectedReply(asked, "", "a line that is not UTF-8 text")
-        return line.removesuffix("\r")
+        return line_text(self._lines.popleft(), asked, self._framer.max_line)
 
     def lines(self) -> Iterator[str]:
         """Each stream line as text, until the server closes the connection."""
