@@ -16,12 +16,13 @@ a stop still slides along it. Pure: no clock, no I/O, no randomness.
 
 from __future__ import annotations
 
+import functools
 import math
-from typing import NamedTuple
+from collections.abc import Callable
+from typing import Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
-from scipy.linalg.lapack import dposv
 
 from .chain import IkChain
 from .target import Goal
@@ -246,5 +247,14 @@ def _solve_spd(normal: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     LAPACK's ``dposv`` straight from scipy (which pink's qpsolvers loads anyway):
     a third of ``np.linalg.solve``'s cost on these 3x3 to 6x6 systems.
     """
-    _, solution, info = dposv(normal, rhs)
+    _, solution, info = _dposv()(normal, rhs)
     return solution if info == 0 else np.linalg.lstsq(normal, rhs)[0]
+
+
+@functools.cache
+def _dposv() -> Callable[..., Any]:
+    """scipy's LAPACK ``dposv``, imported at the first solve: scipy.linalg costs a quarter
+    of a second, which a program that never solves IK should not pay at start."""
+    from scipy.linalg.lapack import dposv
+
+    return dposv  # type: ignore[no-any-return]

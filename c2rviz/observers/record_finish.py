@@ -8,12 +8,15 @@ import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..world.state import RobotState
-from .bag_recorder import BagRecorder
 from .record_files import RecordFiles
 from .recorded import Recorded
 from .recorder import Recorder
+
+if TYPE_CHECKING:  # rosbags is loaded at the first recording, not at start
+    from .bag_recorder import BagRecorder
 
 __all__ = ["Exporter", "Recording", "finish"]
 

@@ -27,13 +27,12 @@ import re
 import shutil
 from collections.abc import Callable, Coroutine, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import C2rvizError
 from ..world.effects import Observer
 from ..world.state import RobotState
 from ..world.world import World
-from .bag_recorder import BagRecorder
 from .record_errors import (
     AlreadyRecording,
     LinkedName,
@@ -49,6 +48,9 @@ from .record_files import RecordFiles, existing, is_bag_folder, links
 from .record_finish import Exporter, Recording, finish
 from .recorded import Recorded
 from .recorder import Recorder
+
+if TYPE_CHECKING:  # rosbags is loaded at the first recording, not at start
+    from .bag_recorder import BagRecorder
 
 log = logging.getLogger("c2rviz.record")
 
@@ -140,6 +142,8 @@ class Recordings:
         recording = Recording(name, {}, None, bag_files, t0)
         try:
             if self.bag:
+                from .bag_recorder import BagRecorder
+
                 recording.bag = BagRecorder(
                     self.world, robots, bag_files.bag_folder(), t0, self._bag_failed
                 )
