@@ -1,9 +1,10 @@
 """What each link looks like: URDF visual and collision geometry, ready to draw.
 
-yourdfpy parses the URDF (links, their ``<visual>``/``<collision>`` elements
-and materials); this module turns every element into a ``Shape`` placed at its
-URDF origin in the link frame. Boxes, cylinders and spheres stay primitives
-(the viewer draws them natively); mesh files are loaded with trimesh, resolved
+``urdf_elements`` reads the URDF (links, their ``<visual>``/``<collision>``
+elements and materials); this module turns every element into a ``Shape`` placed
+at its URDF origin in the link frame. Boxes, cylinders and spheres stay
+primitives (the viewer draws them natively); mesh files are loaded with trimesh
+(imported at the first mesh: a robot of primitives never loads it), resolved
 through ``RobotSource.resolve``. Link poses are not computed here: the viewer
 takes them from Pinocchio.
 
@@ -15,16 +16,18 @@ the program.
 
 from __future__ import annotations
 
-import io
 import logging
 import warnings
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import trimesh
-import yourdfpy
 
 from .sources import RobotSource
+from .urdf_elements import Element, read_links
+
+if TYPE_CHECKING:
+    import trimesh
 
 __all__ = ["LinkGeometry", "Shape", "load_link_geometry"]
 
@@ -79,25 +82,21 @@ def load_link_geometry(source: RobotSource) -> dict[str, LinkGeometry]:
 
     Never raises for a missing or broken mesh: see the module docstring.
     """
-    urdf = yourdfpy.URDF.load(
-        io.BytesIO(source.xml.encode("utf-8")), build_scene_graph=False, load_meshes=False
-    )
-    materials = {m.name: m for m in urdf.robot.materials if m.name is not None}
+    urdf = read_links(source.xml)
     for missing in source.missing_meshes():  # each once, with its links and a hint
         log.warning("%s", missing.message())
     loader = _MeshLoader(source)
     links: dict[str, LinkGeometry] = {}
-    for link in urdf.robot.links:
+    for name, visuals in urdf.visuals.items():
         geometry = LinkGeometry()
-        for element in link.visuals:
-            rgba = _material_rgba(element.material, materials)
-            shapes = _shapes(element, rgba, loader, geometry.missing)
+        for element in visuals:
+            shapes = _shapes(element, urdf.rgba(element), loader, geometry.missing)
             geometry.visual.extend(shapes)
-        for element in link.collisions:
+        for element in urdf.collisions[name]:
             geometry.collision.extend(_shapes(element, COLLISION_RGBA, loader, []))
         if geometry.missing:
-            _fall_back(link.name, geometry)
-        links[link.name] = geometry
+            _fall_back(name, geometry)
+        links[name] = geometry
     return links
 
 
@@ -117,45 +116,21 @@ def _fall_back(link: str, geometry: LinkGeometry) -> None:
     log.warning("link %s is drawn with %s instead of its missing mesh", link, how)
 
 
-def _material_rgba(
-    material: yourdfpy.Material | None, materials: dict[str, yourdfpy.Material]
-) -> tuple[float, float, float, float] | None:
-    """The colour a visual's material names, directly or through a top-level material."""
-    if material is None:
-        return None
-    color = material.color
-    if color is None and material.name in materials:
-        color = materials[material.name].color
-    if color is None:
-        return None
-    r, g, b, a = (float(c) for c in color.rgba)
-    return (r, g, b, a)
-
-
 def _shapes(
-    element: yourdfpy.Visual | yourdfpy.Collision,
+    element: Element,
     rgba: tuple[float, float, float, float] | None,
     loader: _MeshLoader,
     missing: list[str],
 ) -> list[Shape]:
     """The shapes of one ``<visual>`` or ``<collision>`` element (none when a mesh is missing)."""
-    origin = element.origin if element.origin is not None else np.eye(4)
-    geom = element.geometry
+    origin, geom = element.origin, element.geometry
     if geom is None:
         return []
-    if geom.box is not None:
-        size = tuple(float(s) for s in geom.box.size)
-        return [Shape("box", origin, rgba or DEFAULT_RGBA, size)]
-    if geom.cylinder is not None:
-        size = (float(geom.cylinder.radius), float(geom.cylinder.length))
-        return [Shape("cylinder", origin, rgba or DEFAULT_RGBA, size)]
-    if geom.sphere is not None:
-        return [Shape("sphere", origin, rgba or DEFAULT_RGBA, (float(geom.sphere.radius),))]
-    if geom.mesh is None:
-        return []
-    meshes = loader.load(geom.mesh.filename, geom.mesh.scale)
+    if geom.kind != "mesh":
+        return [Shape(geom.kind, origin, rgba or DEFAULT_RGBA, geom.size)]
+    meshes = loader.load(geom.filename, geom.scale)
     if meshes is None:
-        missing.append(geom.mesh.filename)
+        missing.append(geom.filename)
         return []
     shapes = []
     for mesh in meshes:
@@ -196,6 +171,8 @@ class _MeshLoader:
         path = self.source.resolve(uri)
         if path is None:  # said already (load_link_geometry)
             return None
+        import trimesh  # the first mesh: robots of primitives never pay for it
+
         try:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")

@@ -12,11 +12,11 @@ update per node whatever the number of markers sent.
 from __future__ import annotations
 
 import functools
+import threading
 from collections.abc import Callable, Iterable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import trimesh
 import viser
 
 from ..protocol.grammar import MARKER_SHAPES
@@ -24,17 +24,25 @@ from ..world.effects import MAX_MARKERS, Marker
 from . import adapter
 from .robot_view import node_name
 
-__all__ = ["MARKER_SIZE_M", "MarkerLayer", "marker_mesh"]
+if TYPE_CHECKING:
+    import trimesh
+
+__all__ = ["MARKER_SIZE_M", "MarkerLayer", "marker_mesh", "warm_up"]
 
 MARKER_SIZE_M = 0.03
 
 
+@functools.cache
 def marker_mesh(shape: str, size: float = MARKER_SIZE_M) -> trimesh.Trimesh:
-    """The mesh of one marker of ``shape`` (``protocol.MARKER_SHAPES``), centred.
+    """The mesh of one marker of ``shape`` (``protocol.MARKER_SHAPES``), centred (made once:
+    the caller must not change it).
 
     A sphere of diameter ``size``, a cube of edge ``size``, a cylinder of
     height ``size`` along z, an arrow of length 1.7 ``size`` along x (as RViz).
+    trimesh is imported at the first marker (``warm_up`` does it before, off the loop).
     """
+    import trimesh
+
     if shape == "cube":
         return trimesh.creation.box(extents=(size, size, size))
     if shape == "cylinder":
@@ -51,6 +59,20 @@ def marker_mesh(shape: str, size: float = MARKER_SIZE_M) -> trimesh.Trimesh:
         arrow.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (0, 1, 0)))
         return arrow
     return trimesh.creation.icosphere(subdivisions=2, radius=size / 2)
+
+
+def warm_up() -> threading.Thread:
+    """Make every shape's marker mesh in a thread of its own, trimesh's import with it
+    (half a second), so that the first ``mark`` after the start does not wait for it on
+    the loop; the program's start does not wait for it either."""
+
+    def make() -> None:
+        for shape in MARKER_SHAPES:
+            marker_mesh(shape)
+
+    thread = threading.Thread(target=make, name="c2rviz-marker-meshes", daemon=True)
+    thread.start()
+    return thread
 
 
 class _Ring:
@@ -92,7 +114,6 @@ class MarkerLayer:
         self._instances: dict[tuple[str, str], np.ndarray] = {}  # slot of each drawn instance
         self._rings: dict[str, _Ring] = {}
         self._shape_index = {shape: k for k, shape in enumerate(MARKER_SHAPES)}
-        self._meshes = {shape: marker_mesh(shape) for shape in MARKER_SHAPES}
         self.nodes: dict[tuple[str, str], Any] = {}
         self.dirty = False
 
@@ -178,7 +199,7 @@ class MarkerLayer:
         colors = ring.colors[chosen]
         self._instances[robot, shape] = chosen
         if node is None:
-            mesh = self._meshes[shape]
+            mesh = marker_mesh(shape)
             self.nodes[robot, shape] = self._scene.add_batched_meshes_simple(
                 f"/markers/{self._segments.get(robot) or node_name(robot)}/{shape}",
                 mesh.vertices,

@@ -24,7 +24,6 @@ from typing import Any
 
 import numpy as np
 import pinocchio as pin
-import trimesh
 import viser
 
 from ..robot.model import Robot
@@ -282,5 +281,5 @@ class RobotView:
         if shape.kind == "sphere":
             return scene.add_icosphere(name, radius=shape.size[0], color=rgb, **common)
         mesh = shape.mesh
-        assert isinstance(mesh, trimesh.Trimesh)
+        assert mesh is not None
         return scene.add_mesh_simple(name, mesh.vertices, mesh.faces, color=rgb, **common)

@@ -17,7 +17,6 @@ from typing import Any
 
 import numpy as np
 import pinocchio as pin
-import trimesh
 import viser
 
 from ..collision.workcell import WorkcellObject
@@ -94,6 +93,8 @@ def add_object(scene: Any, name: str, obj: WorkcellObject, placement: pin.SE3) -
     if obj.shape == "cylinder":
         radius, length = obj.size
         return scene.add_cylinder(name, radius=radius, height=length, color=rgb, **common)
+    import trimesh  # imported when first needed (a robot of primitives never loads it)
+
     mesh = trimesh.load(obj.mesh_path, force="mesh")
     assert isinstance(mesh, trimesh.Trimesh)
     vertices = np.asarray(mesh.vertices) * np.asarray(obj.size)
