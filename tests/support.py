@@ -10,6 +10,7 @@ from __future__ import annotations
 import asyncio
 import socket
 import subprocess
+import sys
 import threading
 from collections.abc import Callable
 from concurrent.futures import Future
@@ -26,6 +27,15 @@ from c2rviz.world.effects import RecordingScene
 from c2rviz.world.world import World
 
 ROOT = Path(__file__).resolve().parent.parent
+CTRL_C_ABLE = [
+    sys.executable,
+    "-c",
+    "import os, signal, sys; signal.signal(signal.SIGINT, signal.SIG_DFL); "
+    "os.execv(sys.executable, [sys.executable, *sys.argv[1:]])",
+]
+"""The start of a child's argv that undoes an inherited "ignore SIGINT" (a job started in the
+background by a shell gets one, and Python then never raises KeyboardInterrupt), so a test's
+SIGINT acts as a Ctrl-C typed at a terminal."""
 LIMITS_URDF = ROOT / "tests" / "data" / "limits_robot" / "limits.urdf"
 """A robot whose limits are at awkward numbers (puma560's +-1.570796325 rad)."""
 CHROMIUM = Path("/usr/bin/chromium")  # Debian's; Playwright cannot download browsers here

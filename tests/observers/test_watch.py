@@ -8,13 +8,12 @@ import math
 import re
 import socket
 import subprocess
-import sys
 import threading
 import time
 
 import numpy as np
 import pytest
-from support import ROOT, Client, ServerThread
+from support import CTRL_C_ABLE, ROOT, Client, ServerThread
 from watch_support import EVENT, STATE, ask, read_until, states
 
 from c2rviz.observers.watch import STREAM_ALLOWANCE_BYTES, NotAConnection
@@ -229,7 +228,7 @@ def _read_lines(client: Client, count: int, into: list[str]) -> None:
 
 def test_cli_watch_prints_the_stream_until_ctrl_c(server: ServerThread, connect):
     proc = subprocess.Popen(
-        [sys.executable, "-m", "c2rviz.clients.repl", "--watch", "50", "--port", str(server.port)],
+        [*CTRL_C_ABLE, "-m", "c2rviz.clients.repl", "--watch", "50", "--port", str(server.port)],
         cwd=ROOT,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -257,7 +256,7 @@ def test_cli_watch_prints_the_stream_until_ctrl_c(server: ServerThread, connect)
 
 def test_repl_watch_prints_the_stream_until_ctrl_c_then_goes_on(server: ServerThread, connect):
     proc = subprocess.Popen(
-        [sys.executable, "-m", "c2rviz.clients.repl", "--port", str(server.port)],
+        [*CTRL_C_ABLE, "-m", "c2rviz.clients.repl", "--port", str(server.port)],
         cwd=ROOT,
         stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,
