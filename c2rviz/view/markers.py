@@ -12,9 +12,8 @@ update per node whatever the number of markers sent.
 from __future__ import annotations
 
 import functools
-import threading
 from collections.abc import Callable, Iterable
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import viser
@@ -22,57 +21,10 @@ import viser
 from ..protocol.grammar import MARKER_SHAPES
 from ..world.effects import MAX_MARKERS, Marker
 from . import adapter
+from .marker_meshes import marker_mesh
 from .robot_view import node_name
 
-if TYPE_CHECKING:
-    import trimesh
-
-__all__ = ["MARKER_SIZE_M", "MarkerLayer", "marker_mesh", "warm_up"]
-
-MARKER_SIZE_M = 0.03
-
-
-@functools.cache
-def marker_mesh(shape: str, size: float = MARKER_SIZE_M) -> trimesh.Trimesh:
-    """The mesh of one marker of ``shape`` (``protocol.MARKER_SHAPES``), centred (made once:
-    the caller must not change it).
-
-    A sphere of diameter ``size``, a cube of edge ``size``, a cylinder of
-    height ``size`` along z, an arrow of length 1.7 ``size`` along x (as RViz).
-    trimesh is imported at the first marker (``warm_up`` does it before, off the loop).
-    """
-    import trimesh
-
-    if shape == "cube":
-        return trimesh.creation.box(extents=(size, size, size))
-    if shape == "cylinder":
-        return trimesh.creation.cylinder(radius=size / 3, height=size, sections=24)
-    if shape == "arrow":
-        head = size / 2
-        shaft_length = 1.7 * size - head
-        shaft = trimesh.creation.cylinder(radius=size / 8, height=shaft_length, sections=16)
-        shaft.apply_translation((0.0, 0.0, shaft_length / 2))
-        cone = trimesh.creation.cone(radius=size / 3, height=head, sections=16)
-        cone.apply_translation((0.0, 0.0, shaft_length))
-        arrow = trimesh.util.concatenate([shaft, cone])
-        assert isinstance(arrow, trimesh.Trimesh)
-        arrow.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (0, 1, 0)))
-        return arrow
-    return trimesh.creation.icosphere(subdivisions=2, radius=size / 2)
-
-
-def warm_up() -> threading.Thread:
-    """Make every shape's marker mesh in a thread of its own, trimesh's import with it
-    (half a second), so that the first ``mark`` after the start does not wait for it on
-    the loop; the program's start does not wait for it either."""
-
-    def make() -> None:
-        for shape in MARKER_SHAPES:
-            marker_mesh(shape)
-
-    thread = threading.Thread(target=make, name="c2rviz-marker-meshes", daemon=True)
-    thread.start()
-    return thread
+__all__ = ["MarkerLayer"]
 
 
 class _Ring:
@@ -199,11 +151,11 @@ class MarkerLayer:
         colors = ring.colors[chosen]
         self._instances[robot, shape] = chosen
         if node is None:
-            mesh = marker_mesh(shape)
+            vertices, faces = marker_mesh(shape)
             self.nodes[robot, shape] = self._scene.add_batched_meshes_simple(
                 f"/markers/{self._segments.get(robot) or node_name(robot)}/{shape}",
-                mesh.vertices,
-                mesh.faces,
+                vertices,
+                faces,
                 batched_wxyzs=wxyzs,
                 batched_positions=positions,
                 batched_colors=colors,

@@ -38,7 +38,7 @@ from ..robot.model import Robot
 from ..robot.visuals import load_link_geometry
 from ..world.state import RobotState
 from . import adapter
-from .markers import marker_mesh
+from .marker_meshes import marker_mesh
 from .record_commands import Commands, read_commands
 from .record_kinematics import chain_kinematics
 from .record_rows import HTML_HZ, MAX_HTML_FRAMES, Frames, read_frames
@@ -161,12 +161,12 @@ def _scene(
         used = {int(s) for s in commands.marks[:, 12]} if len(commands.marks) else set()
         for k in sorted(used):
             shape = MARKER_SHAPES[k]
-            mesh = marker_mesh(shape)
+            vertices, faces = marker_mesh(shape)
             markers[shape] = node = f"/markers/{_SEGMENT}/{shape}"
             server.scene.add_batched_meshes_simple(
                 node,
-                mesh.vertices,
-                mesh.faces,
+                vertices,
+                faces,
                 batched_wxyzs=np.zeros((0, 4)),
                 batched_positions=np.zeros((0, 3)),
                 batched_colors=np.zeros((0, 3), dtype=np.uint8),

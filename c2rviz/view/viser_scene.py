@@ -40,7 +40,7 @@ from ..world.effects import Marker, Scene
 from . import adapter
 from .handle import ToolHandles
 from .instruments import Instruments
-from .markers import MarkerLayer, warm_up
+from .markers import MarkerLayer
 from .page_input import PageInput
 from .panel import RECENT_COMMANDS, RobotPanel, StatePanel
 from .policy import DoorPolicy
@@ -274,7 +274,6 @@ class ViserScene(Scene):
         self.instruments.start(loop, self.scheduler.request)
         self._dirty.update(self.world.robots)
         self.scheduler.start(loop)
-        warm_up()  # the marker meshes, off the loop
 
     def stop(self) -> None:
         """Stop the server and free its port, within ``STOP_TIMEOUT_S``; later calls do nothing."""
