@@ -20,10 +20,6 @@ from lxml import etree
 
 __all__ = ["Element", "Geometry", "UrdfLinks", "read_links"]
 
-_PARSER = etree.XMLParser(
-    resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False, recover=True
-)
-
 
 @dataclass(frozen=True)
 class Geometry:
@@ -75,7 +71,10 @@ class UrdfLinks:
 
 def read_links(xml: str) -> UrdfLinks:
     """The links' elements of the URDF text ``xml`` (see the module docstring)."""
-    root = etree.fromstring(xml.encode("utf-8"), parser=_PARSER)
+    parser = etree.XMLParser(  # one per call: an lxml parser is not for two threads at once
+        resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False, recover=True
+    )
+    root = etree.fromstring(xml.encode("utf-8"), parser=parser)
     links = UrdfLinks()
     if root is None:
         return links
