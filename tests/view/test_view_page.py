@@ -78,10 +78,12 @@ def test_a_cell_draws_every_robot_at_its_origin(harness: Callable[..., Harness])
     for _ in range(5):
         qs = {name: state.robot.random(rng) for name, state in world.robots.items()}
         h.call(lambda qs=qs: [world.set_q(q, name) for name, q in qs.items()])
-        h.run(0.02)
+        h.until(
+            lambda qs=qs: all(h.scene.views[n].sent_q == tuple(q) for n, q in qs.items()),
+            "the send of every robot's new pose",
+        )
         for name, state in world.robots.items():
             view = h.scene.views[name]
-            assert view.sent_q == tuple(qs[name])
             data = fk(state.robot, qs[name])
             root = placement(view.root)
             assert root.isApprox(origins[name], 1e-6)

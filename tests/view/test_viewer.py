@@ -73,8 +73,7 @@ def test_link_frames_are_pinocchio_fk(harness: Callable[..., Harness], name: str
     for _ in range(30):
         q = h.robot.random(rng)
         h.call(lambda q=q: h.world.set_q(q))
-        h.run(0.002)
-        assert h.scene.sent_q == tuple(q)
+        h.until(lambda q=q: h.scene.sent_q == tuple(q), "the send of the new pose")
         assert_frames_match(h, q)
 
 
@@ -108,16 +107,19 @@ def test_urdf_link_frames_are_pinocchio_body_frames(name: str) -> None:
 def test_the_fingers_are_drawn_at_the_gripper_opening(harness: Callable[..., Harness]) -> None:
     h = harness("fanuc_lrmate200id", hz=1000.0)
     robot = h.robot
+    view = h.scene.views[h.world.default]
     for opening in (1.0, 0.25):
         h.call(lambda o=opening: h.world.grips.set(h.world.state(), o, "test"))
-        h.run(0.005)
         data = robot.model.createData()
         pin.framesForwardKinematics(robot.model, data, robot.configuration(robot.home, opening))
         for link in ("gripper_finger_left", "gripper_finger_right"):
             expected = data.oMf[robot.model.getFrameId(link, pin.BODY)].translation
-            got = h.scene.views[h.world.default].link_pose(link).translation
-            np.testing.assert_allclose(got, expected, atol=1e-9, err_msg=link)
-    view = h.scene.views[h.world.default]
+            h.until(  # the send after the change (no other change moves a finger)
+                lambda link=link, expected=expected: np.allclose(
+                    view.link_pose(link).translation, expected, atol=1e-9
+                ),
+                f"{link} drawn at opening {opening}",
+            )
     left, right = (view.link_pose(f"gripper_finger_{s}").translation for s in ("left", "right"))
     assert np.linalg.norm(left - right) == pytest.approx(0.002 + 0.25 * 0.06)
 
