@@ -9,7 +9,9 @@ thread, where ``MoveChecker.check`` answers with the path the arm may take
 - ``target_only`` (a move shown at once): the goal alone is checked;
 - otherwise the path (the straight joint-space segment, or the polyline given)
   at the checker's resolution, first point first (``path_check.first_blocked``:
-  contacts at the start may be left, not pushed into);
+  contacts at the start may be left, not pushed into); with several goals (a guarded
+  ``rand``'s free draws) the first with a free straight path is taken, and if none
+  has one the first goal's contact is the answer;
 - ``plan="blocked"`` (``guard plan``): a blocked straight path is planned around;
   ``plan="always"`` (``plan``): every goal is planned (the direct edge first),
   trying the goals given in order (several IK answers of a pose) until one plans.
@@ -154,16 +156,26 @@ class MoveChecker:
             if blocked is not None:
                 raise PathCollides(*blocked[1], 1.0, True, target=goal.tolist())
             return CheckedMove(np.array([start, goal]), None, allowed, revision)
-        waypoints = request.path if request.path is not None else np.array([start, goal])
-        points = path_points(checker, waypoints)
-        blocked = first_blocked(checker, points, allowed)
-        if blocked is None:
-            return CheckedMove(np.asarray(waypoints, dtype=float), None, allowed, revision)
-        index, pair = blocked
-        end = waypoints[-1] if request.path is not None else goal
-        collides = PathCollides(
-            *pair, index / max(len(points) - 1, 1), False, target=np.asarray(end).tolist()
+        tries = (
+            [request.path]
+            if request.path is not None
+            else [np.array([start, np.asarray(g, dtype=float)]) for g in request.goals]
         )
+        collides: PathCollides | None = None
+        for waypoints in tries:  # the first free way (the goals in order); else the first's hit
+            points = path_points(checker, waypoints)
+            blocked = first_blocked(checker, points, allowed)
+            if blocked is None:
+                return CheckedMove(np.asarray(waypoints, dtype=float), None, allowed, revision)
+            if collides is None:
+                index, pair = blocked
+                collides = PathCollides(
+                    *pair,
+                    index / max(len(points) - 1, 1),
+                    False,
+                    target=np.asarray(waypoints[-1]).tolist(),
+                )
+        assert collides is not None
         if request.plan != "blocked" or request.path is not None:
             raise collides
         try:

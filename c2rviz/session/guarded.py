@@ -61,6 +61,9 @@ __all__ = [
 
 TRIES = 3  # checks of one move while the world keeps changing under it
 DRAWS = 1000  # random configurations a guarded rand draws at most
+RAND_GOALS = 8
+"""Free configurations a guarded ``rand`` offers when the path is checked (motion on or
+follow): the first one the arm reaches along a free path is taken."""
 _TAKEN = "another command moved the arm while this move was checked; nothing moved, send it again"
 
 
@@ -206,12 +209,15 @@ def play_checked(
     return play, arrival
 
 
-async def guarded_go(session: GuardedSession, q: Sequence[float], speed: float) -> str:
-    """``Session.go`` under the guard (see the module): ``ok`` when shown, started
-    (``follow``) or arrived (``on``); ``speed`` is the session's [%] when the move was
-    asked (a door may change it for one move: it is read now, not once checked)."""
+async def guarded_go(
+    session: GuardedSession, goals: Sequence[Sequence[float]], speed: float
+) -> str:
+    """``Session.go`` under the guard (see the module) to the first workable of ``goals``:
+    ``ok`` when shown, started (``follow``) or arrived (``on``); ``speed`` is the session's
+    [%] when the move was asked (a door may change it for one move: it is read now, not
+    once checked)."""
     plan = "blocked" if session.plan_around else "never"
-    checked, at_once = await checked_move(session, [q], plan=plan)
+    checked, at_once = await checked_move(session, goals, plan=plan)
     if at_once:
         session.world.set_q(checked.goal, session.state.name, session.source)
         return replies.OK
@@ -220,18 +226,22 @@ async def guarded_go(session: GuardedSession, q: Sequence[float], speed: float) 
 
 
 async def guarded_rand(session: GuardedSession) -> str:
-    """``rand`` under the guard: a configuration free of everything, drawn off the loop."""
+    """``rand`` under the guard: a configuration free of everything, drawn off the loop
+    (with the path checked, ``RAND_GOALS`` of them: the first with a free path is taken)."""
     rng, worker, speed = session.services.rng, session.services.worker, session.speed
     checker = checker_of(worker)
     asked = request(session, session.now(), [session.now()], target_only=True)
     name = session.state.robot.name
+    wanted = 1 if session.motion == "off" else RAND_GOALS
 
-    def draw() -> list[float]:
+    def draw() -> list[list[float]]:
         batch = checker.checker(asked).batch
-        found = batch.random_free(rng, DRAWS)
-        if found is None:
+        found: list[list[float]] = []
+        while len(found) < wanted and (q := batch.random_free(rng, DRAWS)) is not None:
+            found.append(q)
+        if not found:
             raise NoFreeConfiguration(name, DRAWS, batch.lasting(rng))
         return found
 
-    q = await worker.run(draw, key=("move", id(session)))
-    return await guarded_go(session, q, speed)
+    goals = await worker.run(draw, key=("move", id(session)))
+    return await guarded_go(session, goals, speed)

@@ -124,7 +124,7 @@ class Session:
         event loop and played on the checked path (``guarded.guarded_go``): the reply
         is then always awaitable."""
         if self.guard:
-            return guarded_go(self, q, self.speed)
+            return guarded_go(self, [q], self.speed)
         if self.motion == "off":
             self.world.set_q(q, self.state.name, self.source)
             return replies.OK

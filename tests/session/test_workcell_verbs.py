@@ -5,7 +5,10 @@ from __future__ import annotations
 import re
 
 import pytest
-from support import ROBOTS, ServerThread
+from support import ROBOTS, ServerThread, load_robot
+
+from c2rviz.session import ServerLimits
+from c2rviz.world.clocks import parse_clock
 
 FOLDED = {
     "motoman_sia20d": ("0,-106,0,122,0,0,0", "base_link~link_b,base_link~link_r,base_link~link_u"),
@@ -200,3 +203,22 @@ def test_the_observers_hear_of_collisions_as_they_change(server: ServerThread, c
     told = server.call(lambda: list(server.scene.collisions))
     assert any(pairs and all(b == "table" for _, b in pairs) for _, pairs in told)
     assert told[-1] == (server.robot.name, [])
+
+
+def test_rand_with_motion_under_guard_goes_along_a_free_path(connect):
+    """With motion on the guard checks the path too: `rand` offers several free
+    configurations and takes the first the arm reaches along a free path, so it says ok
+    (the docs' workcell session), where one free target often had a blocked way to it."""
+    clock = parse_clock("virtual")  # the moves take no wall time
+    server = ServerThread(load_robot("motoman_sia20d"), ServerLimits(), clock=clock).start()
+    try:
+        client = connect(server)
+        for line in ("degrees", "object table box 0.6,0.8,0.05 0.8,0,0.4,0,0,0", "guard on"):
+            assert client.ask(line) == "ok", line
+        assert client.ask("j 0,60,0,60,0,0,0") == "ok"
+        assert client.ask("motion on") == "ok"
+        for _ in range(30):
+            assert client.ask("rand") == "ok"
+            assert client.ask("collisions") == "ok none"
+    finally:
+        server.stop()

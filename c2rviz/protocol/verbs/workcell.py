@@ -101,7 +101,8 @@ class Collisions:
     "[on|off|plan]",
     "with `guard on` this connection's commands whose target, or any point of a move's path, "
     "collides are refused (`error: link_t would hit table at 40% of the move`); `rand` "
-    "draws a free configuration; `guard plan`: joint-space moves go around what their "
+    "draws a free configuration (with motion, one reached along a free path); "
+    "`guard plan`: joint-space moves go around what their "
     "straight path would hit instead (docs/planning.md); alone, reply it",
 )
 @dataclass(frozen=True, slots=True)
