@@ -43,8 +43,8 @@ def placement(handle: Any) -> pin.SE3:
 def test_an_object_stands_at_its_world_place_and_goes_when_removed(h: Harness) -> None:
     session = Session(h.services, source="test")
     run(h, session, "object table box 0.2,0.2,0.2 0,0.8,0.85,0,0,0")
-    h.run(0.05)
     layer, view = h.scene.workcells["arm"], h.scene.views["arm"]
+    h.until(lambda: "table" in layer.objects, "the send that draws the table")
     node = layer.objects["table"]
     state = h.world.state("arm")
     expected = (
@@ -54,8 +54,7 @@ def test_an_object_stands_at_its_world_place_and_goes_when_removed(h: Harness) -
     np.testing.assert_allclose(got.homogeneous, expected.homogeneous, atol=1e-6)
     assert node.name == "/robots/arm/objects/table"
     run(h, session, "object all remove")
-    h.run(0.05)
-    assert layer.objects == {}
+    h.until(lambda: layer.objects == {}, "the send that removes the table")
     assert node.name not in h.scene.server.scene._handle_from_node_name
 
 

@@ -114,7 +114,7 @@ def test_a_cell_page_moves_the_robot_of_its_folder(harness: Callable[..., Harnes
     h.call(lambda: world.add_marker(None, (0.0, 1.0, 0.0), "cube", robot="b"))
     h.call(lambda: world.add_marker(None, (0.0, 1.0, 0.0), "cube", robot="a"))
     h.call(lambda: world.clear_markers("a"))
-    h.run(0.05)
+    h.until(lambda: ("b", "cube") in h.scene.markers.nodes, "the send that draws b's marker")
     assert h.scene.markers.count("a") == 0 and h.scene.markers.count("b") == 1
     node = h.scene.markers.nodes["b", "cube"]
     state = world.state("b")
