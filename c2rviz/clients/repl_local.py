@@ -46,7 +46,7 @@ LOCAL_USAGE = {
         "step=/rate=: only for a server without motion, which gets small joints steps",
     ),
     "watch": ("watch [HZ]", "print the server's state and event lines until Ctrl-C"),
-    "help": ("help", "this list"),
+    "help": ("help [VERB]", "this list; with a verb: its line and its docs page"),
     "q": ("q", "leave (the server keeps running)"),
     "quit": ("quit", "stop the server, then leave"),
 }
@@ -245,6 +245,15 @@ class LocalCommands:
         raise ConnectionLost(client.host, client.port)
 
     def _help(self, words: list[str]) -> bool:
+        if words:  # one verb: this client's own, or the server's line and docs page
+            local = LOCAL_USAGE.get(words[0].lower()) if len(words) == 1 else None
+            if local is not None:
+                self.show(f"{local[0]}: {local[1]} (this client; see docs/clients.md)")
+                return True
+            reply = self.ask(" ".join(["help", *words]))
+            self.show(reply)
+            self.errors += not reply.startswith("ok")
+            return True
         self.show("local commands (this client):")
         width = max(len(usage) for usage, _ in LOCAL_USAGE.values())
         for usage, what in LOCAL_USAGE.values():

@@ -612,6 +612,18 @@ def test_repl_help_lists_each_command_once(server, monkeypatch, capsys):
     assert len(listed) == len(set(listed)), sorted(w for w in listed if listed.count(w) > 1)
 
 
+def test_repl_help_verb_gives_one_line(server, monkeypatch, capsys):
+    text = "help moveto\nhelp goto\nhelp nope\n"
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 1  # `help nope`: an error
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("ok moveto x,y,z[,roll,pitch,yaw] | marker N: ")
+    assert lines[0].endswith("; see docs/cartesian.md")
+    assert lines[1].startswith("goto v0,...,vn-1 [step=S] [rate=HZ]: move there")
+    assert lines[1].endswith("(this client; see docs/clients.md)")
+    assert lines[2] == "error: help: no verb 'nope' (usage: help [VERB])"
+    assert len(lines) == 3
+
+
 def test_repl_file_stops_at_the_first_error(server, tmp_path, monkeypatch, capsys):
     bad = write(tmp_path, "bad.txt", BAD_LINE_3)
     limit = write(tmp_path, "limit.txt", LIMIT_LINE_3)
