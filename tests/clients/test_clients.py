@@ -193,6 +193,20 @@ def test_player_plays_motoman_txt_to_the_seed_end_pose(server, connect, capsys):
     assert "\r" not in out  # plain lines when not on a terminal
 
 
+def test_player_quiet_prints_errors_and_the_summary_only(server, tmp_path, capsys):
+    assert player.main([MOTOMAN, "--port", str(server.port), "--speed", "1e4", "--quiet"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.startswith(f"{MOTOMAN}: 16 commands, all ok, in ")
+    assert captured.out.count("\n") == 1 and captured.err == ""
+    limit = write(tmp_path, "limit.txt", LIMIT_LINE_3)
+    assert player.main([limit, "--port", str(server.port), "-q", "--keep-going"]) == 1
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    first, summary = captured.err.splitlines()
+    assert first.startswith(f"{limit}:3: error: joint_l (index 1) = 500 deg is outside")
+    assert summary == f"{limit}: 1 error (4 commands)"
+
+
 BAD_LINE_3 = "degrees\nmove 0 30\nmvoe 1 30   # typo\nhome\n"
 
 

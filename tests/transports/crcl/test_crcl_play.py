@@ -115,6 +115,17 @@ def test_check_only_reads_the_program(tmp_path, capsys) -> None:
     assert capsys.readouterr().out == "demo.xml: 6 CRCL commands, all check\n"
 
 
+def test_quiet_shows_the_summary_alone(crcl_server, tmp_path, capsys) -> None:
+    assert play(crcl_server, write(tmp_path, GOOD), "--quiet") == 0
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) == 1 and out[0].startswith("demo.xml: 6 CRCL commands, all done, in ")
+    bad = program(move(2, (3.0, 0.0, 0.0)))
+    assert play(crcl_server, write(tmp_path, bad, "bad.xml"), "-q") == 1
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.startswith("bad.xml: command 1 (MoveToType, CommandID 2): ")
+
+
 def test_no_server_is_exit_1(tmp_path, capsys) -> None:
     with socket.socket() as probe:  # a port nothing listens on
         probe.bind(("127.0.0.1", 0))
