@@ -167,6 +167,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         where = f"{args.file}: " if isinstance(exc, CrclError) else ""
         print(f"c2rviz-play: {where}{exc}", file=err)
         return 2
+    except Exception as exc:  # the codec's slip on a hostile document: one line, never a trace
+        problem = f"{type(exc).__name__}: {exc}"
+        print(f"c2rviz-play: {args.file}: not a CRCL program this can read ({problem})", file=err)
+        return 2
     name = path.name
     if args.check:
         print(f"{name}: {len(commands)} CRCL commands, all check", file=out)
