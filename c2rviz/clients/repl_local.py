@@ -160,6 +160,7 @@ class LocalCommands:
             self.show(f"{script.name}: nothing was sent")
             return True
         show = Progress(self.out, self.out, in_place=False)
+        degrees = client.in_degrees
         try:
             errors = play(client, script, show, speed=options.get("speed", self.speed))
         except ConnectionLost:
@@ -168,7 +169,22 @@ class LocalCommands:
         self.errors += errors > 0
         if not errors:
             self.show(f"{script.name}: {script.count} commands, all ok")
+        self._left(script.name, degrees, None if errors else script.last_mode)
         return True
+
+    def _left(self, name: str, degrees: bool, mode: str | None) -> None:
+        """Say what a command file's own lines left set on this connection: its lines act
+        as if typed here, so a ``degrees`` or ``motion`` line stays (docs/clients.md)."""
+        changed = []
+        if self.client.in_degrees != degrees:
+            unit, back = (
+                ("degrees", "radians") if self.client.in_degrees else ("radians", "degrees")
+            )
+            changed.append(f"in {unit} ('{back}' goes back)")
+        if mode is not None:
+            changed.append(f"in motion {mode}")
+        if changed:
+            self.say(f"{name} left this connection {' and '.join(changed)}, as its lines say")
 
     def _sleep(self, words: list[str]) -> bool:
         command = parse_line(" ".join(["sleep", *words]))

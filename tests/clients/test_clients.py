@@ -638,6 +638,25 @@ def test_repl_help_verb_gives_one_line(server, monkeypatch, capsys):
     assert len(lines) == 3
 
 
+def test_repl_file_says_what_its_lines_left_set(server, tmp_path, monkeypatch, capsys):
+    """Issue 39, rough edge 3: a file's lines act as if typed, so its `degrees` stays; the
+    REPL says so (a bag, which names no unit, leaves the connection as it was)."""
+    motion = write(tmp_path, "motion.txt", "motion on\nradians\nhome\n")
+    text = (
+        f"file motoman.txt speed=1000\nwhere\nfile motoman.txt speed=1000\nfile {motion}\nmotion\n"
+    )
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 0
+    captured = capsys.readouterr()
+    notes = [line for line in captured.err.splitlines() if " left this connection " in line]
+    assert notes == [
+        "motoman.txt left this connection in degrees ('radians' goes back), as its lines say",
+        f"{motion} left this connection in radians ('degrees' goes back) and in motion on, "
+        "as its lines say",
+    ]  # the second motoman.txt changed nothing: no note
+    assert "\nok -90,-90,0,0,0,0,0\n" in captured.out  # `where` in degrees, as the file said
+    assert captured.out.endswith("\nok on\n")
+
+
 def test_repl_file_stops_at_the_first_error(server, tmp_path, monkeypatch, capsys):
     bad = write(tmp_path, "bad.txt", BAD_LINE_3)
     limit = write(tmp_path, "limit.txt", LIMIT_LINE_3)
