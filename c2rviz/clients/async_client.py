@@ -27,11 +27,12 @@ from typing import TypeVar
 
 from ..errors import C2rvizError
 from ..protocol.grammar import parse_line
+from ..protocol.replies import SHUTTING_DOWN
 from .aio_lines import AsyncLineClient, AsyncWatchStream
 from .aio_scene_verbs import AsyncSceneVerbs
 from .aio_verbs import AsyncVerbs
 from .calls import Call, count_problem, read_call, speaks
-from .errors import CommandError
+from .errors import CommandError, ServerShutdown
 
 __all__ = ["AsyncClient"]
 
@@ -54,7 +55,11 @@ class AsyncClient(AsyncLineClient, AsyncVerbs, AsyncSceneVerbs):
         if call.joint_count is not None or call.highest_index is not None:
             names = await self.joint_names()
             count_problem(call, self.robot_name or "the robot", names)
-        return read_call(call, await self.ask(call.line, call.track))
+        reply = await self.ask(call.line, call.track)
+        if reply == SHUTTING_DOWN:  # the server goes away mid-call: ConnectionLost's case
+            await self.close()
+            raise ServerShutdown(self.host, self.port, call.line, reply)
+        return read_call(call, reply)
 
     async def send(self, line: str) -> str:
         """Send one line as typed; return its ``ok`` reply (``CommandError`` for an error).
@@ -70,6 +75,9 @@ class AsyncClient(AsyncLineClient, AsyncVerbs, AsyncSceneVerbs):
             raise ValueError(f"{line!r} is not a command: the server would not answer")
         text = line.strip()
         reply = await self.ask(text, command)
+        if reply == SHUTTING_DOWN:
+            await self.close()
+            raise ServerShutdown(self.host, self.port, text, reply)
         if reply.startswith("error"):
             raise CommandError(text, reply)
         return reply

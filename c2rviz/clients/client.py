@@ -19,7 +19,8 @@ Angles are radians, lengths metres, unless the connection chose degrees (``degre
 or ``Client(degrees=True)``): then angles are degrees, both ways. Arguments are checked
 before anything is sent (``calls``); an ``error:`` reply raises ``CommandError`` with
 the server's message; a server gone mid-call raises ``ConnectionLost`` (a
-``ConnectionError``) naming the command.
+``ConnectionError``) naming the command, also when it said it is shutting down
+(``ServerShutdown``, a ``CommandError`` too).
 ``send(line)`` sends any line as typed. The REPL and the player use this client too.
 """
 
@@ -27,9 +28,10 @@ from __future__ import annotations
 
 from typing import TypeVar
 
+from ..protocol.replies import SHUTTING_DOWN
 from .calls import Call, count_problem, read_call, speaks
 from .connect import ServerUnavailable
-from .errors import CommandError, ConnectionLost
+from .errors import CommandError, ConnectionLost, ServerShutdown
 from .lines import LineClient
 from .options import COMMANDS_DIR, add_connection_args, default_address, find_script, server_address
 from .scene_verbs import SceneVerbs
@@ -75,7 +77,8 @@ class Client(LineClient, Verbs, SceneVerbs):
         """Send ``call``'s line and read its reply (every earlier reply must be read).
 
         Raises:
-            CommandError, ConnectionLost, ServerUnavailable, UnexpectedReply, ArgumentError.
+            CommandError, ConnectionLost (``ServerShutdown``: the server stopped while the
+            call waited), ServerUnavailable, UnexpectedReply, ArgumentError.
         """
         if self.pending:
             raise RuntimeError(f"a call with {self.pending} replies unread")
@@ -83,7 +86,11 @@ class Client(LineClient, Verbs, SceneVerbs):
             names = self.joint_names()
             count_problem(call, self.robot_name or "the robot", names)
         self._post(call.line, call.track, call.data)
-        return read_call(call, self.read_reply())
+        reply = self.read_reply()
+        if reply == SHUTTING_DOWN:  # the server goes away mid-call: ConnectionLost's case
+            self.close()
+            raise ServerShutdown(self.host, self.port, call.line, reply)
+        return read_call(call, reply)
 
     def send(self, line: str) -> str:
         """Send one line as typed; return its ``ok`` reply (the whole line).
@@ -93,6 +100,9 @@ class Client(LineClient, Verbs, SceneVerbs):
             ValueError: the line is blank or only a comment (nothing would answer).
         """
         reply = self.ask(line)
+        if reply == SHUTTING_DOWN:
+            self.close()
+            raise ServerShutdown(self.host, self.port, line.strip(), reply)
         if reply.startswith("error"):
             raise CommandError(line.strip(), reply)
         return reply
