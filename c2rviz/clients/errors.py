@@ -56,7 +56,7 @@ class ConnectionLost(C2rvizError, ConnectionError):
         )
 
 
-class ServerShutdown(ConnectionLost, CommandError):
+class ServerShutdown(ConnectionLost, CommandError):  # type: ignore[misc]  # command: str here
     """The server stopped while the command waited (it replied ``error: server is shutting
     down`` and closed): a ``ConnectionLost`` (the server went away mid-call), and a
     ``CommandError`` too, for code that catches the reply.
