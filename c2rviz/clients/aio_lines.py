@@ -22,8 +22,8 @@ from ..protocol.framing import Line, LineFramer
 from ..protocol.verbs.cell import RobotChoice
 from ..protocol.verbs.joints import Units
 from .connect import ServerUnavailable
-from .errors import CommandError, ConnectionLost, ReplyTimeout, ReplyTooLong, UnexpectedReply
-from .lines import MAX_REPLY_BYTES
+from .errors import CommandError, ConnectionLost, ReplyTimeout, ReplyTooLong
+from .line_state import MAX_REPLY_BYTES, LineState
 from .records import Event, State, read_stream_line
 from .stream import line_text, watch_request
 
@@ -86,8 +86,9 @@ class _LineReader:
         return line_text(self.lines.popleft(), asked, self.framer.max_line)
 
 
-class AsyncLineClient:
-    """One asyncio connection to the command server (see the module docstring)."""
+class AsyncLineClient(LineState):
+    """One asyncio connection to the command server (see the module docstring, and
+    ``LineState`` for what it remembers)."""
 
     def __init__(
         self,
@@ -101,24 +102,18 @@ class AsyncLineClient:
         max_reply: int = MAX_REPLY_BYTES,
     ) -> None:
         """Args as ``Client``'s."""
-        self.host = host
-        self.port = port
-        self.timeout = timeout
-        self.retry_s = retry_s
-        self.max_reply = max_reply
-        self._degrees = degrees
-        self.chosen_robot = robot
-        self._insist = robot is not None
-        self.robot_name: str | None = None
-        self._names: tuple[str, ...] | None = None
+        super().__init__(
+            host,
+            port,
+            timeout=timeout,
+            retry_s=retry_s,
+            degrees=degrees,
+            robot=robot,
+            max_reply=max_reply,
+        )
         self._streams: Streams | None = None
         self._reader: _LineReader | None = None
         self._lock = asyncio.Lock()
-
-    @property
-    def in_degrees(self) -> bool:
-        """The connection's angle unit is degrees (as last confirmed by the server)."""
-        return self._degrees
 
     @property
     def is_open(self) -> bool:
@@ -138,11 +133,10 @@ class AsyncLineClient:
         if self.chosen_robot is not None:
             line = f"robot {self.chosen_robot}"
             reply = await self._exchange(line, RobotChoice(self.chosen_robot))
-            if not reply.startswith("ok"):
-                self.chosen_robot = None
-                if self._insist:
-                    await self._close()
-                    raise CommandError(line, reply)
+            refused = self._robot_refused(line, reply)
+            if refused is not None:
+                await self._close()
+                raise refused
         self._insist = False
         if self._degrees:
             await self._exchange("degrees", Units(degrees=True))
@@ -193,12 +187,7 @@ class AsyncLineClient:
         if reply is None:
             await self._close()
             raise ConnectionLost(self.host, self.port, line)
-        if reply.startswith("ok"):
-            if isinstance(tracked, Units):
-                self._degrees = tracked.degrees
-            elif isinstance(tracked, RobotChoice) and tracked.name is not None:
-                self.chosen_robot = tracked.name
-                self._names = None
+        self._remember(reply, tracked)
         return reply
 
     async def _reply(self, line: str) -> str | None:
@@ -212,14 +201,7 @@ class AsyncLineClient:
     async def joint_names(self) -> tuple[str, ...]:
         """The chain's joint names, in index order (asked once per connection and robot)."""
         if self._names is None or not self.is_open:
-            reply = await self.ask("names")
-            if reply.startswith("error"):
-                raise CommandError("names", reply)
-            robot, _, names = reply[3:].partition(" ")
-            if not reply.startswith("ok ") or not robot or not names or " " in names:
-                raise UnexpectedReply("names", reply)
-            self.robot_name = robot
-            self._names = tuple(names.split(","))
+            return self._take_names(await self.ask("names"))
         return self._names
 
 

@@ -1,4 +1,8 @@
-"""``AsyncClient``'s methods for the scene: markers, trails, recordings, workcell objects."""
+"""``AsyncClient``'s methods for the scene: markers, trails, recordings, workcell objects.
+
+The one source of both clients' scene methods: ``scripts/unasync_clients.py`` writes the
+blocking ``scene_verbs.py`` from this file (edit here, then run it).
+"""
 
 from __future__ import annotations
 
@@ -21,6 +25,8 @@ class AsyncSceneVerbs:
 
     async def call(self, call: Call[T]) -> T:
         raise NotImplementedError  # the client's
+
+    # Markers.
 
     @speaks("mark")
     async def mark(self, pose: Sequence[float] | None = None, *, world: bool = False) -> None:
@@ -47,6 +53,8 @@ class AsyncSceneVerbs:
     async def clear(self) -> None:
         """Home, and remove every marker."""
         return await self.call(calls.CLEAR)
+
+    # Watching, trails, recordings.
 
     @speaks("unwatch")
     async def unwatch(self) -> None:
@@ -75,6 +83,8 @@ class AsyncSceneVerbs:
     async def recording(self) -> RecordingStatus | None:
         """The recording running (None: none)."""
         return await self.call(calls.RECORDING)
+
+    # The workcell.
 
     @speaks("object")
     async def add_object(

@@ -15,8 +15,9 @@ the bag's index, streamed: memory stays flat however long the bag. Playing:
    value anywhere in the span moves nothing.
 3. Then the span streams: ``radians`` and ``motion off`` (or ``--motion``), then a
    ``joints`` line per message (chain order, exact values) with ``sleep DT`` lines
-   between them at the bag's pace divided by ``--rate`` (a gap over
-   ``MAX_SLEEP_S`` is split); ``--window`` lines are sent ahead of their replies.
+   between them at the bag's pace divided by ``--rate`` (one line however long the
+   gap; over ``LONG_PAUSE_S`` a warning); ``--window`` lines are sent ahead of their
+   replies.
    ``--loop N`` plays the span N times (0: until Ctrl-C). The first ``error:``
    reply stops the play.
 
@@ -42,12 +43,12 @@ from pathlib import Path
 from typing import TextIO
 
 from ..errors import C2rvizError
-from .bag_span import MAX_SLEEP_S, BagSpan, check_span, command_lines, open_bag, write_commands
+from .bag_span import LONG_PAUSE_S, BagSpan, check_span, command_lines, open_bag, write_commands
 from .client import Client, ConnectionLost, ServerUnavailable, server_address
 
 __all__ = [
     "BAG_SUFFIXES",
-    "MAX_SLEEP_S",
+    "LONG_PAUSE_S",
     "BagSpan",
     "add_bag_args",
     "check_span",

@@ -22,10 +22,10 @@ from ..tolerance import within_limit
 if TYPE_CHECKING:
     from ..ros.bag_reader import JointStateBag
 
-__all__ = ["MAX_SLEEP_S", "BagSpan", "check_span", "command_lines", "open_bag", "write_commands"]
+__all__ = ["LONG_PAUSE_S", "BagSpan", "check_span", "command_lines", "open_bag", "write_commands"]
 
-MAX_SLEEP_S = 60.0
-"""Longest ``sleep`` line sent; a longer gap in the bag becomes several."""
+LONG_PAUSE_S = 3600.0
+"""A pause longer than this (the server's default longest ``sleep``) is warned about."""
 
 
 @dataclass(frozen=True)
@@ -56,7 +56,11 @@ def check_span(span: BagSpan, limits: Sequence[tuple[float, float, str]] | None)
     from ..ros.errors import BadSample
 
     warnings: list[str] = []
+    longest, at_s, previous_s = 0.0, 0.0, None
     for t_s, values in span.samples(warnings):
+        if previous_s is not None and (t_s - previous_s) / span.rate > longest:
+            longest, at_s = (t_s - previous_s) / span.rate, previous_s
+        previous_s = t_s
         for k, (value, (lower, upper, unit)) in enumerate(zip(values, limits or ())):
             if not within_limit(value, lower, upper):
                 raise BadSample(
@@ -64,6 +68,11 @@ def check_span(span: BagSpan, limits: Sequence[tuple[float, float, str]] | None)
                     f"joint {span.chain[k]!r} is {value:.10g} {unit} at {t_s:.6f} s, outside "
                     f"its limits {lower:g}..{upper:g} {unit} (the server's 'limits')",
                 )
+    if longest > LONG_PAUSE_S:
+        warnings.append(
+            f"a pause of {longest:.6g} s from {at_s:.6f} s: a server refuses a sleep over "
+            f"its longest ({LONG_PAUSE_S:g} s unless --max-sleep); cut it with --start/--duration"
+        )
     return warnings
 
 
@@ -72,16 +81,15 @@ def _seconds(us: float) -> str:
 
 
 def command_lines(span: BagSpan) -> Iterator[str]:
-    """``joints`` lines of the span, with ``sleep`` lines between (read as they go)."""
+    """``joints`` lines of the span, with one ``sleep`` line between two (read as they go):
+    a line per message, however long the pause."""
     previous_us: int | None = None
     for t_s, values in span.samples():
         now_us = round(t_s * 1e6)
         if previous_us is not None:
             gap_us = (now_us - previous_us) / span.rate
-            while gap_us > 0.5:  # under half a microsecond is no pause at all
-                step = min(gap_us, MAX_SLEEP_S * 1e6)
-                yield f"sleep {_seconds(step)}"
-                gap_us -= step
+            if gap_us > 0.5:  # under half a microsecond is no pause at all
+                yield f"sleep {_seconds(gap_us)}"
         previous_us = now_us
         yield "joints " + ",".join([repr(float(v)) for v in values])
 

@@ -88,10 +88,17 @@ class _Statuses:
 
 
 def run(
-    sock: socket.socket, commands: Sequence[Command], name: str, out: TextIO, err: TextIO
+    sock: socket.socket,
+    commands: Sequence[Command],
+    name: str,
+    out: TextIO,
+    err: TextIO,
+    *,
+    quiet: bool = False,
 ) -> int:
     """Send every command and wait for each one's CRCL_Done; return the index of the
-    command that got CRCL_Error, or -1 when all were done."""
+    command that got CRCL_Error, or -1 when all were done (``quiet``: show the error
+    alone, not each command)."""
     statuses = _Statuses(sock)
     width = len(str(len(commands)))
     for index, command in enumerate(commands):
@@ -107,7 +114,8 @@ def run(
         while True:
             state = statuses.next().command_status
             if state.state == "CRCL_Error":  # about this command: the ones before are done
-                print(f"{label}: error", file=out, flush=True)
+                if not quiet:
+                    print(f"{label}: error", file=out, flush=True)
                 print(
                     f"{name}: command {index} ({command.XSI_TYPE}, CommandID "
                     f"{command.command_id}): {state.description}",
@@ -116,7 +124,8 @@ def run(
                 )
                 return index
             if state.command_id == command.command_id and state.state == "CRCL_Done":
-                print(f"{label}: done", file=out, flush=True)
+                if not quiet:
+                    print(f"{label}: done", file=out, flush=True)
                 break
     return -1
 
@@ -142,6 +151,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="keep retrying the connection for S seconds, then give up (default 10)",
     )
     add("--check", action="store_true", help="only read and check the program; do not connect")
+    add("--quiet", "-q", action="store_true", help="print errors and the summary line only")
     return parser
 
 
@@ -156,6 +166,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (OSError, C2rvizError) as exc:
         where = f"{args.file}: " if isinstance(exc, CrclError) else ""
         print(f"c2rviz-play: {where}{exc}", file=err)
+        return 2
+    except Exception as exc:  # the codec's slip on a hostile document: one line, never a trace
+        problem = f"{type(exc).__name__}: {exc}"
+        print(f"c2rviz-play: {args.file}: not a CRCL program this can read ({problem})", file=err)
         return 2
     name = path.name
     if args.check:
@@ -172,7 +186,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         notify(str(exc).replace("c2rviz server", "c2rviz CRCL door"))
         return 1
     try:
-        failed = run(sock, commands, name, out, err)
+        failed = run(sock, commands, name, out, err, quiet=args.quiet)
     except (ConnectionError, OSError, CrclError) as exc:
         notify(f"connection to {host}:{port} lost: {exc}")
         return 1

@@ -17,6 +17,7 @@ __all__ = [
     "ConnectionLost",
     "ReplyTimeout",
     "ReplyTooLong",
+    "ServerShutdown",
     "UnexpectedReply",
 ]
 
@@ -52,6 +53,29 @@ class ConnectionLost(C2rvizError, ConnectionError):
         during = f" while waiting for the reply to {shown(command, 60)}" if command else ""
         super().__init__(
             f"connection to {host}:{port} lost{during} (the server stopped or restarted)"
+        )
+
+
+class ServerShutdown(ConnectionLost, CommandError):  # type: ignore[misc]  # command: str here
+    """The server stopped while the command waited (it replied ``error: server is shutting
+    down`` and closed): a ``ConnectionLost`` (the server went away mid-call), and a
+    ``CommandError`` too, for code that catches the reply.
+
+    Attributes:
+        host, port, command: As ``ConnectionLost``'s.
+        reply, message: As ``CommandError``'s.
+    """
+
+    def __init__(self, host: str, port: int, command: str, reply: str) -> None:
+        self.host = host
+        self.port = port
+        self.command = command
+        self.reply = reply
+        self.message = reply.removeprefix("error:").strip()
+        C2rvizError.__init__(  # not the parents' own: their arguments differ
+            self,
+            f"connection to {host}:{port} lost while waiting for the reply to "
+            f"{shown(command, 60)} (the server is shutting down)",
         )
 
 

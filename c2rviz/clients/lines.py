@@ -19,37 +19,24 @@ from collections.abc import Callable
 from ..errors import C2rvizError, LineTooLong
 from ..protocol.framing import Line, LineFramer
 from ..protocol.grammar import parse_line
-from ..protocol.verbs.cell import RobotChoice
-from ..protocol.verbs.joints import Units
 from .connect import dial
-from .errors import CommandError, ConnectionLost, ReplyTimeout, ReplyTooLong, UnexpectedReply
+from .errors import ConnectionLost, ReplyTimeout, ReplyTooLong, UnexpectedReply
+from .line_state import MAX_REPLY_BYTES, LineState
 
 __all__ = ["MAX_REPLY_BYTES", "LineClient"]
 
-MAX_REPLY_BYTES = 1 << 20
-"""Longest reply line a client reads [bytes]; past it the connection is closed."""
 _CHUNK = 65536
 _STREAM = ("state ", "event ")  # a watch stream's lines, which no reply starts with
 
 
-class LineClient:
-    """One connection; see the module docstring.
+class LineClient(LineState):
+    """One connection; see the module docstring (and ``LineState`` for what it remembers).
 
     The connection opens lazily (``open``, or the first line sent). Replies are
     matched to lines by order, so several lines may be sent (``post``) before
     their replies are read (``read_reply``): pipelining. An interrupted read or
     write leaves the stream out of step, so the connection is closed; the next
     line reconnects and restores the unit mode and the robot chosen.
-
-    Attributes:
-        host, port: The command server.
-        timeout: Longest wait for one reply [s] (None: as long as it takes: a reply may
-            follow a long move or ``sleep``).
-        retry_s: How long to keep retrying a refused connection [s].
-        max_reply: Longest reply line [bytes].
-        chosen_robot: The robot a ``robot NAME`` line chose (the server said ``ok``);
-            None: the port's own robot.
-        robot_name, names: From ``names``, once ``joint_names()`` has asked.
     """
 
     def __init__(
@@ -64,35 +51,22 @@ class LineClient:
         max_reply: int = MAX_REPLY_BYTES,
         notify: Callable[[str], None] | None = None,
     ) -> None:
-        """Args:
-        host, port: The command server.
-        timeout: Longest wait for one reply [s]; None: no limit.
-        retry_s: How long to keep retrying a refused connection [s].
-        degrees: Speak degrees (the connection sends ``degrees`` when it opens).
-        robot: Drive this robot of a cell (``robot NAME`` when it opens).
-        max_reply: Longest reply line [bytes].
-        notify: Called with a short message when retrying to connect begins.
-        """
-        self.host = host
-        self.port = port
-        self.timeout = timeout
-        self.retry_s = retry_s
-        self.max_reply = max_reply
+        """Args as ``LineState``'s, and ``notify``: called with a short message when
+        retrying to connect begins."""
+        super().__init__(
+            host,
+            port,
+            timeout=timeout,
+            retry_s=retry_s,
+            degrees=degrees,
+            robot=robot,
+            max_reply=max_reply,
+        )
         self.notify = notify
-        self._degrees = degrees
-        self.chosen_robot = robot
-        self._insist = robot is not None  # the first open refuses a robot the server lacks
-        self.robot_name: str | None = None
-        self._names: tuple[str, ...] | None = None
         self._sock: socket.socket | None = None
         self._framer = LineFramer(max_reply)
         self._lines: deque[Line] = deque()  # framed, not yet read
         self._sent: deque[tuple[str, object]] = deque()  # (line, tracked command) per reply due
-
-    @property
-    def in_degrees(self) -> bool:
-        """The connection's angle unit is degrees (as last confirmed by the server)."""
-        return self._degrees
 
     @property
     def is_open(self) -> bool:
@@ -120,12 +94,10 @@ class LineClient:
         self._names = None
         if self.chosen_robot is not None:
             line = f"robot {self.chosen_robot}"
-            reply = self.ask(line)
-            if not reply.startswith("ok"):  # the restarted server has no such robot
-                self.chosen_robot = None
-                if self._insist:
-                    self.close()
-                    raise CommandError(line, reply)
+            refused = self._robot_refused(line, self.ask(line))
+            if refused is not None:
+                self.close()
+                raise refused
         self._insist = False
         if self._degrees:
             reply = self.ask("degrees")
@@ -240,12 +212,7 @@ class LineClient:
         if not isinstance(raw, str):
             raise UnexpectedReply(line, "", "a line that is not UTF-8 text")
         reply = raw.removesuffix("\r")
-        if reply.startswith("ok"):
-            if isinstance(tracked, Units):
-                self._degrees = tracked.degrees
-            elif isinstance(tracked, RobotChoice) and tracked.name is not None:
-                self.chosen_robot = tracked.name
-                self._names = None  # another robot: other joints
+        self._remember(reply, tracked)
         return reply
 
     def _read_line(self) -> Line | None:
@@ -298,12 +265,5 @@ class LineClient:
         """
         self.open()
         if self._names is None:
-            reply = self.ask("names")
-            if reply.startswith("error"):
-                raise CommandError("names", reply)
-            robot, _, names = reply[3:].partition(" ")
-            if not reply.startswith("ok ") or not robot or not names or " " in names:
-                raise UnexpectedReply("names", reply)
-            self.robot_name = robot
-            self._names = tuple(names.split(","))
+            return self._take_names(self.ask("names"))
         return self._names

@@ -1,6 +1,6 @@
-"""The clients' methods for planning, the guard's modes, the gripper and the ghost: their
-calls (pure: arguments checked before anything is sent) and a part of ``Client`` and of
-``AsyncClient`` each.
+"""The calls of planning, the guard's modes, the gripper and the ghost (pure: arguments
+checked before anything is sent), and the plan's record; the clients' methods that send
+them are in ``aio_verbs`` (and its blocking twin, ``verbs``).
 
 Angles are in the connection's unit (radians unless the client chose degrees), lengths
 in metres, times in seconds.
@@ -8,16 +8,13 @@ in metres, times in seconds.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from typing import NamedTuple, TypeVar
+from typing import NamedTuple
 
 from . import arguments as check
 from . import records as read
-from .calls import Call, fixed, parsed, pose_text, speaks, with_value
+from .calls import Call, fixed, parsed, pose_text, with_value
 
-__all__ = ["AsyncPlanVerbs", "PlanSummary", "PlanVerbs"]
-
-T = TypeVar("T")
+__all__ = ["PlanSummary"]
 
 GUARD_MODES = ("on", "off", "plan")
 
@@ -95,103 +92,3 @@ def ghost(on: object) -> Call[bool]:
 
 
 PLAN = fixed("plan", read_waypoints)
-
-
-class PlanVerbs:
-    """Planning, the guard's modes, the gripper and the ghost (a part of the client)."""
-
-    def call(self, call: Call[T]) -> T:
-        raise NotImplementedError  # the client's
-
-    @speaks("plan")
-    def plan_joints(self, values: Sequence[float]) -> PlanSummary:
-        """A collision-free path to joint ``values`` [rad, or deg; m]; with motion on, the
-        arm moves along it (the reply comes as ``motion`` says)."""
-        return self.call(plan_joints(values))
-
-    @speaks("plan")
-    def plan_pose(self, pose: Sequence[float]) -> PlanSummary:
-        """A collision-free path to a tool ``pose`` (x, y, z [m], and roll, pitch, yaw
-        [rad, or deg], or the position alone); moves as ``plan_joints``."""
-        return self.call(plan_pose(pose))
-
-    @speaks("plan")
-    def plan(self) -> list[tuple[float, ...]]:
-        """The last planned path's waypoints, each the chain's joint values [rad, or deg; m]."""
-        return self.call(PLAN)
-
-    @speaks("plan")
-    def plan_timeout(self, seconds: float | None = None) -> float:
-        """Set (or with None, return) this connection's planning time limit [s]."""
-        return self.call(plan_timeout(seconds))
-
-    @speaks("plan")
-    def plan_resolution(self, steps: Sequence[float] | None = None) -> tuple[float, ...]:
-        """Set (or with None, return) the checks' steps: (a joint's angle [rad, or deg],
-        the tool's travel [m])."""
-        return self.call(plan_resolution(steps))
-
-    @speaks("guard")
-    def guard_mode(self, mode: str | None = None) -> str:
-        """The guard as ``on``, ``off`` or ``plan`` (a refused move is planned around);
-        returns it."""
-        return self.call(guard_mode(mode))
-
-    @speaks("grip")
-    def grip(self, opening: float | None = None) -> float:
-        """The gripper to ``opening`` [0 closed .. 1 open] (arrives as ``motion`` says), or
-        with None return its opening; returns the opening."""
-        return self.call(grip(opening))
-
-    @speaks("ghost")
-    def ghost(self, on: bool | None = None) -> bool:
-        """Show this connection's targets and paths as a ghost on the page (``True``, the
-        default); returns whether it does."""
-        return self.call(ghost(on))
-
-
-class AsyncPlanVerbs:
-    """``PlanVerbs`` for the async client."""
-
-    async def call(self, call: Call[T]) -> T:
-        raise NotImplementedError  # the client's
-
-    @speaks("plan")
-    async def plan_joints(self, values: Sequence[float]) -> PlanSummary:
-        """As ``PlanVerbs.plan_joints``."""
-        return await self.call(plan_joints(values))
-
-    @speaks("plan")
-    async def plan_pose(self, pose: Sequence[float]) -> PlanSummary:
-        """As ``PlanVerbs.plan_pose``."""
-        return await self.call(plan_pose(pose))
-
-    @speaks("plan")
-    async def plan(self) -> list[tuple[float, ...]]:
-        """As ``PlanVerbs.plan``."""
-        return await self.call(PLAN)
-
-    @speaks("plan")
-    async def plan_timeout(self, seconds: float | None = None) -> float:
-        """As ``PlanVerbs.plan_timeout``."""
-        return await self.call(plan_timeout(seconds))
-
-    @speaks("plan")
-    async def plan_resolution(self, steps: Sequence[float] | None = None) -> tuple[float, ...]:
-        """As ``PlanVerbs.plan_resolution``."""
-        return await self.call(plan_resolution(steps))
-
-    @speaks("guard")
-    async def guard_mode(self, mode: str | None = None) -> str:
-        """As ``PlanVerbs.guard_mode``."""
-        return await self.call(guard_mode(mode))
-
-    @speaks("grip")
-    async def grip(self, opening: float | None = None) -> float:
-        """As ``PlanVerbs.grip``."""
-        return await self.call(grip(opening))
-
-    @speaks("ghost")
-    async def ghost(self, on: bool | None = None) -> bool:
-        """As ``PlanVerbs.ghost``."""
-        return await self.call(ghost(on))

@@ -202,6 +202,12 @@ def build_parser() -> argparse.ArgumentParser:
     add("--keep-going", action="store_true", help="go on after an error reply")
     add("--check", action="store_true", help="only parse the file; do not connect")
     add(
+        "--quiet",
+        "-q",
+        action="store_true",
+        help="print errors, warnings and the summary line only, not each line and its reply",
+    )
+    add(
         "--strict",
         action="store_true",
         help="refuse (exit 2) when the file's '# robot: NAME' line names another robot "
@@ -256,7 +262,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 2
     if script.problems:
         return _fail(script.all_problems(), script.name, err)
-    if path != Path(args.file):
+    if path != Path(args.file) and not args.quiet:
         print(f"c2rviz-play: playing {path}", file=err, flush=True)
     if script.closes is not None and args.loop != 1:
         problem = script.problem(
@@ -274,7 +280,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"c2rviz-play: {shown(message)}", file=err, flush=True)
 
     client = Client(host, port, retry_s=args.timeout, notify=notify)
-    show = Progress(out, err)
+    show = Progress(out, err, quiet=args.quiet)
     errors = played = 0
     start = time.monotonic()
     try:
@@ -292,7 +298,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             reply = client.ask(f"motion {motion}")
             if not reply.startswith("ok"):  # a server from before motion
                 return _fail([f"--motion {motion}: the server replied {reply!r}"], script.name, err)
-        elif show.in_place:
+        elif show.in_place and not args.quiet:
             motion = motion_of(client.ask("motion"))  # to show "-> moving"; None: no motion
         loop = 0
         while args.loop == 0 or loop < args.loop:

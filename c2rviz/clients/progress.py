@@ -16,16 +16,21 @@ class Progress:
 
     On a terminal (``in_place``) one status line is rewritten in place; replies
     that carry data and every error stay on screen. Otherwise one plain line
-    per command.
+    per command. ``quiet``: errors alone (``c2rviz-play --quiet``).
     """
 
-    def __init__(self, out: TextIO, err: TextIO, in_place: bool | None = None) -> None:
+    def __init__(
+        self, out: TextIO, err: TextIO, in_place: bool | None = None, *, quiet: bool = False
+    ) -> None:
         self.out = out
         self.err = err
+        self.quiet = quiet
         self.in_place = out.isatty() if in_place is None else in_place
         self._dirty = False
 
     def step(self, label: str, text: str, reply: str) -> None:
+        if self.quiet:
+            return
         message = f"{label} {text} -> {shown(reply)}"
         if not self.in_place:
             print(message, file=self.out, flush=True)
@@ -39,7 +44,7 @@ class Progress:
     def waiting(self, label: str, text: str, note: str) -> None:
         """On a terminal, show that ``text``'s reply is awaited (``-> moving``); the
         ``step`` that follows overwrites it. Elsewhere nothing: one line per command."""
-        if not self.in_place:
+        if not self.in_place or self.quiet:
             return
         self.out.write("\r\x1b[K" + self._fit(f"{label} {text} -> {note}"))
         self.out.flush()

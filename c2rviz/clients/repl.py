@@ -139,7 +139,9 @@ class Repl(LocalCommands):
         local = self.local.get(verb)
         if verb == "where" and not self.interactive:
             local = None  # piped: the server's reply as it is, as any client would see it
-        if local is not None and (verb in ("file", "sleep", "goto", "watch") or len(words) == 1):
+        if local is not None and (
+            verb in ("file", "sleep", "goto", "watch", "help") or len(words) == 1
+        ):
             return local(words[1:])
         reply = self.ask(line)
         self.show(reply)

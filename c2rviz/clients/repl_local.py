@@ -46,7 +46,7 @@ LOCAL_USAGE = {
         "step=/rate=: only for a server without motion, which gets small joints steps",
     ),
     "watch": ("watch [HZ]", "print the server's state and event lines until Ctrl-C"),
-    "help": ("help", "this list"),
+    "help": ("help [VERB]", "this list; with a verb: its line and its docs page"),
     "q": ("q", "leave (the server keeps running)"),
     "quit": ("quit", "stop the server, then leave"),
 }
@@ -160,6 +160,7 @@ class LocalCommands:
             self.show(f"{script.name}: nothing was sent")
             return True
         show = Progress(self.out, self.out, in_place=False)
+        degrees = client.in_degrees
         try:
             errors = play(client, script, show, speed=options.get("speed", self.speed))
         except ConnectionLost:
@@ -168,7 +169,22 @@ class LocalCommands:
         self.errors += errors > 0
         if not errors:
             self.show(f"{script.name}: {script.count} commands, all ok")
+        self._left(script.name, degrees, None if errors else script.last_mode)
         return True
+
+    def _left(self, name: str, degrees: bool, mode: str | None) -> None:
+        """Say what a command file's own lines left set on this connection: its lines act
+        as if typed here, so a ``degrees`` or ``motion`` line stays (docs/clients.md)."""
+        changed = []
+        if self.client.in_degrees != degrees:
+            unit, back = (
+                ("degrees", "radians") if self.client.in_degrees else ("radians", "degrees")
+            )
+            changed.append(f"in {unit} ('{back}' goes back)")
+        if mode is not None:
+            changed.append(f"in motion {mode}")
+        if changed:
+            self.say(f"{name} left this connection {' and '.join(changed)}, as its lines say")
 
     def _sleep(self, words: list[str]) -> bool:
         command = parse_line(" ".join(["sleep", *words]))
@@ -245,6 +261,15 @@ class LocalCommands:
         raise ConnectionLost(client.host, client.port)
 
     def _help(self, words: list[str]) -> bool:
+        if words:  # one verb: this client's own, or the server's line and docs page
+            local = LOCAL_USAGE.get(words[0].lower()) if len(words) == 1 else None
+            if local is not None:
+                self.show(f"{local[0]}: {local[1]} (this client; see docs/clients.md)")
+                return True
+            reply = self.ask(" ".join(["help", *words]))
+            self.show(reply)
+            self.errors += not reply.startswith("ok")
+            return True
         self.show("local commands (this client):")
         width = max(len(usage) for usage, _ in LOCAL_USAGE.values())
         for usage, what in LOCAL_USAGE.values():

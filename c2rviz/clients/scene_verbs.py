@@ -1,3 +1,5 @@
+# Written by scripts/unasync_clients.py from c2rviz/clients/aio_scene_verbs.py: do not edit;
+# edit aio_scene_verbs.py, then run `python scripts/unasync_clients.py`.
 """``Client``'s methods for the scene: markers, trails, recordings, workcell objects."""
 
 from __future__ import annotations

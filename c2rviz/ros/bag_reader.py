@@ -12,10 +12,11 @@ from the bag's first message, what ``ros2 bag play`` paces by; a span is
 raises at the first thing a player must not send (each error one line, a
 ``BagError``): a NaN or infinite position, a message naming some of the chain's
 joints but not all (the missing one named), names and positions of unequal
-length, header stamps going backwards, or no message with the chain's joints
-at all. It returns warnings, each once: joints the bag names that the chain
-does not have (ignored), and messages naming none of the chain's joints
-(skipped: a gripper's states on the same topic). ``samples`` yields the same
+length, a joint named twice, header stamps going backwards, or no message with the
+chain's joints at all. A bag file (or a file of a bag folder) that is not a regular
+file (a FIFO) is refused before it is opened. It returns warnings, each once: joints
+the bag names that the chain does not have (ignored), and messages naming none of the
+chain's joints (skipped: a gripper's states on the same topic). ``samples`` yields the same
 span as ``(t_s, positions in chain order)``, lazily, with the same checks, so
 memory stays flat however long the bag.
 """
@@ -116,6 +117,7 @@ class JointStateBag:
             raise NotABag(str(path), f"does not exist; give {_KINDS}")
         if not path.is_dir() and path.suffix not in _SUFFIXES:
             raise NotABag(str(path), f"is not a bag (by its name); give {_KINDS}")
+        _regular_files(path)
         try:
             reader = AnyReader([path])
             reader.open()
@@ -275,6 +277,19 @@ class JointStateBag:
         return stamp.sec * 1_000_000_000 + stamp.nanosec, names, positions
 
 
+def _regular_files(path: Path) -> None:
+    """Refuse a bag file, or a file of a bag folder, that is not a regular file: a FIFO
+    or a device would be read forever (a symlink to a regular file is one).
+
+    Raises:
+        NotABag: naming the file.
+    """
+    files = [entry for entry in path.iterdir() if not entry.is_dir()] if path.is_dir() else [path]
+    for file in files:
+        if not file.is_file():
+            raise NotABag(str(file), f"is not a regular file (a FIFO or a device?); give {_KINDS}")
+
+
 def _choose(path: Path, reader: AnyReader, topic: str | None) -> str:
     ours = sorted({c.topic for c in reader.connections if c.msgtype in JOINT_STATE_TYPES})
     if not ours:
@@ -295,6 +310,9 @@ def _chain_index(
 ) -> list[int] | None:
     """Where each chain joint is in ``names``; None if it names none of them."""
     position = {name: k for k, name in enumerate(names)}
+    if len(position) != len(names):  # which value would count? rosbridge refuses it too
+        twice = next(name for k, name in enumerate(names) if name in names[:k])
+        raise BadSample(path, f"the JointState at {t_s:.6f} s names joint {twice!r} twice")
     missing = [name for name in chain if name not in position]
     if len(missing) == len(chain):
         return None

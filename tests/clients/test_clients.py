@@ -193,6 +193,20 @@ def test_player_plays_motoman_txt_to_the_seed_end_pose(server, connect, capsys):
     assert "\r" not in out  # plain lines when not on a terminal
 
 
+def test_player_quiet_prints_errors_and_the_summary_only(server, tmp_path, capsys):
+    assert player.main([MOTOMAN, "--port", str(server.port), "--speed", "1e4", "--quiet"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.startswith(f"{MOTOMAN}: 16 commands, all ok, in ")
+    assert captured.out.count("\n") == 1 and captured.err == ""
+    limit = write(tmp_path, "limit.txt", LIMIT_LINE_3)
+    assert player.main([limit, "--port", str(server.port), "-q", "--keep-going"]) == 1
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    first, summary = captured.err.splitlines()
+    assert first.startswith(f"{limit}:3: error: joint_l (index 1) = 500 deg is outside")
+    assert summary == f"{limit}: 1 error (4 commands)"
+
+
 BAD_LINE_3 = "degrees\nmove 0 30\nmvoe 1 30   # typo\nhome\n"
 
 
@@ -610,6 +624,37 @@ def test_repl_help_lists_each_command_once(server, monkeypatch, capsys):
     listed = [word for word in listed if word not in ("server", "local")]  # the two headings
     assert "where" in listed and "goto" in listed and "pose" in listed
     assert len(listed) == len(set(listed)), sorted(w for w in listed if listed.count(w) > 1)
+
+
+def test_repl_help_verb_gives_one_line(server, monkeypatch, capsys):
+    text = "help moveto\nhelp goto\nhelp nope\n"
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 1  # `help nope`: an error
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("ok moveto x,y,z[,roll,pitch,yaw] | marker N: ")
+    assert lines[0].endswith("; see docs/cartesian.md")
+    assert lines[1].startswith("goto v0,...,vn-1 [step=S] [rate=HZ]: move there")
+    assert lines[1].endswith("(this client; see docs/clients.md)")
+    assert lines[2] == "error: help: no verb 'nope' (usage: help [VERB])"
+    assert len(lines) == 3
+
+
+def test_repl_file_says_what_its_lines_left_set(server, tmp_path, monkeypatch, capsys):
+    """Issue 39, rough edge 3: a file's lines act as if typed, so its `degrees` stays; the
+    REPL says so (a bag, which names no unit, leaves the connection as it was)."""
+    motion = write(tmp_path, "motion.txt", "motion on\nradians\nhome\n")
+    text = (
+        f"file motoman.txt speed=1000\nwhere\nfile motoman.txt speed=1000\nfile {motion}\nmotion\n"
+    )
+    assert run_repl(monkeypatch, text, "--port", str(server.port)) == 0
+    captured = capsys.readouterr()
+    notes = [line for line in captured.err.splitlines() if " left this connection " in line]
+    assert notes == [
+        "motoman.txt left this connection in degrees ('radians' goes back), as its lines say",
+        f"{motion} left this connection in radians ('degrees' goes back) and in motion on, "
+        "as its lines say",
+    ]  # the second motoman.txt changed nothing: no note
+    assert "\nok -90,-90,0,0,0,0,0\n" in captured.out  # `where` in degrees, as the file said
+    assert captured.out.endswith("\nok on\n")
 
 
 def test_repl_file_stops_at_the_first_error(server, tmp_path, monkeypatch, capsys):

@@ -7,6 +7,8 @@ from __future__ import annotations
 import asyncio
 import inspect
 import math
+import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -260,6 +262,60 @@ def test_a_server_gone_mid_call_raises_connection_lost_naming_the_command(c2rviz
     assert isinstance(caught.value, ConnectionError)
     assert caught.value.command == "sleep 30.0"
     assert "while waiting for the reply to 'sleep 30.0'" in str(caught.value)
+
+
+def test_a_server_stopped_mid_move_raises_connection_lost(start_server):
+    """Issue 39, rough edge 4: docs/testing.md promises ConnectionLost; the server's
+    `error: server is shutting down` raised a bare CommandError."""
+    server = start_server()
+    robot = Client(server.host, server.port)
+    robot.motion("on")
+    robot.speed(1)
+    caught: list[BaseException] = []
+
+    def move() -> None:
+        try:
+            robot.joints([1.5, 0, 0, 0, 0, 0, 0])
+        except BaseException as exc:
+            caught.append(exc)
+
+    mover = threading.Thread(target=move)
+    mover.start()
+    with Client(server.host, server.port) as other:
+        while not other.status().moving:
+            time.sleep(0.01)
+    server.stop()
+    mover.join(60)
+    (error,) = caught
+    assert isinstance(error, ConnectionLost) and isinstance(error, ConnectionError)
+    assert isinstance(error, CommandError)  # what caught it before still does
+    assert (
+        error.command == "joints 1.5,0.0,0.0,0.0,0.0,0.0,0.0"
+        and error.message == "server is shutting down"
+    )
+    assert str(error) == (
+        f"connection to {server.host}:{server.port} lost while waiting for the reply to "
+        "'joints 1.5,0.0,0.0,0.0,0.0,0.0,0.0' (the server is shutting down)"
+    )
+    assert not robot.is_open  # the next call reconnects
+
+
+def test_the_async_client_too_raises_connection_lost_at_shutdown(start_server):
+    server = start_server()
+
+    async def main() -> None:
+        async with AsyncClient(server.host, server.port) as robot:
+            await robot.motion("on")
+            await robot.speed(1)
+            move = asyncio.ensure_future(robot.joints([1.5, 0, 0, 0, 0, 0, 0]))
+            async with AsyncClient(server.host, server.port) as other:
+                while not (await other.status()).moving:
+                    await asyncio.sleep(0.01)
+            await asyncio.get_running_loop().run_in_executor(None, server.stop)
+            with pytest.raises(ConnectionLost, match="the server is shutting down"):
+                await move
+
+    asyncio.run(main())
 
 
 def test_the_client_drives_a_robot_of_a_cell_in_degrees(cell):

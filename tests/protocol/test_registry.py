@@ -40,6 +40,30 @@ def test_help_lists_every_verb_and_alias_once():
     assert "ok commands: " + help_text() == replies.help_reply()
 
 
+def test_help_verb_gives_its_line_and_a_docs_page_that_tells_of_it():
+    lines = help_text().split("; ")
+    for word, entry in LOOKUP.items():
+        command = parse_line(f"help {word}")
+        text = command.reply_text()
+        line = next(item for item in lines if item.split()[0].split("|")[0] == entry.name)
+        assert text.startswith(f"{line}: {entry.summary}; see docs/"), text
+        page = ROOT / text.rsplit("; see ", 1)[1]
+        assert page.is_file(), page
+        said = page.read_text()
+        assert f"`{entry.name}" in said or f"> {entry.name}" in said, f"{page} lacks {word}"
+
+
+def test_help_verb_through_a_server(server, connect):
+    client = connect(server)
+    assert client.ask("help") == replies.help_reply()  # alone: the list, as ever
+    reply = client.ask("help moveto")
+    assert reply.startswith("ok moveto x,y,z[,roll,pitch,yaw] | marker N: go to that tool pose")
+    assert reply.endswith("; see docs/cartesian.md")
+    assert client.ask("help movto") == (
+        "error: help: no verb 'movto': did you mean 'moveto'? (usage: help [VERB])"
+    )
+
+
 def test_the_readme_command_table_is_the_registry():
     text = COMMANDS_DOC.read_text()
     found = re.search(r"<!-- commands:[^\n]*-->\n(.*?)\n<!-- /commands -->", text, re.S)

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass
 
 from ...errors import BadArguments, shown
 from ..grammar import one_word
-from ..registry import usage, verb
+from ..registry import LOOKUP, Verb, usage, verb
 
-__all__ = ["Help", "Limits", "Names", "Pose", "Version", "Where"]
+__all__ = ["DOCS_PAGES", "Help", "Limits", "Names", "Pose", "Version", "Where", "docs_page"]
 
 
 @verb("where", "", "reply the chain's joint values")
@@ -67,7 +68,66 @@ class Version:
     """Ask for the c2rviz version and which robot file the robot came from."""
 
 
-@verb("help", "", "reply the list of commands")
+HELP_USAGE = "help [VERB]"
+"""``help``'s usage in its errors (the list shows ``help`` alone, as it always has)."""
+
+DOCS_PAGES = {
+    "joints": "docs/commands.md",
+    "markers": "docs/commands.md",
+    "queries": "docs/commands.md",
+    "connection": "docs/commands.md",
+    "cartesian": "docs/cartesian.md",
+    "cell": "docs/cells.md",
+    "motion": "docs/motion.md",
+    "observe": "docs/watch.md",
+    "record": "docs/recording.md",
+    "workcell": "docs/workcell.md",
+    "planning": "docs/planning.md",
+    "gripper": "docs/commands.md",
+    "ghost": "docs/page.md",
+    "objects": "docs/commands.md",  # workcell.md shows objects, not this question
+}
+"""The docs page of each family of verbs (``protocol/verbs/<family>.py``), and of a verb
+documented elsewhere than its family (by name); a new family's verbs get docs/commands.md,
+which lists every verb."""
+
+
+def docs_page(entry: Verb) -> str:
+    """The docs page that tells of ``entry`` (a path from the project's root)."""
+    family = entry.command.__module__.rsplit(".", 1)[-1]
+    return DOCS_PAGES.get(entry.name) or DOCS_PAGES.get(family, "docs/commands.md")
+
+
+@verb(
+    "help",
+    "",
+    "reply the list of commands; `help VERB`: that verb's line (as the list gives it), "
+    "what it does, and its docs page",
+)
 @dataclass(frozen=True, slots=True)
 class Help:
-    """Ask for the list of commands."""
+    """Ask for the list of commands, or (``verb``) for one verb's line and docs page."""
+
+    verb: str | None = None
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> Help:
+        if not words:
+            return Help()
+        if len(words) > 1:
+            raise BadArguments(verb, "takes one verb at most", HELP_USAGE)
+        asked = words[0].lower()
+        if asked not in LOOKUP:
+            close = difflib.get_close_matches(asked, LOOKUP, n=2, cutoff=0.75)
+            hint = " or ".join(f"'{word}'" for word in close) if len(asked) <= 40 else ""
+            problem = f"no verb {shown(words[0])}" + (f": did you mean {hint}?" if hint else "")
+            raise BadArguments(verb, problem, HELP_USAGE)
+        return Help(LOOKUP[asked].name)
+
+    def reply_text(self) -> str:
+        """``help VERB``'s payload: ``moveto|... ARGS: SUMMARY; see docs/PAGE.md``."""
+        assert self.verb is not None
+        entry = LOOKUP[self.verb]
+        names = "|".join((entry.name, *entry.aliases))
+        line = f"{names} {entry.args}" if entry.args else names
+        return f"{line}: {entry.summary}; see {docs_page(entry)}"

@@ -61,4 +61,6 @@ def version(session: Session, command: Version) -> str:
 
 @handler(Help)
 def help_(session: Session, command: Help) -> str:
-    return replies.help_reply()
+    if command.verb is None:
+        return replies.help_reply()
+    return replies.ok(command.reply_text())

@@ -115,6 +115,36 @@ def test_check_only_reads_the_program(tmp_path, capsys) -> None:
     assert capsys.readouterr().out == "demo.xml: 6 CRCL commands, all check\n"
 
 
+def test_quiet_shows_the_summary_alone(crcl_server, tmp_path, capsys) -> None:
+    assert play(crcl_server, write(tmp_path, GOOD), "--quiet") == 0
+    out = capsys.readouterr().out.splitlines()
+    assert len(out) == 1 and out[0].startswith("demo.xml: 6 CRCL commands, all done, in ")
+    bad = program(move(2, (3.0, 0.0, 0.0)))
+    assert play(crcl_server, write(tmp_path, bad, "bad.xml"), "-q") == 1
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.startswith("bad.xml: command 1 (MoveToType, CommandID 2): ")
+
+
+@pytest.mark.parametrize(
+    ("x_axis", "z_axis"),
+    [((1e300, 0, 0), (0, 0, -1)), ((1, 0, 0), (0, 0, -1e300)), ((1, 0, 0), (0, 1e308, 0))],
+    ids=["x-i", "z-k", "z-j"],
+)
+def test_check_of_a_huge_axis_is_one_line_and_exit_2(tmp_path, capsys, x_axis, z_axis) -> None:
+    """Issue 39, fault 2: `--check` printed a traceback and exited 1."""
+    body = "    <MoveStraight>false</MoveStraight>\n" + pose(
+        "EndPosition", (500.0, 0.0, 800.0), x_axis, z_axis
+    )
+    path = tmp_path / "huge.xml"
+    path.write_text(program(middle("MoveTo", 2, body)))
+    assert player.main([str(path), "--check"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.count("\n") == 1 and "Traceback" not in captured.err
+    assert captured.err.startswith(f"c2rviz-play: {path}: "), captured.err
+
+
 def test_no_server_is_exit_1(tmp_path, capsys) -> None:
     with socket.socket() as probe:  # a port nothing listens on
         probe.bind(("127.0.0.1", 0))

@@ -1,0 +1,287 @@
+"""The verbs of the asyncio client, one coroutine each: THE ONE SOURCE of both clients' verbs.
+
+``scripts/unasync_clients.py`` writes ``verbs.py`` (the blocking ``Verbs``) from this file
+by dropping ``async``/``await`` and renaming ``Async*`` (as httpcore builds its sync half
+with ``unasync``); a test fails when ``verbs.py`` is out of date. Edit here, then run
+``python scripts/unasync_clients.py``.
+
+Each method checks its arguments before anything is sent (``calls``, ``plan_verbs``),
+and returns a typed record (``records``). Angles are radians, lengths metres, unless the
+connection chose degrees.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, TypeVar
+
+from ..protocol.registry import VERBS
+from . import calls, records
+from . import plan_verbs as plans
+from .calls import Call, speaks
+from .plan_verbs import PlanSummary
+from .records import (
+    JointLimit,
+    MotionLimit,
+    MotionStatus,
+    Pose,
+    RobotNames,
+    VersionInfo,
+)
+
+__all__ = ["AsyncVerbs"]
+
+T = TypeVar("T")
+
+
+class AsyncVerbs:
+    """The robot's verbs: joints, questions, the connection, the tool point, motion, cells
+    and planning (a part of the client; its ``call`` sends, its ``close`` closes)."""
+
+    robot_name: str | None
+    _names: tuple[str, ...] | None
+
+    async def call(self, call: Call[T]) -> T:
+        raise NotImplementedError  # the client's
+
+    async def close(self) -> None:
+        raise NotImplementedError  # the client's
+
+    async def send(self, line: str) -> str:
+        raise NotImplementedError  # the client's
+
+    if not TYPE_CHECKING:  # a type checker sees the typed methods alone
+
+        def __getattr__(self, name: str):
+            """A verb of the registry with no typed method (yet): ``client.VERB(*words)``
+            sends ``VERB words...`` (each word as ``str`` gives it) and returns the ``ok``
+            reply as it came (``CommandError`` for an ``error:``), as ``send`` does."""
+            if name.startswith("_") or name not in VERBS:
+                raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+            async def send_verb(*words: object) -> str:
+                return await self.send(" ".join([name, *map(str, words)]))
+
+            send_verb.__name__ = send_verb.__qualname__ = name
+            return send_verb
+
+    # The joints.
+
+    @speaks("joints")
+    async def joints(self, values: Sequence[float]) -> None:
+        """Set all chain joints [rad, or deg; m for a prismatic joint]: at once (``motion
+        off``), or travelling (``on``: returns on arrival; ``follow``: at once)."""
+        return await self.call(calls.joints(values))
+
+    @speaks("move")
+    async def move(self, indices: Sequence[int] | int, values: Sequence[float]) -> None:
+        """Set the joints at ``indices`` to ``values`` [rad, or deg; m], the rest stay."""
+        return await self.call(calls.move(indices, values))
+
+    @speaks("home")
+    async def home(self) -> None:
+        """Every chain joint to 0 (or its nearest limit)."""
+        return await self.call(calls.HOME)
+
+    @speaks("rand")
+    async def rand(self) -> None:
+        """Every chain joint to a random value within its limits (free, with the guard)."""
+        return await self.call(calls.RAND)
+
+    @speaks("degrees")
+    async def degrees(self) -> None:
+        """Angles of this connection in degrees from now on, both ways."""
+        return await self.call(calls.DEGREES)
+
+    @speaks("radians")
+    async def radians(self) -> None:
+        """Angles of this connection in radians from now on (the default)."""
+        return await self.call(calls.RADIANS)
+
+    # Questions.
+
+    @speaks("where")
+    async def where(self) -> tuple[float, ...]:
+        """The chain's joint values now [rad, or deg; m] (mid-move too)."""
+        return await self.call(calls.WHERE)
+
+    @speaks("pose")
+    async def pose(self) -> Pose:
+        """The tool pose in the base frame: x, y, z [m], roll, pitch, yaw [rad, or deg]."""
+        return await self.call(calls.POSE)
+
+    @speaks("limits")
+    async def limits(self) -> list[JointLimit]:
+        """Each chain joint's range [rad, or deg; m] and unit, in index order."""
+        return await self.call(calls.LIMITS)
+
+    @speaks("limits")
+    async def motion_limits(self) -> list[MotionLimit]:
+        """Each chain joint's velocity, acceleration and jerk limits [rad, or deg; m per s,
+        s^2, s^3] (``limits all``)."""
+        return await self.call(calls.MOTION_LIMITS)
+
+    @speaks("names")
+    async def names(self) -> RobotNames:
+        """The robot this connection drives and its chain's joint names, in index order."""
+        names = await self.call(calls.NAMES)
+        self.robot_name, self._names = names  # what a joint count is checked against
+        return names
+
+    @speaks("version")
+    async def version(self) -> VersionInfo:
+        """The server's version and the robot file it loaded."""
+        return await self.call(calls.VERSION)
+
+    @speaks("help")
+    async def help(self) -> list[str]:
+        """Every verb's usage, as the server lists them."""
+        return await self.call(calls.HELP)
+
+    # The connection.
+
+    @speaks("sleep")
+    async def sleep(self, seconds: float) -> None:
+        """Pause this connection for ``seconds`` [s of the server's clock] (others go on)."""
+        return await self.call(calls.sleep(seconds))
+
+    @speaks("bye")
+    async def bye(self) -> None:
+        """Close this connection politely (a later call reconnects)."""
+        await self.call(calls.BYE)
+        await self.close()
+
+    @speaks("quit")
+    async def quit(self) -> None:
+        """Stop the server (command server and viewer); this connection closes."""
+        await self.call(calls.QUIT)
+        await self.close()
+
+    # The tool point.
+
+    @speaks("tool")
+    async def tool(self, pose: Sequence[float] | None = None) -> Pose:
+        """Set the tool point relative to the end-effector link (x, y, z [m], roll, pitch,
+        yaw [rad, or deg]) for every connection; return it (without ``pose``: as it is)."""
+        return await self.call(calls.tool(pose))
+
+    @speaks("ik")
+    async def ik(self, pose: Sequence[float]) -> tuple[float, ...]:
+        """Joint values [rad, or deg; m] that put the tool point at ``pose`` (x, y, z [m],
+        roll, pitch, yaw [rad, or deg]); nothing moves."""
+        return await self.call(calls.ik(pose))
+
+    @speaks("moveto")
+    async def moveto(
+        self, pose: Sequence[float] | None = None, *, marker: int | None = None
+    ) -> None:
+        """Go to a tool pose (x, y, z [m], roll, pitch, yaw [rad, or deg]) through joint
+        space, or to marker N's pose (1: the oldest)."""
+        return await self.call(calls.moveto(pose, marker))
+
+    @speaks("movel")
+    async def movel(self, pose: Sequence[float]) -> None:
+        """The tool point travels a straight line to ``pose`` (x, y, z [m], roll, pitch,
+        yaw [rad, or deg]) at this connection's ``lspeed``."""
+        return await self.call(calls.movel(pose))
+
+    @speaks("lspeed")
+    async def lspeed(self, m_s: float | None = None) -> float:
+        """Set ``movel``'s tool speed [m/s] (0 < V <= 5); return it (without one: as it is)."""
+        return float(await self.call(calls.setting("lspeed", "m_s", m_s, records.read_number)))
+
+    # Motion.
+
+    @speaks("motion")
+    async def motion(self, mode: str | None = None) -> str:
+        """Set how this connection's moves travel: ``off`` (at once), ``on`` (the call
+        returns on arrival) or ``follow`` (travel, return at once); return the mode."""
+        return await self.call(calls.motion(mode))
+
+    @speaks("speed")
+    async def speed(self, percent: float | None = None) -> float:
+        """Set this connection's moves to ``percent`` [% of the joints' limits, 1..100];
+        return it (without one: as it is)."""
+        return float(
+            await self.call(calls.setting("speed", "percent", percent, records.read_number))
+        )
+
+    @speaks("stop")
+    async def stop(self) -> None:
+        """Bring the arm to rest within its limits; returns when it is."""
+        return await self.call(calls.STOP)
+
+    @speaks("wait")
+    async def wait(self) -> None:
+        """Return when the arm is at rest."""
+        return await self.call(calls.WAIT)
+
+    @speaks("target")
+    async def target(self) -> tuple[float, ...]:
+        """The joint values the arm is moving to, or stands at [rad, or deg; m]."""
+        return await self.call(calls.TARGET)
+
+    @speaks("status")
+    async def status(self) -> MotionStatus:
+        """Whether the arm moves, and the seconds until it is at rest [s of the server's clock]."""
+        return await self.call(calls.STATUS)
+
+    # Cells.
+
+    @speaks("robot")
+    async def robot(self, name: str | None = None) -> str:
+        """Drive robot ``name`` of the cell from now on; return the robot driven."""
+        return await self.call(calls.robot(name))
+
+    @speaks("robots")
+    async def robots(self) -> dict[str, int | None]:
+        """The cell's robots and their command ports."""
+        return await self.call(calls.ROBOTS)
+
+    # Planning, the guard's modes, the gripper and the ghost.
+
+    @speaks("plan")
+    async def plan_joints(self, values: Sequence[float]) -> PlanSummary:
+        """A collision-free path to joint ``values`` [rad, or deg; m]; with motion on, the
+        arm moves along it (the reply comes as ``motion`` says)."""
+        return await self.call(plans.plan_joints(values))
+
+    @speaks("plan")
+    async def plan_pose(self, pose: Sequence[float]) -> PlanSummary:
+        """A collision-free path to a tool ``pose`` (x, y, z [m], and roll, pitch, yaw
+        [rad, or deg], or the position alone); moves as ``plan_joints``."""
+        return await self.call(plans.plan_pose(pose))
+
+    @speaks("plan")
+    async def plan(self) -> list[tuple[float, ...]]:
+        """The last planned path's waypoints, each the chain's joint values [rad, or deg; m]."""
+        return await self.call(plans.PLAN)
+
+    @speaks("plan")
+    async def plan_timeout(self, seconds: float | None = None) -> float:
+        """Set (or with None, return) this connection's planning time limit [s]."""
+        return await self.call(plans.plan_timeout(seconds))
+
+    @speaks("plan")
+    async def plan_resolution(self, steps: Sequence[float] | None = None) -> tuple[float, ...]:
+        """Set (or with None, return) the checks' steps: (a joint's angle [rad, or deg],
+        the tool's travel [m])."""
+        return await self.call(plans.plan_resolution(steps))
+
+    @speaks("guard")
+    async def guard_mode(self, mode: str | None = None) -> str:
+        """The guard as ``on``, ``off`` or ``plan`` (a refused move is planned around);
+        returns it."""
+        return await self.call(plans.guard_mode(mode))
+
+    @speaks("grip")
+    async def grip(self, opening: float | None = None) -> float:
+        """The gripper to ``opening`` [0 closed .. 1 open] (arrives as ``motion`` says), or
+        with None return its opening; returns the opening."""
+        return await self.call(plans.grip(opening))
+
+    @speaks("ghost")
+    async def ghost(self, on: bool | None = None) -> bool:
+        """Show this connection's targets and paths as a ghost on the page (``True``, the
+        default); returns whether it does."""
+        return await self.call(plans.ghost(on))
