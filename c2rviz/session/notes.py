@@ -25,6 +25,7 @@ from ..world.world import World
 
 __all__ = ["INTERNAL", "Said", "recorded", "taken", "taken_all"]
 
+
 class Session(Protocol):
     """What the notes need of the session whose command they tell (``session.Session``)."""
 
