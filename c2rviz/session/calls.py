@@ -113,7 +113,7 @@ def play(session: Session, plan: Plan, speed: float | None) -> Reply:
     if line is None:
         return session.go(plan.goal, speed)
     if session.travel.active or session.state.q != line.start:
-        raise ArmMoved("the arm moved (another door drives it) since the line was planned")
+        raise ArmMoved("the arm moved (another door drives it) between the waypoints")
     return play_straight(session, line, speed)
 
 
