@@ -108,11 +108,12 @@ class Said:
             self.reply(INTERNAL)
 
 
-def recorded(session: Session, said: str | None, act: Callable[[], Reply]) -> Reply:
-    """``act()``'s reply, told to the world as ``said`` (None: its door tells it)."""
+def recorded(session: Session, said: str | Said | None, act: Callable[[], Reply]) -> Reply:
+    """``act()``'s reply, told to the world as ``said`` (a ``Said`` the door made first, to
+    tell its own refusals through it too; None: the door tells it)."""
     if said is None:
         return act()
-    record = Said(session, said)
+    record = said if isinstance(said, Said) else Said(session, said)
     try:
         reply = act()
     except C2rvizError as error:

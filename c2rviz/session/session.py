@@ -193,7 +193,7 @@ class Session(UnitEdge):
         return Said(self, text)
 
     def set_joints(
-        self, q: Sequence[float], *, speed: float | None = None, said: str | None = None
+        self, q: Sequence[float], *, speed: float | None = None, said: str | Said | None = None
     ) -> Reply:
         """The chain to ``q`` [rad or m, within the limits] as ``go``, at ``speed`` % of the
         joints' limits (None: the session's)."""
@@ -226,7 +226,7 @@ class Session(UnitEdge):
         return await calls.plan_through(self, targets, straight=straight)
 
     def play(
-        self, plan: calls.Plan, *, speed: float | None = None, said: str | None = None
+        self, plan: calls.Plan, *, speed: float | None = None, said: str | Said | None = None
     ) -> Reply:
         """Move as ``plan`` says, at ``speed`` % (None: the session's), as ``motion`` says.
 
@@ -235,30 +235,28 @@ class Session(UnitEdge):
         """
         return recorded(self, said, functools.partial(calls.play, self, plan, speed))
 
-    def play_trajectory(self, trajectory: PlannedTrajectory, *, said: str | None = None) -> Reply:
+    def play_trajectory(
+        self, trajectory: PlannedTrajectory, *, said: str | Said | None = None
+    ) -> Reply:
         """Play a checked timed trajectory from now (the arm at rest at its start), checked
         for collisions first with the guard (``calls.MAX_TRAJECTORY_CHECKS`` instants)."""
         return recorded(self, said, functools.partial(calls.play_trajectory, self, trajectory))
 
-    def stop(self, *, fingers: bool = False, said: str | None = None) -> Reply:
+    def stop(self, *, fingers: bool = False, said: str | Said | None = None) -> Reply:
         """Brake the arm to rest within its limits (``fingers``: stop the gripper too)."""
         return recorded(self, said, functools.partial(calls.brake, self, fingers))
 
-    def dwell(self, seconds: float, *, said: str | None = None) -> Reply:
+    def dwell(self, seconds: float, *, said: str | Said | None = None) -> Reply:
         """``ok`` in ``seconds`` [s] of the world's clock (``after``)."""
         return recorded(self, said, lambda: self.after(seconds, replies.OK))
 
-    def grip(self, opening: float, *, said: str | None = None) -> Reply:
+    def grip(self, opening: float, *, said: str | Said | None = None) -> Reply:
         """The gripper's fingers to ``opening`` (0 closed .. 1 open), as ``motion`` says.
 
         Raises:
             NoGripper: the robot has none.
         """
         return recorded(self, said, functools.partial(calls.grip, self, opening))
-
-    def check_path(self, q: Sequence[float], path: Sequence[Sequence[float]] = ()) -> None:
-        """``calls.check_path`` on the event loop (to go: the doors move through calls)."""
-        calls.check_path(self, q, path)
 
     # Settings a door sets (the text verbs' handlers set them too).
 
