@@ -33,6 +33,7 @@ from ..world.moves import Travel
 from ..world.state import RobotState
 from . import calls
 from .guarded import guarded_go
+from .modes import Modes
 from .notes import Said, recorded, taken, taken_all
 from .services import Services
 from .units import UnitEdge, UnitTable
@@ -45,7 +46,7 @@ BATCHED = tuple(f"{name} " for name in (VERBS["joints"].name, *VERBS["joints"].a
 streaming setpoints writes plain ``joints`` lines)."""
 
 
-class Session(UnitEdge):
+class Session(UnitEdge, Modes):
     """Applies one source's commands to the shared world.
 
     Attributes:
@@ -257,25 +258,6 @@ class Session(UnitEdge):
             NoGripper: the robot has none.
         """
         return recorded(self, said, functools.partial(calls.grip, self, opening))
-
-    # Settings a door sets (the text verbs' handlers set them too).
-
-    def set_motion(self, mode: str) -> None:
-        """Move ``off`` (at once), ``on`` (replies on arrival) or ``follow`` from now on."""
-        self.motion = mode
-
-    def set_speed(self, percent: float) -> None:
-        """Move at ``percent`` of the joints' limits from now on."""
-        self.speed = percent
-
-    def set_lspeed(self, m_s: float) -> None:
-        """Straight lines at ``m_s`` [m/s] from now on."""
-        self.lspeed = m_s
-
-    def set_guard(self, on: bool, plan_around: bool = False) -> None:
-        """Refuse (``plan_around``: plan around) what would collide, from now on."""
-        self.guard = on
-        self.plan_around = on and plan_around
 
     def go(self, q: Sequence[float], speed: float | None = None) -> Reply:
         """Send this session's robot to ``q`` [rad or m, checked] at ``speed`` % (None: the

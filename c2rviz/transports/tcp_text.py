@@ -91,7 +91,7 @@ class Connection(asyncio.Protocol):
         self.transport = transport
         peer = transport.get_extra_info("peername")
         self.peer = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
-        self.session.source = f"tcp {self.peer}"
+        self.session.set_source(f"tcp {self.peer}")
         server = self.server
         server.open.add(self)
         if server.stopping:
