@@ -1,9 +1,12 @@
 """One source's session: its robot, unit mode and marker style — the one way in.
 
 Every change of the world comes through a ``Session``: a TCP connection has
-one, so does the page, so does a replay. ``run(line)`` parses a line and
-executes it; ``execute(command)`` runs an already parsed one through its
-handler (``registry.HANDLERS``). This is the unit boundary: sources speak
+one, so do a CRCL connection, a rosbridge client, the page and a replay. Doors
+call ``run(line)`` (parse a text line and run it through its handler,
+``registry.HANDLERS``), ``set_joints_batch`` (a run of ``joints`` lines at once)
+or the typed calls (``calls``: ``set_joints``, ``plan_to``, ``play``,
+``stop``, ``dwell``, ``grip``...); each tells the world what it was asked, in
+one place (``notes``). This is the unit boundary: sources speak
 degrees or radians (metres for prismatic joints, always); everything past the
 session is SI. A handler checks a command whole before the world changes, so a
 bad command never moves the robot partly.
@@ -13,31 +16,37 @@ from __future__ import annotations
 
 import asyncio
 import functools
+import itertools
 import math
 from collections.abc import Sequence
 
 import numpy as np
-import pinocchio as pin
 
-from ..errors import C2rvizError, JointLimitError, MotionInterrupted, PathCollides
-from ..planning import EdgeResolution, MoveChecker, edge_resolution, first_blocked, path_points
+from ..errors import C2rvizError
+from ..ik.target import Target
+from ..motion.trajectory import PlannedTrajectory
+from ..planning import EdgeResolution, edge_resolution
 from ..protocol import replies
-from ..protocol.grammar import ForeignProtocol, numbers_batch, parse_line
-from ..protocol.registry import HANDLERS, Reply
-from ..robot.frames import pose_se3, se3_pose
-from ..tolerance import within_limit
+from ..protocol.grammar import numbers_batch, parse_line
+from ..protocol.registry import HANDLERS, VERBS, Reply
 from ..world.moves import Travel
 from ..world.state import RobotState
-from .guarded import guarded_go, request
+from . import calls
+from .guarded import guarded_go
+from .modes import Modes
+from .notes import Said, recorded, taken, taken_all
 from .services import Services
-from .units import UnitTable
+from .units import UnitEdge, UnitTable
 
-__all__ = ["Session", "UnitTable"]
+__all__ = ["BATCHED", "Session", "UnitTable"]
 
 _CADENCE_S = 0.02  # a pause this soon after the previous one's end continues its cadence
+BATCHED = tuple(f"{name} " for name in (VERBS["joints"].name, *VERBS["joints"].aliases))
+"""How the lines ``Session.set_joints_batch`` may answer as one begin (a controller
+streaming setpoints writes plain ``joints`` lines)."""
 
 
-class Session:
+class Session(UnitEdge, Modes):
     """Applies one source's commands to the shared world.
 
     Attributes:
@@ -53,6 +62,13 @@ class Session:
         last_plan: The waypoints of the last path ``plan`` found [rad or m], if any.
         hangup: Set by a handler to ``"bye"`` or ``"quit"``: the connection closes
             after this reply (and for ``quit`` stops the program).
+        listens: The last line run was ``watch``: the source only listens now (a virtual
+            clock need not wait for it until it speaks).
+
+    The doors' way in: ``run`` (a text line), ``set_joints_batch`` (a run of ``joints``
+    lines), and the typed calls of ``calls`` (``set_joints``, ``plan_to``, ``play``,
+    ``stop``, ``dwell``, ``grip``...), each telling the world of what it was asked
+    (``notes.Said``). The handlers use ``go`` and ``execute``.
     """
 
     def __init__(self, services: Services, source: str = "tcp", robot: str | None = None) -> None:
@@ -65,6 +81,7 @@ class Session:
         self.rgb: tuple[float, float, float] = (1.0, 0.0, 0.0)
         self.shape = "sphere"
         self.hangup: str | None = None
+        self.listens = False
         self._pause_end = -math.inf  # when the latest `after` was due [clock s]
         defaults = services.defaults
         self.motion = defaults.motion
@@ -116,122 +133,154 @@ class Session:
         self._steps = (step_rad, tool_step_m)
         self._resolution = None
 
-    def go(self, q: Sequence[float]) -> Reply:
-        """Send this session's robot to ``q`` [rad or m, checked]: at once (``motion off``),
-        or travelling (``on``: the reply comes on arrival; ``follow``: ``ok`` now).
-
-        With the guard, the move is checked (or planned around, ``guard plan``) off the
-        event loop and played on the checked path (``guarded.guarded_go``): the reply
-        is then always awaitable."""
-        if self.guard:
-            return guarded_go(self, [q], self.speed)
-        if self.motion == "off":
-            self.world.set_q(q, self.state.name, self.source)
-            return replies.OK
-        arrival = self.world.travels.go(
-            self.state, q, self.speed / 100.0, self.source, wait=self.motion == "on"
-        )
-        return replies.OK if arrival is None else arrival
-
-    def check_path(self, q: Sequence[float], path: Sequence[Sequence[float]] = ()) -> None:
-        """Refuse ``q`` if it collides, or if any point of the way there does (``path``,
-        else the straight joint-space segment from where the arm is now): with itself,
-        its objects, and the other robots of the world as they stand. Contacts where
-        the arm is now may be left, not pushed into (``planning.first_blocked``).
-
-        This checks on the event loop; moves sent through ``go`` are checked off it.
-
-        Raises:
-            PathCollides: naming the pair and how far along the move.
-        """
-        at_target = self.motion == "off" and not path
-        start = self.now()
-        asked = request(self, start, [q])
-        checker = MoveChecker().checker(asked)
-        allowed = checker.batch.colliding(start)
-        if at_target:
-            points = np.array([q], dtype=float)
-        else:
-            waypoints = np.array(path if path else [start, q], dtype=float)
-            points = path_points(checker, waypoints)
-        found = first_blocked(checker, points, allowed)
-        if found is not None:
-            index, (first, second) = found
-            fraction = index / max(len(points) - 1, 1)
-            raise PathCollides(first, second, fraction, at_target, target=q)
-
-    def joints_run(self, texts: Sequence[str]) -> bool:
-        """A run of ``joints`` lines (their value lists) checked as one: with ``motion off``
-        and no guard, if every line has n values within the limits, only the last is
-        applied (the ones before would be shown for no time at all) and True is returned;
-        else False, and nothing changed: the lines are then run one by one, so every
-        reply and error is exactly as if they had been."""
-        if self.motion != "off" or self.guard:
-            return False
-        flat = numbers_batch(texts, self.n)
-        table = self.table
-        if flat is None or not table.within(flat):
-            return False
-        self.world.set_q(table.to_si(flat[-self.n :]), self.state.name, self.source)
-        return True
-
-    def now(self) -> tuple[float, ...]:
-        """The robot's joints at this instant [rad or m] (mid-move too)."""
-        return self.world.travels.now(self.state) if self.travel.active else self.state.q
-
-    def set_degrees(self, degrees: bool) -> None:
-        self.degrees = degrees
-        self.table = self._tables[degrees]
-
-    @property
-    def angle_scale(self) -> float:
-        """SI angle = client angle * this (for poses)."""
-        return math.pi / 180.0 if self.degrees else 1.0
-
-    def execute(self, command: object) -> Reply:
-        """Run ``command``; return its reply (or an awaitable of it), or raise a
-        ``C2rvizError`` having changed nothing."""
-        return HANDLERS[command.__class__](self, command)
+    # The one way in: text lines.
 
     def run(self, line: str) -> Reply | None:
-        """Parse and run one line (None for a blank or comment line), noting it in the
-        world as accepted or refused, and its reply once known (``World.replied``: a reply
-        that waits is handed back as a future that notes it when it comes)."""
-        world = self.world
+        """Parse and run one line (None for a blank or comment line), telling the world of it
+        (``notes.Said``): taken or refused, and its reply once known (a reply that waits is
+        handed back as a future that tells it when it comes).
+
+        Raises:
+            C2rvizError: the line is refused (nothing changed); the world was told.
+        """
         try:
             command = parse_line(line)
             if command is None:
                 return None
+            self.listens = False
             reply = HANDLERS[command.__class__](self, command)
         except C2rvizError as exc:
-            world.note(self.source, line, False)
-            world.refused(self.state.name, self.source, line, exc)
-            if not isinstance(exc, ForeignProtocol):  # a door answers that one its own way
-                world.replied(self.source, line, replies.error(exc))
+            self.listens = False
+            Said(self, line).refuse(exc)
             raise
-        world.note(self.source, line, True)
-        if isinstance(reply, str):
-            world.replied(self.source, line, reply)
-            return reply
-        later = asyncio.ensure_future(reply)
-        later.add_done_callback(functools.partial(self._replied, self.state.name, line))
-        return later
+        return taken(self, line, reply)
 
-    def _replied(self, robot: str, line: str, later: asyncio.Future[str]) -> None:
-        """A reply that waited has come (one cancelled never reached anyone): the world
-        hears it, and a refusal (not a preemption) as a refusal."""
-        if later.cancelled():
-            return
-        error = later.exception()
-        if error is None:
-            text = later.result()
-        elif isinstance(error, C2rvizError):
-            text = replies.error(error)
-            if not isinstance(error, MotionInterrupted):
-                self.world.refused(robot, self.source, line, error)
-        else:
-            text = replies.error("internal error (see the server log)")
-        self.world.replied(self.source, line, text)
+    def set_joints_batch(self, lines: Sequence[object], start: int) -> int:
+        """Answer the run of plain ``joints`` lines of ``lines`` from ``start`` (each begins
+        with one of ``BATCHED``) as one: with ``motion off`` and no guard, if there are two
+        or more and every one has n values within the limits, only the last is applied (the
+        ones before would be shown for no time at all), each is told to the world and
+        answered ``ok``, and their count is returned; else 0, and nothing changed: run the
+        lines one by one (``run``), so every reply and error is exactly as if they had been.
+        """
+        if self.motion != "off" or self.guard:
+            return 0
+        texts: list[str] = []
+        for line in itertools.islice(lines, start, None):
+            if not isinstance(line, str) or not line.startswith(BATCHED):
+                break
+            texts.append(line)
+        if len(texts) < 2:
+            return 0
+        flat = numbers_batch([t[t.index(" ") + 1 :].removesuffix("\r") for t in texts], self.n)
+        table = self.table
+        if flat is None or not table.within(flat):
+            return 0
+        self.world.set_q(table.to_si(flat[-self.n :]), self.state.name, self.source)
+        self.listens = False
+        taken_all(self, texts, replies.OK)
+        return len(texts)
+
+    def execute(self, command: object) -> Reply:
+        """Run a parsed ``command`` as ``run`` would, without telling the world of it; return
+        its reply (or an awaitable of it), or raise a ``C2rvizError`` having changed nothing."""
+        return HANDLERS[command.__class__](self, command)
+
+    # The one way in: typed calls. ``said``: the command as its door shows it, told to the
+    # world as ``run`` tells a line (None: the door tells it once, with ``said()``).
+
+    def said(self, text: str) -> Said:
+        """A command of this session as its door shows it, to tell the world of once."""
+        return Said(self, text)
+
+    def set_joints(
+        self, q: Sequence[float], *, speed: float | None = None, said: str | Said | None = None
+    ) -> Reply:
+        """The chain to ``q`` [rad or m, within the limits] as ``go``, at ``speed`` % of the
+        joints' limits (None: the session's)."""
+        return recorded(self, said, functools.partial(self.go, q, speed))
+
+    async def plan_to(
+        self,
+        target: Target,
+        *,
+        straight: bool = False,
+        start: Sequence[float] | None = None,
+    ) -> calls.Plan:
+        """Solve (``straight``: plan and check the tool's straight line to) ``target`` (base
+        frame, SI), from ``start`` [rad or m] (None: the arm now), off the loop; nothing moves.
+
+        Raises:
+            C2rvizError: out of reach, or (guarded line) it collides; ``ArmMoved``.
+        """
+        return await calls.plan_to(self, target, straight=straight, start=start)
+
+    async def plan_through(
+        self, targets: Sequence[Target], *, straight: bool = False
+    ) -> list[calls.Plan]:
+        """``plan_to`` each of ``targets`` in turn from the end of the one before; with the
+        guard, each joint-space leg after the first is checked too (off the loop).
+
+        Raises:
+            WaypointError: naming the waypoint (1-based) that fails, and why.
+        """
+        return await calls.plan_through(self, targets, straight=straight)
+
+    def play(
+        self, plan: calls.Plan, *, speed: float | None = None, said: str | Said | None = None
+    ) -> Reply:
+        """Move as ``plan`` says, at ``speed`` % (None: the session's), as ``motion`` says.
+
+        Raises:
+            ArmMoved: a straight line's arm moved since it was planned.
+        """
+        return recorded(self, said, functools.partial(calls.play, self, plan, speed))
+
+    def play_trajectory(
+        self, trajectory: PlannedTrajectory, *, said: str | Said | None = None
+    ) -> Reply:
+        """Play a checked timed trajectory from now (the arm at rest at its start), checked
+        for collisions first with the guard (``calls.MAX_TRAJECTORY_CHECKS`` instants)."""
+        return recorded(self, said, functools.partial(calls.play_trajectory, self, trajectory))
+
+    def stop(self, *, fingers: bool = False, said: str | Said | None = None) -> Reply:
+        """Brake the arm to rest within its limits (``fingers``: stop the gripper too)."""
+        return recorded(self, said, functools.partial(calls.brake, self, fingers))
+
+    def dwell(self, seconds: float, *, said: str | Said | None = None) -> Reply:
+        """``ok`` in ``seconds`` [s] of the world's clock (``after``)."""
+        return recorded(self, said, lambda: self.after(seconds, replies.OK))
+
+    def grip(self, opening: float, *, said: str | Said | None = None) -> Reply:
+        """The gripper's fingers to ``opening`` (0 closed .. 1 open), as ``motion`` says.
+
+        Raises:
+            NoGripper: the robot has none.
+        """
+        return recorded(self, said, functools.partial(calls.grip, self, opening))
+
+    def go(self, q: Sequence[float], speed: float | None = None) -> Reply:
+        """Send this session's robot to ``q`` [rad or m, checked] at ``speed`` % (None: the
+        session's): at once (``motion off``), or travelling (``on``: the reply comes on
+        arrival; ``follow``: ``ok`` now). The handlers' move; doors call ``set_joints``.
+
+        With the guard, the move is checked (or planned around, ``guard plan``) off the
+        event loop and played on the checked path (``guarded.guarded_go``): the reply
+        is then always awaitable."""
+        percent = self.speed if speed is None else speed
+        if self.guard:
+            return guarded_go(self, [q], percent)
+        if self.motion == "off":
+            self.world.set_q(q, self.state.name, self.source)
+            return replies.OK
+        arrival = self.world.travels.go(
+            self.state, q, percent / 100.0, self.source, wait=self.motion == "on"
+        )
+        return replies.OK if arrival is None else arrival
+
+    def now(self) -> tuple[float, ...]:
+        """The robot's joints at this instant [rad or m] (mid-move too)."""
+        return self.world.travels.now(self.state) if self.travel.active else self.state.q
 
     def after(self, seconds: float, reply: str) -> asyncio.Future[str]:
         """A reply that comes ``seconds`` [s] from now (on the running loop).
@@ -249,45 +298,6 @@ class Session:
         timer = clock.call_at(self._pause_end, _settle, future, reply)
         future.add_done_callback(lambda _: timer.cancel())
         return future
-
-    # The unit boundary.
-
-    def pose_se3(self, pose: Sequence[float]) -> pin.SE3:
-        """A pose as this source writes it (x, y, z [m]; roll, pitch, yaw in its angle unit)
-        as a placement."""
-        x, y, z, roll, pitch, yaw = pose
-        angle = self.angle_scale
-        return pose_se3((x, y, z, roll * angle, pitch * angle, yaw * angle))
-
-    def pose_text(self, placement: pin.SE3) -> str:
-        """A placement as this source reads a pose: ``x,y,z,roll,pitch,yaw`` in its units."""
-        x, y, z, roll, pitch, yaw = se3_pose(placement)
-        angle = self.angle_scale
-        return replies.numbers([x, y, z, roll / angle, pitch / angle, yaw / angle])
-
-    def to_si(self, indices: Sequence[int], values: Sequence[float]) -> list[float]:
-        """Check ``values`` (client units) against the limits; return them in SI.
-
-        Raises:
-            JointLimitError: naming the first joint out of its limits.
-        """
-        table = self.table
-        robot = self.robot
-        out = []
-        for i, value in zip(indices, values):
-            lower = table.lower[i]
-            upper = table.upper[i]
-            if lower <= value <= upper:
-                out.append(value * table.scale[i])
-            elif within_limit(value, lower, upper):  # a rounding error past it: at the limit
-                out.append(robot.lower[i] if value < lower else robot.upper[i])
-            else:
-                raise JointLimitError(robot.joint_names[i], i, value, lower, upper, table.unit[i])
-        return out
-
-    def from_si(self, values: Sequence[float]) -> list[float]:
-        """Chain values in this source's units."""
-        return [v / s for v, s in zip(values, self.table.scale)]
 
 
 def _settle(future: asyncio.Future[str], reply: str) -> None:

@@ -14,9 +14,15 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from operator import le, mul
 
-from ..robot.model import Robot
+import pinocchio as pin
 
-__all__ = ["UnitTable"]
+from ..errors import JointLimitError
+from ..protocol import replies
+from ..robot.frames import pose_se3, se3_pose
+from ..robot.model import Robot
+from ..tolerance import within_limit
+
+__all__ = ["UnitEdge", "UnitTable"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -61,3 +67,59 @@ class UnitTable:
     def to_si(self, values: Sequence[float]) -> Sequence[float]:
         """``values`` (one configuration, client units) in SI, unchecked."""
         return values if self.identity else tuple(map(mul, values, self.scale))
+
+
+class UnitEdge:
+    """The unit boundary of a source (``session.Session`` is one): what it writes in its
+    units, in SI, and back."""
+
+    robot: Robot
+    degrees: bool
+    table: UnitTable
+    _tables: tuple[UnitTable, UnitTable]
+
+    def set_degrees(self, degrees: bool) -> None:
+        self.degrees = degrees
+        self.table = self._tables[degrees]
+
+    @property
+    def angle_scale(self) -> float:
+        """SI angle = client angle * this (for poses)."""
+        return math.pi / 180.0 if self.degrees else 1.0
+
+    def pose_se3(self, pose: Sequence[float]) -> pin.SE3:
+        """A pose as this source writes it (x, y, z [m]; roll, pitch, yaw in its angle unit)
+        as a placement."""
+        x, y, z, roll, pitch, yaw = pose
+        angle = self.angle_scale
+        return pose_se3((x, y, z, roll * angle, pitch * angle, yaw * angle))
+
+    def pose_text(self, placement: pin.SE3) -> str:
+        """A placement as this source reads a pose: ``x,y,z,roll,pitch,yaw`` in its units."""
+        x, y, z, roll, pitch, yaw = se3_pose(placement)
+        angle = self.angle_scale
+        return replies.numbers([x, y, z, roll / angle, pitch / angle, yaw / angle])
+
+    def to_si(self, indices: Sequence[int], values: Sequence[float]) -> list[float]:
+        """Check ``values`` (client units) against the limits; return them in SI.
+
+        Raises:
+            JointLimitError: naming the first joint out of its limits.
+        """
+        table = self.table
+        robot = self.robot
+        out = []
+        for i, value in zip(indices, values):
+            lower = table.lower[i]
+            upper = table.upper[i]
+            if lower <= value <= upper:
+                out.append(value * table.scale[i])
+            elif within_limit(value, lower, upper):  # a rounding error past it: at the limit
+                out.append(robot.lower[i] if value < lower else robot.upper[i])
+            else:
+                raise JointLimitError(robot.joint_names[i], i, value, lower, upper, table.unit[i])
+        return out
+
+    def from_si(self, values: Sequence[float]) -> list[float]:
+        """Chain values in this source's units."""
+        return [v / s for v, s in zip(values, self.table.scale)]

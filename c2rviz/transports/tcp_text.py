@@ -15,7 +15,6 @@ closed, and no other client notices.
 from __future__ import annotations
 
 import asyncio
-import itertools
 import logging
 import time
 from collections.abc import Awaitable, Sequence
@@ -27,9 +26,8 @@ from ..observers.watch import STREAM_ALLOWANCE_BYTES
 from ..protocol import replies
 from ..protocol.framing import Line, LineFramer
 from ..protocol.grammar import ForeignProtocol, parse_line
-from ..protocol.registry import VERBS
 from ..session.services import Services
-from ..session.session import Session
+from ..session.session import BATCHED, Session
 from ..session.settings import ServerLimits
 
 __all__ = ["Connection", "Host", "TURN_S"]
@@ -93,7 +91,7 @@ class Connection(asyncio.Protocol):
         self.transport = transport
         peer = transport.get_extra_info("peername")
         self.peer = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
-        self.session.source = f"tcp {self.peer}"
+        self.session.set_source(f"tcp {self.peer}")
         server = self.server
         server.open.add(self)
         if server.stopping:
@@ -180,10 +178,7 @@ class Connection(asyncio.Protocol):
             return
         with hold.acting():
             self._run_lines(lines)
-        said = next(
-            (line for line in reversed(lines) if isinstance(line, str) and line.strip()), ""
-        )
-        if said and said.split()[0].lower() == "watch" and not (self.waiting or self.closing):
+        if self.session.listens and not (self.waiting or self.closing):
             hold.release()
 
     def _run_lines(self, lines: Sequence[Line]) -> None:
@@ -191,8 +186,9 @@ class Connection(asyncio.Protocol):
         or after ``TURN_S`` of work (the rest runs after the other clients' turns)."""
         out: list[str] = []
         reply = out.append
-        run = self.session.run
         session = self.session
+        run = session.run
+        batch = session.set_joints_batch
         skip_to = 0
         started = time.perf_counter()
         for i, line in enumerate(lines):
@@ -205,9 +201,11 @@ class Connection(asyncio.Protocol):
             try:
                 if not isinstance(line, str):
                     raise line
-                if line.startswith(_PLAIN_JOINTS):
-                    skip_to = self._joints_run(lines, i, out)
-                    if skip_to > i:
+                if line.startswith(BATCHED):
+                    taken = batch(lines, i)
+                    if taken:
+                        skip_to = i + taken
+                        out.extend([replies.OK] * taken)
                         continue
                 answer = run(line)
                 if answer is None:
@@ -238,28 +236,6 @@ class Connection(asyncio.Protocol):
                 log.exception("internal error on %r from %s", line, self.peer)
                 reply(replies.error("internal error (see the server log)"))
         self._write(out)
-
-    def _joints_run(self, lines: Sequence[Line], start: int, out: list[str]) -> int:
-        """Answer the run of plain ``joints`` lines from ``start`` as a batch, if it checks
-        whole (``Session.joints_run``); return where the run ends (``start``: not taken)."""
-        run: list[str] = []
-        for line in itertools.islice(lines, start, None):
-            if not isinstance(line, str) or not line.startswith(_PLAIN_JOINTS):
-                break
-            run.append(line)
-        if len(run) < 2:
-            return start
-        texts = [line[line.index(" ") + 1 :].removesuffix("\r") for line in run]
-        if not self.session.joints_run(texts):
-            return start
-        note = self.session.world.note
-        replied = self.session.world.replied
-        source = self.session.source
-        for line in run:
-            note(source, line, True)
-            replied(source, line, replies.OK)
-        out.extend([replies.OK] * len(run))
-        return start + len(run)
 
     def _hang_up(self, rest: Sequence[Line]) -> None:
         """After ``bye`` or ``quit``: close (``quit`` also stops the program)."""
@@ -413,8 +389,6 @@ def _is_command(line: Line) -> bool:
         return True
 
 
-# How a controller streaming setpoints writes them: the registry's spellings of `joints`.
-_PLAIN_JOINTS = tuple(f"{name} " for name in (VERBS["joints"].name, *VERBS["joints"].aliases))
 TURN_S = 0.002  # work per client per loop turn [s]: then the others go first
 _TURN_CHECK = 32  # lines between looks at the clock
 _LINGER_S = 2.0  # after the last reply, how long a closing client's input is read and dropped

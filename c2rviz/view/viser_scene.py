@@ -163,7 +163,7 @@ class ViserScene(Scene):
         for name, state in world.robots.items():
             session = Session(self.services, source="page", robot=name)
             session.set_degrees(True)
-            session.motion = "off" if self.services.defaults.motion == "off" else "follow"
+            session.set_motion("off" if self.services.defaults.motion == "off" else "follow")
             self.sessions[name] = session
             self.panels[name] = RobotPanel(server.gui, state, session.speed)
             self.page_input.add_robot(self.panels[name], session)

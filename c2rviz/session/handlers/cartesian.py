@@ -104,13 +104,15 @@ async def plan_straight(
     return StraightPlan(first, waypoints, line, allowed)
 
 
-def play_straight(session: Session, plan: StraightPlan) -> Reply:
-    """Move along a planned line as ``motion`` says (at once, or travelling at ``lspeed``)."""
+def play_straight(session: Session, plan: StraightPlan, speed: float | None = None) -> Reply:
+    """Move along a planned line as ``motion`` says (at once, or travelling at ``lspeed``
+    within ``speed`` % of the joints' limits; None: the session's)."""
     state, world = session.state, session.world
     if session.motion == "off":
         world.set_q(plan.waypoints[-1], state.name, session.source)
         return replies.OK
-    fraction, limits = session.speed / 100.0, session.travel.motion.limits
+    fraction = (session.speed if speed is None else speed) / 100.0
+    limits = session.travel.motion.limits
     times = plan.line.timestamps(session.lspeed, [v * fraction for v in limits.velocity])
     ramp = ramp_limits(limits, fraction)
     brake = brake_limits(limits, fraction)

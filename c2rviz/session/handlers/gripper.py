@@ -22,8 +22,4 @@ def grip(session: Session, command: Grip) -> Reply:
         raise NoGripper(state.name)
     if command.opening is None:
         return replies.ok(replies.numbers([grips.now(state)]))
-    if session.motion == "off":
-        grips.set(state, command.opening, session.source)
-        return replies.OK
-    arrival = grips.go(state, command.opening, session.source, wait=session.motion == "on")
-    return replies.OK if arrival is None else arrival
+    return session.grip(command.opening)

@@ -32,8 +32,7 @@ def speed(session: Session, command: Speed) -> str:
 
 @handler(Stop)
 def stop(session: Session, command: Stop) -> Reply:
-    at_rest = session.world.travels.stop(session.state, session.source)
-    return replies.OK if at_rest is None else at_rest
+    return session.stop()
 
 
 @handler(Wait)

@@ -17,6 +17,7 @@ __all__: list[str] = []
 @handler(Watch)
 def watch(session: Session, command: Watch) -> str:
     session.services.watch.watch(session, command.hz)
+    session.listens = True  # only listens from now on, until its next line
     return replies.OK
 
 

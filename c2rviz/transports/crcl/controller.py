@@ -18,10 +18,13 @@ does; motions are ``motions``' jobs). The rules:
 - **Takeover**: the arm, the gripper and Dwell each run one command at a time. A new
   one of the same kind takes over the one Working: a move blends from the arm's
   motion (or, for a straight line, brakes to rest first) and ``StopMotion`` brakes;
-  the old command is then reported ``CRCL_Done`` "taken over by ..." (at once if it
-  had not started moving, else when the new motion starts: a refused new command
+  the old command is then reported ``CRCL_Done`` "taken over by ..." (if it had not
+  started moving: once its planning ends, so a move that cannot be planned is
+  ``CRCL_Error`` saying why; else when the new motion starts: a refused new command
   leaves the old one running and reported as usual). A move stopped or preempted by
   another door (its ``stop``, the page) is ``CRCL_Error`` naming who.
+- **The world** hears of every command through the session (``Session.said``): taken
+  or refused, and how it ended (``ok`` and its StateDescription, or the error).
 
 Values in and out are in the connection's units; the session sees SI, its angles in
 the connection's angle unit (so its limit errors speak it).
@@ -35,6 +38,7 @@ from collections.abc import Awaitable, Callable
 from typing import Any, Final
 
 from ...errors import C2rvizError, MotionInterrupted
+from ...protocol import replies
 from ...protocol.registry import Reply
 from ...session.session import Session
 from .commands import GetStatus, InitCanon
@@ -51,6 +55,7 @@ from .jobs import (
     Job,
     Refused,
     Report,
+    TakenOver,
 )
 from .reports import ConnectionSettings, StatusParts
 from .scalars import xml_safe_text
@@ -69,6 +74,7 @@ __all__ = [
     "Job",
     "Refused",
     "Report",
+    "TakenOver",
     "registrar",
 ]  # the lanes, states and records are ``jobs``'; here for the actions and motions
 
@@ -118,8 +124,8 @@ class Controller:
         actions: dict[type, Action],
     ) -> None:
         self.session = session
-        session.motion = "on"  # a command is Working until its motion arrives
-        session.guard = True  # a colliding target or path is refused, never driven into
+        session.set_motion("on")  # a command is Working until its motion arrives
+        session.set_guard(True)  # a colliding target or path is refused, never driven into
         self.settings = ConnectionSettings()
         self.parts = StatusParts(session, self.settings)
         self.canon = False
@@ -151,6 +157,7 @@ class Controller:
             program_file=instance.program_file,
             program_index=instance.program_index,
             program_length=instance.program_length,
+            said=self.session.said(f"{command.XSI_TYPE} (CommandID {command.command_id})"),
         )
         self.latest = report
         try:
@@ -162,21 +169,21 @@ class Controller:
             description = self._actions[command.__class__](self, report, command)
         except C2rvizError as error:
             self.settings.revision += 1  # an action may have set something before it refused
-            self.note(report.what, False)
-            self.finish(report, ERROR, str(error))
+            self.finish(report, ERROR, str(error), error=error)
             return
         self.settings.revision += 1
-        self.note(report.what, True)
+        if report.said is not None:
+            report.said.accept()
         if report.state == WORKING and not self._runs(report):
             self.finish(report, DONE, description)
 
     def refuse_document(self, error: CrclError) -> None:
         """A document (or bytes) refused before it was a command: report it as an error."""
         command_id = error.command_id if error.command_id is not None else 0
-        report = Report(command_id, error.command_type or "document")
+        said = self.session.said(f"refused: {error.description}")
+        report = Report(command_id, error.command_type or "document", said=said)
         self.latest = report
-        self.note(f"refused: {error.description}", False)
-        self.finish(report, ERROR, error.description, named=True)
+        self.finish(report, ERROR, error.description, named=True, error=error)
 
     # lanes and jobs
 
@@ -201,15 +208,23 @@ class Controller:
         if old is None or old.over:
             return
         old.successor = successor
-        if not old.moving:
-            if old.task is not None:
-                old.task.cancel()
-            before = "" if lane == DWELL else " before it moved"
-            self.finish(old.report, DONE, f"taken over by {successor.what}{before}")
+        if lane == DWELL and old.task is not None:  # a pause has nothing to finish
+            old.task.cancel()
+            self.finish(old.report, DONE, f"taken over by {successor.what}")
+        # A job that has not moved yet ends as its planning does: refused (CRCL_Error),
+        # or at ``moving`` (CRCL_Done, taken over before it moved).
 
     @staticmethod
-    async def moving(job: Job, reply: Reply) -> None:
-        """``job``'s motion has begun (``reply``: the session's, ``ok`` on arrival); wait for it."""
+    async def moving(job: Job, start: Callable[[], Reply]) -> None:
+        """Start ``job``'s motion (``start()``: the session's reply, ``ok`` on arrival) and
+        wait for it; none if the job was taken over meanwhile.
+
+        Raises:
+            TakenOver: taken over before its motion began (nothing moved).
+        """
+        if job.successor is not None and not job.moving:
+            raise TakenOver()
+        reply = start()
         job.moving = True
         job.under_way = None
         if not isinstance(reply, str):
@@ -219,14 +234,18 @@ class Controller:
         report = job.report
         try:
             await body(self, job)
+        except TakenOver:
+            assert job.successor is not None
+            self.finish(report, DONE, f"taken over by {job.successor.what} before it moved")
         except MotionInterrupted as interrupted:
             own = interrupted.why.endswith(f"by {self.session.source}")
             if job.successor is not None and own:
                 self.finish(report, DONE, f"stopped short: taken over by {job.successor.what}")
             else:
-                self.finish(report, ERROR, f"stopped short: {interrupted.why}")
+                why = f"stopped short: {interrupted.why}"
+                self.finish(report, ERROR, why, error=interrupted)
         except C2rvizError as error:
-            self.finish(report, ERROR, str(error))
+            self.finish(report, ERROR, str(error), error=error)
         except asyncio.CancelledError:
             raise
         except Exception:  # a bug costs this command, never the server
@@ -241,14 +260,27 @@ class Controller:
     # statuses out
 
     def finish(
-        self, report: Report, state: str, why: str | None = None, named: bool = False
+        self,
+        report: Report,
+        state: str,
+        why: str | None = None,
+        named: bool = False,
+        error: C2rvizError | None = None,
     ) -> None:
         """``report``'s command ends in ``state``: say so (once), with ``why`` after the
-        command's name (``named``: ``why`` names it already)."""
+        command's name (``named``: ``why`` names it already); the world hears of it, an
+        ``ERROR`` as a refusal (with ``error``: what refused it)."""
         if report.state != WORKING and report.state != READY:
             return
         report.state = state
         report.description = why if why is None or named else f"{report.what}: {why}"
+        said = report.said
+        if said is not None:
+            if state == ERROR:
+                said.refuse(error if error is not None else Refused(why or "refused"))
+            else:
+                said.accept()
+                said.reply(replies.OK if why is None else replies.ok(why))
         self._push(report)
 
     def _push(self, report: Report) -> None:
@@ -298,10 +330,6 @@ class Controller:
             if asked is None or asked.report_settings_status
             else None,
         )
-
-    def note(self, text: str, accepted: bool) -> None:
-        """Show ``text`` in the page's "last commands" (the world's log of commands)."""
-        self.session.world.note(self.session.source, text, accepted)
 
     def close(self) -> None:
         """The connection ended: nothing more is sent; commands not yet moving are dropped

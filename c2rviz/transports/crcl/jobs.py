@@ -11,6 +11,7 @@ import asyncio
 from dataclasses import dataclass
 
 from ...errors import C2rvizError
+from ...session.notes import Said
 
 __all__ = [
     "ARM",
@@ -23,6 +24,7 @@ __all__ = [
     "Job",
     "Refused",
     "Report",
+    "TakenOver",
 ]
 
 DONE, ERROR, WORKING, READY = "CRCL_Done", "CRCL_Error", "CRCL_Working", "CRCL_Ready"
@@ -32,6 +34,10 @@ ARM, GRIPPER, DWELL = "arm", "gripper", "dwell"
 
 class Refused(C2rvizError):
     """A command c2rviz will not carry out; the message says why."""
+
+
+class TakenOver(Exception):
+    """A job taken over before its motion began: it starts none (``Controller.moving``)."""
 
 
 @dataclass(eq=False)
@@ -46,6 +52,8 @@ class Report:
     program_file: str | None = None
     program_index: int | None = None
     program_length: int | None = None
+    said: Said | None = None
+    """How the world is told of it (``Session.said``), once it is a command."""
 
 
 @dataclass(eq=False)

@@ -78,7 +78,7 @@ def _trans_speed(ctl: Controller, report: Report, command: SetTransSpeed) -> Non
                 f"{speed.setting:g} {unit}/s is outside {low / ctl.settings.length:g}.."
                 f"{high / ctl.settings.length:g} {unit}/s (0.001..5 m/s)"
             )
-        ctl.session.lspeed = m_s
+        ctl.session.set_lspeed(m_s)
     else:
         _set_fraction(ctl, speed)
     ctl.settings.trans_speed = speed
@@ -96,7 +96,7 @@ def _rot_speed(ctl: Controller, report: Report, command: SetRotSpeed) -> str | N
 def _set_fraction(ctl: Controller, speed: TransSpeedRelative | RotSpeedRelative) -> None:
     if speed.fraction < MIN_FRACTION:
         raise Refused(f"a fraction of {speed.fraction:g} is below {MIN_FRACTION:g} (1 %)")
-    ctl.session.speed = speed.fraction * 100.0
+    ctl.session.set_speed(speed.fraction * 100.0)
 
 
 @_action(SetTransAccel, SetRotAccel)
@@ -160,4 +160,4 @@ def _status_report(ctl: Controller, report: Report, command: ConfigureStatusRepo
 
 @_action(Message)
 def _message(ctl: Controller, report: Report, command: Message) -> None:
-    ctl.note(f"{report.what}: {command.message[:200]}", True)
+    ctl.session.said(f"{report.what}: {command.message[:200]}").accept()

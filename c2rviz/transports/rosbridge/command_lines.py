@@ -121,7 +121,7 @@ class LineQueue:
         if reply is None:  # a blank or comment line: no reply, as on the text port
             answer("", True)
             return
-        hangup, self.session.hangup = self.session.hangup, None
+        hangup = self.session.take_hangup()
         answer(reply, not reply.startswith("error:"))
         if hangup == "bye":
             self.session = self.make_session()

@@ -2,40 +2,40 @@
 
 A ``sensor_msgs/msg/JointState`` on ``[NS]/joint_command`` is a move like
 ``move``: the named chain joints go to their positions [rad or m] (the others
-keep their target), through ``Session.go`` (the session's motion mode, speed and
-guard apply). A ``trajectory_msgs/msg/JointTrajectory`` on
+keep their target), through ``Session.set_joints`` (the session's motion mode,
+speed and guard apply). A ``trajectory_msgs/msg/JointTrajectory`` on
 ``[NS]/joint_trajectory`` is timed motion: it starts now from where the arm is
 (which must be at rest), passes each point at its ``time_from_start`` and is
-played on the world's clock (``motion.trajectory_play``); chain joints it does
+played on the world's clock (``Session.play_trajectory``); chain joints it does
 not name hold still. It is refused whole if any point or any instant between
 breaks a position, velocity or acceleration limit (the robot's motion limits at
 full speed, whatever the session's ``speed``), or, with ``guard on``, if any
 instant of it collides.
 
-Either is noted among the world's commands (the page's "last commands") as
-``/joint_command joint_s=0.5,...`` or ``/joint_trajectory N points, T s``,
-with whether it was accepted. Units are SI whatever the session's ``degrees``.
+The session tells the world of either (``Session.said``: the page's "last
+commands", its last error, recordings) as ``/joint_command joint_s=0.5,...`` or
+``/joint_trajectory N points, T s``, taken or refused. Units are SI whatever the
+session's ``degrees``.
 """
 
 from __future__ import annotations
 
-import asyncio
 from collections.abc import Sequence
 
 import numpy as np
 
 from ...errors import ArmMoved, C2rvizError, JointLimitError
-from ...motion.trajectory import plan_trajectory
-from ...motion.trajectory_play import TrajectoryPlay
+from ...motion.trajectory import PlannedTrajectory, plan_trajectory
 from ...protocol import replies
 from ...robot.model import Robot
+from ...session.calls import MAX_TRAJECTORY_CHECKS
 from ...session.session import Session
 from ...tolerance import within_limit
 from .messages import JointPositions, JointTrajectory
 
 __all__ = ["MAX_GUARD_SAMPLES", "UnknownJointName", "joint_command", "joint_trajectory"]
 
-MAX_GUARD_SAMPLES = 2000
+MAX_GUARD_SAMPLES = MAX_TRAJECTORY_CHECKS
 """Most instants of a trajectory checked for collisions (one per frame, or fewer)."""
 
 
@@ -65,10 +65,6 @@ def _units(robot: Robot) -> list[str]:
     return ["m" if prismatic else "rad" for prismatic in robot.prismatic]
 
 
-def _note(session: Session, text: str, accepted: bool) -> None:
-    session.world.note(session.source, text, accepted)
-
-
 def joint_command(session: Session, command: JointPositions) -> None:
     """Send the named joints to their positions now (or travelling, as the session moves).
 
@@ -77,9 +73,12 @@ def joint_command(session: Session, command: JointPositions) -> None:
         JointLimitError: A position outside its joint's limits.
         PathCollides: With ``guard on``, the target or the way there collides.
     """
-    text = "/joint_command " + ",".join(
-        f"{name}={replies.numbers([value])}"
-        for name, value in zip(command.names, command.positions)
+    said = session.said(
+        "/joint_command "
+        + ",".join(
+            f"{name}={replies.numbers([value])}"
+            for name, value in zip(command.names, command.positions)
+        )
     )
     try:
         robot = session.robot
@@ -90,18 +89,10 @@ def joint_command(session: Session, command: JointPositions) -> None:
             if not within_limit(value, lower, upper):
                 raise JointLimitError(robot.joint_names[i], i, value, lower, upper, units[i])
             q[i] = min(max(value, lower), upper)
-        reply = session.go(q)
-    except C2rvizError:
-        _note(session, text, False)
+    except C2rvizError as error:
+        said.refuse(error)
         raise
-    _note(session, text, True)
-    if isinstance(reply, asyncio.Future):  # motion on: nobody waits for the arrival
-        reply.add_done_callback(_forget)
-
-
-def _forget(future: asyncio.Future[str]) -> None:
-    if not future.cancelled():
-        future.exception()  # retrieved: a preempted move is no error here
+    session.set_joints(q, said=said)  # motion on: nobody waits for the arrival
 
 
 def joint_trajectory(session: Session, trajectory: JointTrajectory) -> None:
@@ -114,16 +105,18 @@ def joint_trajectory(session: Session, trajectory: JointTrajectory) -> None:
         PathCollides: With ``guard on``, an instant of it collides.
     """
     points = trajectory.points
-    text = f"/joint_trajectory {len(points)} points, {points[-1].time_from_start_s:g} s"
+    said = session.said(
+        f"/joint_trajectory {len(points)} points, {points[-1].time_from_start_s:g} s"
+    )
     try:
-        _play(session, trajectory)
-    except C2rvizError:
-        _note(session, text, False)
+        planned = _plan(session, trajectory)
+    except C2rvizError as error:
+        said.refuse(error)
         raise
-    _note(session, text, True)
+    session.play_trajectory(planned, said=said)
 
 
-def _play(session: Session, trajectory: JointTrajectory) -> None:
+def _plan(session: Session, trajectory: JointTrajectory) -> PlannedTrajectory:
     indices = _indices(session, "joint_names", trajectory.joint_names)
     if session.travel.active:
         raise ArmMoved(
@@ -142,7 +135,7 @@ def _play(session: Session, trajectory: JointTrajectory) -> None:
         return None if values is None else chain(values, zeros)
 
     points = trajectory.points
-    planned = plan_trajectory(
+    return plan_trajectory(
         start,
         [p.time_from_start_s for p in points],
         [chain(p.positions, start) for p in points],
@@ -152,12 +145,3 @@ def _play(session: Session, trajectory: JointTrajectory) -> None:
         robot.joint_names,
         _units(robot),
     )
-    if session.guard:
-        count = min(MAX_GUARD_SAMPLES, max(2, int(planned.duration / world.frame_s) + 1))
-        times = np.unique(
-            np.concatenate([np.linspace(0.0, planned.duration, count), planned.times])
-        )
-        path = [tuple(planned.sample(float(s)).tolist()) for s in times]
-        session.check_path(path[-1], path=path)
-    play = TrajectoryPlay(planned, world.clock.now())
-    world.travels.play(state, play, session.source, wait=False)

@@ -1,0 +1,190 @@
+"""The work of ``Session``'s typed calls: moves planned before they move, checks, grips.
+
+A ``Plan`` is a move solved (a straight line also planned and checked) with
+nothing moved yet; ``play`` moves it. ``plan_through`` plans several, each from
+the end of the one before, and with the guard checks every joint-space leg after
+the first off the event loop, on the session's worker, one leg per job (the first
+is checked as it starts); an error names the waypoint (1-based, as CRCL counts).
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..collision.model import segment
+from ..errors import ArmMoved, C2rvizError, NoGripper, PathCollides
+from ..ik.target import Target
+from ..motion.trajectory import PlannedTrajectory
+from ..motion.trajectory_play import TrajectoryPlay
+from ..planning import MoveChecker, MoveRequest, first_blocked, path_points
+from ..protocol import replies
+from ..protocol.registry import Reply
+from .guarded import checker_of, request
+from .handlers.cartesian import StraightPlan, plan_straight, play_straight, solve
+
+if TYPE_CHECKING:
+    from .session import Session
+
+__all__ = [
+    "MAX_TRAJECTORY_CHECKS",
+    "brake",
+    "grip",
+    "Plan",
+    "WaypointError",
+    "check_path",
+    "plan_through",
+    "plan_to",
+    "play",
+    "play_trajectory",
+]
+
+MAX_TRAJECTORY_CHECKS = 2000
+"""Most instants of a timed trajectory checked for collisions (one per frame, or fewer)."""
+
+
+@dataclass(frozen=True)
+class Plan:
+    """A move to a tool pose, solved (and, for a straight line, planned and checked);
+    nothing has moved yet (``Session.play`` moves)."""
+
+    goal: tuple[float, ...]
+    """The joints at its end [rad or m]."""
+    straight: StraightPlan | None = None
+    """The tool's straight line, or None: through joint space."""
+
+
+class WaypointError(C2rvizError):
+    """A waypoint of a move through several (1-based, as CRCL counts) that fails."""
+
+    def __init__(self, index: int, count: int, cause: C2rvizError) -> None:
+        self.index, self.count, self.cause = index, count, cause
+        super().__init__(f"waypoint {index} of {count}: {cause}")
+
+
+async def plan_to(
+    session: Session,
+    target: Target,
+    *,
+    straight: bool = False,
+    start: Sequence[float] | None = None,
+) -> Plan:
+    """``Session.plan_to``: see there."""
+    if straight:
+        line = await plan_straight(session, target, start)
+        return Plan(tuple(line.waypoints[-1]), line)
+    return Plan(tuple(await solve(session, target, start)))
+
+
+async def plan_through(
+    session: Session, targets: Sequence[Target], *, straight: bool = False
+) -> list[Plan]:
+    """``Session.plan_through``: see there."""
+    plans: list[Plan] = []
+    count = len(targets)
+    start: Sequence[float] | None = None
+    for index, target in enumerate(targets, start=1):
+        try:
+            plan = await plan_to(session, target, straight=straight, start=start)
+        except ArmMoved:
+            raise
+        except C2rvizError as error:
+            raise WaypointError(index, count, error) from error
+        plans.append(plan)
+        start = plan.goal
+    if not straight and session.guard:  # the first leg is checked as it starts
+        worker, robot = session.services.worker, session.robot
+        for index, (before, after) in enumerate(zip(plans, plans[1:]), start=2):
+            check = _path_check(session, after.goal, segment(robot, before.goal, after.goal))
+            try:
+                await worker.run(check)
+            except C2rvizError as error:
+                raise WaypointError(index, count, error) from error
+    return plans
+
+
+def play(session: Session, plan: Plan, speed: float | None) -> Reply:
+    """``Session.play``: see there."""
+    line = plan.straight
+    if line is None:
+        return session.go(plan.goal, speed)
+    if session.travel.active or session.state.q != line.start:
+        raise ArmMoved("the arm moved (another door drives it) between the waypoints")
+    return play_straight(session, line, speed)
+
+
+def play_trajectory(session: Session, planned: PlannedTrajectory) -> Reply:
+    """``Session.play_trajectory``: see there."""
+    world, state = session.world, session.state
+    if session.guard:
+        count = min(MAX_TRAJECTORY_CHECKS, max(2, int(planned.duration / world.frame_s) + 1))
+        times = np.unique(
+            np.concatenate([np.linspace(0.0, planned.duration, count), planned.times])
+        )
+        path = [tuple(planned.sample(float(s)).tolist()) for s in times]
+        check_path(session, path[-1], path=path)
+    world.travels.play(state, TrajectoryPlay(planned, world.clock.now()), session.source, False)
+    return replies.OK
+
+
+def check_path(session: Session, q: Sequence[float], path: Sequence[Sequence[float]] = ()) -> None:
+    """``Session.check_path``, here on the event loop: see there."""
+    _path_check(session, q, path, MoveChecker())()
+
+
+def _path_check(
+    session: Session,
+    q: Sequence[float],
+    path: Sequence[Sequence[float]],
+    checker: MoveChecker | None = None,
+) -> Callable[[], None]:
+    """The check of ``check_path``, with what it checks against taken now: run it here
+    (``checker`` given) or on the worker's thread (its own checker)."""
+    at_target = session.motion == "off" and not path
+    start = session.now()
+    asked = request(session, start, [q])
+    chosen = checker if checker is not None else checker_of(session.services.worker)
+    waypoints = np.array([q] if at_target else (path if path else [start, q]), dtype=float)
+    return functools.partial(_check, chosen, asked, start, waypoints, at_target, tuple(q))
+
+
+def _check(
+    checker: MoveChecker,
+    asked: MoveRequest,
+    start: tuple[float, ...],
+    waypoints: np.ndarray,
+    at_target: bool,
+    q: tuple[float, ...],
+) -> None:
+    valid = checker.checker(asked)
+    allowed = valid.batch.colliding(start)
+    points = waypoints if at_target else path_points(valid, waypoints)
+    found = first_blocked(valid, points, allowed)
+    if found is not None:
+        index, (first, second) = found
+        fraction = index / max(len(points) - 1, 1)
+        raise PathCollides(first, second, fraction, at_target, target=q)
+
+
+def grip(session: Session, opening: float) -> Reply:
+    """``Session.grip``: see there."""
+    state, grips = session.state, session.world.grips
+    if state.robot.gripper is None:
+        raise NoGripper(state.name)
+    if session.motion == "off":
+        grips.set(state, opening, session.source)
+        return replies.OK
+    arrival = grips.go(state, opening, session.source, wait=session.motion == "on")
+    return replies.OK if arrival is None else arrival
+
+
+def brake(session: Session, fingers: bool) -> Reply:
+    """``Session.stop``: see there."""
+    if fingers:
+        session.world.grips.stop(session.state, session.source)
+    rest = session.world.travels.stop(session.state, session.source)
+    return replies.OK if rest is None else rest
