@@ -166,7 +166,7 @@ class Session:
         applied (the ones before would be shown for no time at all) and True is returned;
         else False, and nothing changed: the lines are then run one by one, so every
         reply and error is exactly as if they had been."""
-        if self.motion != "off" or self.guard:
+        if self.motion != "off" or self.guard or self.world.faults.any(self.state.name):
             return False
         flat = numbers_batch(texts, self.n)
         table = self.table
@@ -203,6 +203,8 @@ class Session:
             if command is None:
                 return None
             reply = HANDLERS[command.__class__](self, command)
+            if world.faults.late:  # a latency fault: the reply comes late
+                reply = world.faults.delayed(self.state.name, reply)
         except C2rvizError as exc:
             world.note(self.source, line, False)
             world.refused(self.state.name, self.source, line, exc)

@@ -20,6 +20,8 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypeVar
 
+import numpy as np
+
 from .. import CommandServer  # the package's lazy name follows the text door's home
 from ..app.config import Settings, find_ini, load_settings
 from ..app.doors import Opened, close_doors, open_doors
@@ -227,6 +229,7 @@ class TestServer:
             world,
             limits=settings.limits,
             defaults=settings.session,
+            rng=np.random.default_rng(settings.session.plan_seed),  # as the program: --seed
             record_dir=settings.record_dir,
             trail_points=settings.trail_points,
             exporters=(self._page,),

@@ -1,0 +1,97 @@
+"""What the fault verbs do: start, schedule and clear faults, list them, reset a stop.
+
+The session turns a client's fault (its units, a joint by name or index) into the
+world's (``world.faults.Fault``, SI) and hands it to ``World.faults``; everything a
+fault does from then on happens at the world level, for every door alike.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from ...errors import BadArguments, shown
+from ...protocol import replies
+from ...protocol.registry import handler, usage
+from ...protocol.verbs.faults import Faults, FaultSpec, FaultVerb, Reset
+from ...world.faults import Fault
+
+if TYPE_CHECKING:
+    from ..session import Session
+
+__all__ = ["to_fault"]
+
+
+def to_fault(session: Session, spec: FaultSpec) -> Fault:
+    """``spec`` (the client's units) as the world's fault (SI) on ``session``'s robot.
+
+    Raises:
+        BadArguments: a joint the robot does not have (naming those it has).
+    """
+    if spec.kind == "stall":
+        return Fault("stall", joint=_joint(session, spec.word))
+    if spec.kind == "noise":
+        return Fault("noise", sigma=spec.values[0] * session.angle_scale)
+    if spec.kind == "latency":
+        delay_ms, jitter_ms = spec.values
+        return Fault("latency", delay_s=delay_ms / 1000.0, jitter_s=jitter_ms / 1000.0)
+    return Fault(spec.kind)
+
+
+def _joint(session: Session, word: str) -> int:
+    names = session.robot.joint_names
+    if word.isascii() and word.isdigit() and int(word) < len(names):
+        return int(word)
+    if word in names:
+        return names.index(word)
+    raise BadArguments(
+        "fault",
+        f"no joint {shown(word)}: {session.state.name} has {', '.join(names)} "
+        f"(or 0..{len(names) - 1})",
+        usage("fault"),
+    )
+
+
+def describe(session: Session, fault: Fault) -> str:
+    """``fault`` as this session reads it (noise in its angle unit)."""
+    if fault.kind == "noise":
+        return f"noise {replies.numbers([fault.sigma / session.angle_scale])}"
+    return fault.text(session.robot.joint_names)
+
+
+@handler(FaultVerb)
+def fault(session: Session, command: FaultVerb) -> str:
+    rules = session.world.faults
+    robot = session.state.name
+    if command.clear is not None:
+        rules.clear(robot, command.clear)
+        return replies.OK
+    assert command.spec is not None
+    made = to_fault(session, command.spec)
+    now = session.world.clock.now()
+    if command.at_s is not None:
+        if rules.origin + command.at_s < now:
+            raise BadArguments(
+                "fault",
+                f"T {command.at_s:g} s has passed (the world's time is {now - rules.origin:.3f} s)",
+                usage("fault"),
+            )
+        rules.schedule(robot, made, rules.origin + command.at_s)
+    elif command.after_s is not None:
+        rules.schedule(robot, made, now + command.after_s)
+    else:
+        rules.start(robot, made)
+    return replies.OK
+
+
+@handler(Faults)
+def faults(session: Session, command: Faults) -> str:
+    listed = session.world.faults.of(session.state.name).listing(session.world.faults.origin)
+    if not listed:
+        return replies.ok("none")
+    return replies.ok("; ".join(f"{describe(session, f)} {when}" for f, when in listed))
+
+
+@handler(Reset)
+def reset(session: Session, command: Reset) -> str:
+    session.world.faults.reset(session.state.name)
+    return replies.OK
