@@ -7,6 +7,7 @@ fault does from then on happens at the world level, for every door alike.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from ...errors import BadArguments, shown
@@ -14,41 +15,56 @@ from ...protocol import replies
 from ...protocol.registry import handler, usage
 from ...protocol.verbs.faults import Faults, FaultSpec, FaultVerb, Reset
 from ...world.faults import Fault
+from ...world.world import World
 
 if TYPE_CHECKING:
     from ..session import Session
 
-__all__ = ["to_fault"]
+__all__ = ["start_faults", "to_fault"]
 
 
-def to_fault(session: Session, spec: FaultSpec) -> Fault:
-    """``spec`` (the client's units) as the world's fault (SI) on ``session``'s robot.
+def to_fault(
+    robot: str, joint_names: tuple[str, ...], angle_scale: float, spec: FaultSpec
+) -> Fault:
+    """``spec`` (a client's units: SI angle = its angle * ``angle_scale``) as the world's
+    fault (SI) on ``robot`` (whose chain is ``joint_names``).
 
     Raises:
         BadArguments: a joint the robot does not have (naming those it has).
     """
     if spec.kind == "stall":
-        return Fault("stall", joint=_joint(session, spec.word))
+        return Fault("stall", joint=_joint(robot, joint_names, spec.word))
     if spec.kind == "noise":
-        return Fault("noise", sigma=spec.values[0] * session.angle_scale)
+        return Fault("noise", sigma=spec.values[0] * angle_scale)
     if spec.kind == "latency":
         delay_ms, jitter_ms = spec.values
         return Fault("latency", delay_s=delay_ms / 1000.0, jitter_s=jitter_ms / 1000.0)
     return Fault(spec.kind)
 
 
-def _joint(session: Session, word: str) -> int:
-    names = session.robot.joint_names
+def _joint(robot: str, names: tuple[str, ...], word: str) -> int:
     if word.isascii() and word.isdigit() and int(word) < len(names):
         return int(word)
     if word in names:
         return names.index(word)
     raise BadArguments(
         "fault",
-        f"no joint {shown(word)}: {session.state.name} has {', '.join(names)} "
-        f"(or 0..{len(names) - 1})",
+        f"no joint {shown(word)}: {robot} has {', '.join(names)} (or 0..{len(names) - 1})",
         usage("fault"),
     )
+
+
+def start_faults(world: World, robot: str, commands: Sequence[tuple[FaultVerb, Fault]]) -> None:
+    """Start or schedule the ini's faults of ``robot`` (``at T``: from the server's start;
+    a time already past starts it now)."""
+    rules = world.faults
+    for command, fault in commands:
+        if command.at_s is not None:
+            rules.schedule(robot, fault, rules.origin + command.at_s)
+        elif command.after_s is not None:
+            rules.schedule(robot, fault, world.clock.now() + command.after_s)
+        else:
+            rules.start(robot, fault)
 
 
 def describe(session: Session, fault: Fault) -> str:
@@ -66,7 +82,9 @@ def fault(session: Session, command: FaultVerb) -> str:
         rules.clear(robot, command.clear)
         return replies.OK
     assert command.spec is not None
-    made = to_fault(session, command.spec)
+    made = to_fault(
+        session.state.name, session.robot.joint_names, session.angle_scale, command.spec
+    )
     now = session.world.clock.now()
     if command.at_s is not None:
         if rules.origin + command.at_s < now:
