@@ -32,6 +32,7 @@ from .aio_lines import AsyncLineClient, AsyncWatchStream
 from .aio_scene_verbs import AsyncSceneVerbs
 from .calls import Call, count_problem, read_call, speaks
 from .errors import CommandError
+from .fault_verbs import AsyncFaultVerbs
 from .plan_verbs import AsyncPlanVerbs
 from .records import (
     JointLimit,
@@ -47,7 +48,7 @@ __all__ = ["AsyncClient"]
 T = TypeVar("T")
 
 
-class AsyncClient(AsyncLineClient, AsyncSceneVerbs, AsyncPlanVerbs):
+class AsyncClient(AsyncLineClient, AsyncSceneVerbs, AsyncPlanVerbs, AsyncFaultVerbs):
     """An asyncio connection with a coroutine per verb; arguments as ``Client``'s.
 
     It connects when entering ``async with`` or at the first call; after a lost

@@ -28,6 +28,7 @@ from . import calls, records
 from .calls import Call, count_problem, read_call, speaks
 from .connect import ServerUnavailable
 from .errors import CommandError, ConnectionLost
+from .fault_verbs import FaultVerbs
 from .lines import LineClient
 from .options import COMMANDS_DIR, add_connection_args, default_address, find_script, server_address
 from .plan_verbs import PlanVerbs
@@ -56,7 +57,7 @@ __all__ = [
 T = TypeVar("T")
 
 
-class Client(LineClient, SceneVerbs, PlanVerbs):
+class Client(LineClient, SceneVerbs, PlanVerbs, FaultVerbs):
     """A blocking connection with a method per verb; see the module docstring.
 
     Args (all but host and port by keyword):
