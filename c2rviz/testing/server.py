@@ -40,7 +40,17 @@ __all__ = ["RUNTIME_OPTIONS", "TestServer"]
 
 T = TypeVar("T")
 
-RUNTIME_OPTIONS = ("clock", "viewer", "doors", "record", "motion", "speed", "guard", "lspeed")
+RUNTIME_OPTIONS = (
+    "clock",
+    "viewer",
+    "doors",
+    "record",
+    "motion",
+    "speed",
+    "guard",
+    "lspeed",
+    "faults",
+)
 """Options that do not change which robots are loaded (the rest key the robot cache)."""
 _START_TIMEOUT_S = 120.0
 _loaded: dict[str, tuple[list[Member], str | None]] = {}
@@ -51,7 +61,7 @@ def _settings(options: Mapping[str, Any]) -> Settings:
     """The program's settings for ``options``: flag names as keys (``robot``, ``cell``,
     ``ini``, ``clock``, ``motion``, ``max_objects``...), every port free, no page unless
     ``viewer=True``."""
-    given = {k: v for k, v in options.items() if k not in ("ini", "doors", "record")}
+    given = {k: v for k, v in options.items() if k not in ("ini", "doors", "record", "faults")}
     ports = {name: 0 for name in Settings.__dataclass_fields__ if name.endswith("port")}
     overrides: dict[str, Any] = {**ports, "viewer": False, **given}
     overrides["robot_flag"] = "robot" in given
@@ -236,6 +246,8 @@ class TestServer:
         )
         for member in self.members:
             furnish(world, member)
+        for line in self.options.get("faults", ()):  # `fault` lines on the first robot, at start
+            Session(self.services, "test", self.members[0].name).run(f"fault {line}")
         servers = self._servers
         doors: Sequence[Opened] = []
         scene: Scene = NullScene()

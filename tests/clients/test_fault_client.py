@@ -10,6 +10,8 @@ import pytest
 from c2rviz import AsyncClient, CommandError
 from c2rviz.clients.errors import ArgumentError
 from c2rviz.clients.fault_verbs import clear_faults, fault, read_faults
+from c2rviz.errors import C2rvizError
+from c2rviz.testing.server import TestServer
 
 
 @pytest.mark.parametrize(
@@ -80,3 +82,16 @@ def test_the_async_client_drives_faults(c2rviz_server):
 
     listed = asyncio.run(main())
     assert len(listed) == 1 and listed[0].startswith("noise 0.01 since ")
+
+
+@pytest.mark.c2rviz(clock="virtual", motion="on", faults=["after 0.5 protective"])
+def test_the_marker_schedules_faults(c2rviz):
+    with pytest.raises(CommandError, match="protective stop since t=0.500"):
+        c2rviz.joints([1, 0.5, 0.3, -0.5, 0.2, 0.5, 0.1])
+    c2rviz.reset()
+    c2rviz.home()
+
+
+def test_a_bad_marker_fault_stops_the_start():
+    with pytest.raises(C2rvizError, match="unknown fault 'bogus'"):
+        TestServer({"faults": ["bogus"], "record": False}).start()
