@@ -22,7 +22,8 @@ import numpy as np
 from ..errors import C2rvizError
 from .clock import Clock, Timer
 from .faults import Fault, RobotFaults, Scheduled
-from .moves import MoveRules, Travels
+from .move_rules import MoveRules
+from .moves import Travels
 from .state import RobotState
 
 __all__ = ["FaultRules"]

@@ -15,31 +15,17 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
-from ..errors import C2rvizError, MotionInterrupted
+from ..errors import MotionInterrupted
 from ..motion.path_play import PathPlay
 from ..motion.planner import Motion, MotionLimits
 from ..protocol import replies
 from .clock import Clock, Timer
+from .move_rules import MoveRules
 from .state import RobotState
 
 __all__ = ["TICK_ROBOTS", "MoveRules", "Travel", "Travels"]
 
 TICK_ROBOTS = 8  # robots sampled in one turn of the loop (64 robots: ~0.6 ms a turn)
-
-
-class MoveRules:
-    """What faults make of moves (``fault_rules.FaultRules``); this base changes nothing."""
-
-    def refuse(self, state: RobotState) -> None:
-        """Raise if a move of ``state`` is refused now."""
-
-    def follow(self, state: RobotState, q: tuple[float, ...]) -> tuple[float, ...]:
-        """Where ``state``'s joints are when commanded to ``q``."""
-        return q
-
-    def arrival_error(self, state: RobotState) -> C2rvizError | None:
-        """The error a move that came to rest at its target ends with (None: ``ok``)."""
-        return None
 
 
 @dataclass(eq=False)
