@@ -418,11 +418,11 @@ def fault_banner(world: World, robot: str) -> str:
     faults = rules.of(robot)
     stop = faults.refusal(rules.origin)
     if isinstance(stop, EmergencyStop):
-        return f"🛑 **EMERGENCY STOP** — `{stop}`"
+        return f"**EMERGENCY STOP** — `{stop}`"  # (no emoji: a page may have no font for it)
     if stop is not None:
-        return f"⚠️ **PROTECTIVE STOP** — `{stop}`"
+        return f"**PROTECTIVE STOP** — `{stop}`"
     active = [fault.text(faults.joint_names) for fault, _ in faults.active.values()]
-    return "⚠️ **Faults:** " + ", ".join(f"`{text}`" for text in active) if active else ""
+    return "**Faults:** " + ", ".join(f"`{text}`" for text in active) if active else ""
 
 
 def _check_host(host: str) -> None:
