@@ -12,7 +12,6 @@ import logging
 from collections.abc import Callable
 
 from ..session.services import Services
-from ..world.effects import Observer
 from .tcp_text import Connection
 
 __all__ = ["CommandServer"]
@@ -20,9 +19,8 @@ __all__ = ["CommandServer"]
 log = logging.getLogger("c2rviz.server")
 
 
-class CommandServer(Observer):
-    """Listens for TCP clients and runs each one's lines against one ``World`` (whose
-    observer it is while it listens, for ``fault disconnect``)."""
+class CommandServer:
+    """Listens for TCP clients and runs each one's lines against one ``World``."""
 
     def __init__(
         self,
@@ -65,10 +63,10 @@ class CommandServer(Observer):
         loop = asyncio.get_running_loop()
         self._server = await loop.create_server(lambda: Connection(self), host, port)
         bound = self._server.sockets[0].getsockname()
-        self.world.add_observers([self])
+        self.world.faults.listeners.append(self._fault)
         return bound[0], bound[1]
 
-    def on_fault(self, robot: str, text: str) -> None:
+    def _fault(self, robot: str, text: str) -> None:
         if text == "fault disconnect":  # this robot's clients are cut off (they may come back)
             for connection in [c for c in self.connections if c.session.state.name == robot]:
                 connection.drop()
@@ -83,8 +81,8 @@ class CommandServer(Observer):
     async def stop(self, grace_s: float = 1.0) -> None:
         """Stop accepting, answer and close every client, free the port."""
         self.stopping = True
-        if self in self.world.observers:
-            self.world.remove_observer(self)
+        if self._fault in self.world.faults.listeners:
+            self.world.faults.listeners.remove(self._fault)
         if self._server is not None:
             self._server.close()
         for connection in list(self.connections):

@@ -6,7 +6,7 @@ alike: a move from any door reaches ``World.set_q`` or ``Travels.go``/``play``, 
 ``arrival_error``. What a door reports of the joints passes through ``sensed``, and a
 session's replies through ``delayed``. A fault that begins, ends or is lifted is told
 to every observer (``Observer.on_fault``: ``watch`` streams, rosbridge's
-``/diagnostics``, the page, the TCP door for ``disconnect``).
+``/diagnostics``, the page) and listener (the TCP door, for ``disconnect``).
 
 Scheduled faults are timers on the world's clock, so virtual time runs them exactly.
 """
@@ -61,6 +61,9 @@ class FaultRules(MoveRules):
         }
         self._numbers = itertools.count()
         self._timers: dict[str, Timer] = {}
+        self.listeners: list[Callable[[str, str], None]] = []
+        """Called as observers are (``listener(robot, text)``), by what is no observer: the
+        TCP door, which closes a robot's clients on ``fault disconnect``."""
 
     def bind(self, rng: np.random.Generator, origin: float) -> None:
         """Draw from ``rng`` and count times from ``origin`` [s] from now on."""
@@ -186,6 +189,8 @@ class FaultRules(MoveRules):
     def _tell(self, robot: str, events: list[str]) -> None:
         for text in events:
             self.tell(robot, text)
+            for listener in list(self.listeners):
+                listener(robot, text)
 
 
 def _settle(future: asyncio.Future[str], reply: str) -> None:

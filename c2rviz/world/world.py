@@ -142,7 +142,7 @@ class World:
             JointStalled: a stalled joint stayed where it was (the others moved).
         """
         state = self.robots[self.default if robot is None else robot]
-        faults = self.faults.of(state.name)
+        faults = self.faults.robots[state.name]
         if faults.latch is not None:
             self.faults.refuse(state)
         travel = self.travels.by_robot[state.name]
