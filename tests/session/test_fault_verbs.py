@@ -253,3 +253,35 @@ def test_the_same_seed_gives_the_same_replies():
     assert first == replies_of(11)
     assert first != replies_of(12)
     assert first[6].startswith("error: joint_e stalled at ")  # the stall began mid-move
+
+
+@pytest.mark.c2rviz(cell="twoarms", clock="virtual")
+def test_faults_belong_to_one_robot_of_a_cell(c2rviz_server, connect):
+    left = connect(c2rviz_server)  # the first robot's port
+    right = Client(c2rviz_server.host, c2rviz_server.ports["right"])
+    try:
+        assert left.ask("fault estop") == "ok"
+        assert left.ask("move 0 0.5").startswith("error: emergency stop since")
+        assert right.ask("move 0 0.5") == "ok"  # the other robot goes on
+        assert right.ask("faults") == "ok none"
+        assert right.ask("fault disconnect") == "ok"
+        assert right.closed_by_server()
+        assert left.ask("faults").startswith("ok estop since")  # still connected
+    finally:
+        right.close()
+
+
+@pytest.mark.c2rviz(clock="virtual", motion="follow", speed=20)
+def test_watch_states_carry_the_noise(c2rviz_server, connect):
+    watcher, client = connect(c2rviz_server), connect(c2rviz_server)
+    assert client.ask("fault noise 0.01") == "ok"
+    assert watcher.ask("watch 10").startswith("ok")
+    assert client.ask("move 0 1") == "ok"
+    assert client.ask("wait") == "ok"
+    states = []
+    while len(states) < 3:
+        line = watcher.read_line()
+        if line.startswith("state "):
+            states.append([float(v) for v in line.split()[2].split(",")])
+    assert all(any(v != 0.0 for v in q[1:]) for q in states)  # still joints, yet noisy
+    assert all(abs(v) < 0.06 for q in states for v in q[1:])
