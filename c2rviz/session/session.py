@@ -203,7 +203,7 @@ class Session:
             if command is None:
                 return None
             reply = HANDLERS[command.__class__](self, command)
-            if world.faults.late:  # a latency fault: the reply comes late
+            if world.faults.late and self.hangup is None:  # latency: the reply comes late
                 reply = world.faults.delayed(self.state.name, reply)
         except C2rvizError as exc:
             world.note(self.source, line, False)

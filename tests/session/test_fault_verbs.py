@@ -285,3 +285,11 @@ def test_watch_states_carry_the_noise(c2rviz_server, connect):
             states.append([float(v) for v in line.split()[2].split(",")])
     assert all(any(v != 0.0 for v in q[1:]) for q in states)  # still joints, yet noisy
     assert all(abs(v) < 0.06 for q in states for v in q[1:])
+
+
+@pytest.mark.c2rviz(clock="virtual")
+def test_bye_still_closes_under_latency(c2rviz_server, connect):
+    client = connect(c2rviz_server)
+    assert client.ask("fault latency 100") == "ok"
+    assert client.ask("bye") == "ok bye"  # at once: the connection closes after it
+    assert client.closed_by_server()
