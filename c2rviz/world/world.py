@@ -89,7 +89,7 @@ class World:
         """The grippers' moves (a robot's ``robot.gripper``; checked by the session)."""
         self.faults = FaultRules(self.robots, self.clock, self.travels, self._tell_fault)
         """Every robot's faults (``fault``), which every move from every door meets."""
-        self.travels.rules = self.faults
+        self.travels.rules = self.grips.rules = self.faults
 
     def state(self, name: str | None = None) -> RobotState:
         """The robot called ``name`` (the default robot for None)."""

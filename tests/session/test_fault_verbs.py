@@ -293,3 +293,14 @@ def test_bye_still_closes_under_latency(c2rviz_server, connect):
     assert client.ask("fault latency 100") == "ok"
     assert client.ask("bye") == "ok bye"  # at once: the connection closes after it
     assert client.closed_by_server()
+
+
+@pytest.mark.c2rviz(robot="fanuc_lrmate200id")
+def test_a_stop_refuses_the_gripper_too(c2rviz_server, connect):
+    client = connect(c2rviz_server)
+    assert client.ask("grip 1") == "ok"
+    assert client.ask("fault protective") == "ok"
+    assert client.ask("grip 0").startswith("error: protective stop since t=")
+    assert client.ask("grip") == "ok 1"
+    assert client.ask("reset") == "ok"
+    assert client.ask("grip 0") == "ok"
