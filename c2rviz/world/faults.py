@@ -27,6 +27,7 @@ from ..protocol import replies
 
 __all__ = [
     "MAX_SCHEDULED",
+    "replay_line",
     "STALL_TOLERANCE",
     "Fault",
     "RobotFaults",
@@ -258,3 +259,15 @@ class RobotFaults:
             out.append((Fault("estop"), f"released, reset needed since {latch.since - origin:.3f}"))
         out.extend((s.fault, f"at {s.due - origin:.3f}") for s in self.scheduled)
         return out
+
+
+def replay_line(text: str) -> str | None:
+    """The command that replays a fault event (``fault estop`` -> itself, ``cleared stall
+    joint_l`` -> ``fault clear stall``, ``reset``), for a recording's command file; None for
+    what would act on the replaying client itself (``latency``, ``disconnect``)."""
+    words = text.split()
+    if not words or (len(words) > 1 and words[1] in ("latency", "disconnect")):
+        return None
+    if words[0] == "cleared" and len(words) > 1:
+        return f"fault clear {words[1]}"
+    return text if words[0] in ("fault", "reset") else None
