@@ -55,3 +55,12 @@ _REPORTS = "<ResetAll>true</ResetAll>" + "".join(
     "</ConfigureJointReport>"
     for n in range(1, 8)
 )
+
+
+def test_disconnect_closes_the_robots_crcl_clients(crcl_server, crcl_connect, connect) -> None:
+    client: CrclClient = started(crcl_connect(crcl_server))
+    text: Client = connect(crcl_server)
+    assert text.ask("fault disconnect") == "ok"
+    assert client.closed_by_server()
+    again: CrclClient = started(crcl_connect(crcl_server))  # it may come back
+    assert again.ask(9).command_status.state == DONE
