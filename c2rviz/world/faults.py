@@ -61,6 +61,8 @@ class Fault:
         sigma: ``noise``: the standard deviation [rad, or m for a prismatic joint].
         delay_s: ``latency``: the base delay [s].
         jitter_s: ``latency``: the most added at random [s].
+        word: A kind's word argument as given (a part's, a camera's name: kinds to come).
+        values: A kind's numbers, SI (kinds to come).
     """
 
     kind: str
@@ -68,11 +70,16 @@ class Fault:
     sigma: float = 0.0
     delay_s: float = 0.0
     jitter_s: float = 0.0
+    word: str = ""
+    values: tuple[float, ...] = ()
 
     @property
     def key(self) -> str:
-        """What it is kept under: its kind (``stall``: one per joint)."""
-        return self.kind if self.joint is None else f"{self.kind} {self.joint}"
+        """What it is kept under: its kind (``stall``: one per joint; a kind with a word,
+        one per word)."""
+        if self.joint is not None:
+            return f"{self.kind} {self.joint}"
+        return f"{self.kind} {self.word}" if self.word else self.kind
 
     def text(self, joint_names: tuple[str, ...]) -> str:
         """As an event or a listing says it, in SI (``stall joint_l``, ``noise 0.01``,
@@ -84,7 +91,10 @@ class Fault:
         if self.kind == "latency":
             ms = replies.numbers([self.delay_s * 1000.0, self.jitter_s * 1000.0])
             return f"latency {ms}"
-        return self.kind
+        words = [self.kind, self.word] if self.word else [self.kind]
+        if self.values:
+            words.append(replies.numbers(self.values))
+        return " ".join(words)
 
 
 @dataclass(frozen=True, slots=True)

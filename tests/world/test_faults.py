@@ -136,3 +136,13 @@ def test_clear_all_ends_everything():
     book.add_scheduled(Scheduled(9.0, 1, Fault("estop")))
     assert len(book.clear("all")) == 3
     assert not book.any and not book.held and not book.scheduled
+
+
+def test_a_kind_to_come_is_kept_per_word_and_said_whole():
+    book = faults()
+    blackout = Fault("blackout", word="cam1", values=(2.0,))
+    assert blackout.key == "blackout cam1" and blackout.text(NAMES) == "blackout cam1 2"
+    book.start(blackout, 0.0, Q)
+    book.start(Fault("blackout", word="cam2"), 0.0, Q)
+    assert len(book.active) == 2
+    assert book.clear("blackout") == ["cleared blackout cam1 2", "cleared blackout cam2"]

@@ -39,7 +39,7 @@ def to_fault(
     if spec.kind == "latency":
         delay_ms, jitter_ms = spec.values
         return Fault("latency", delay_s=delay_ms / 1000.0, jitter_s=jitter_ms / 1000.0)
-    return Fault(spec.kind)
+    return Fault(spec.kind, word=spec.word, values=spec.values)  # a kind with no rule here
 
 
 def _joint(robot: str, names: tuple[str, ...], word: str) -> int:
