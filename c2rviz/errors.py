@@ -16,14 +16,18 @@ __all__ = [
     "BadArguments",
     "C2rvizError",
     "ConfigError",
+    "EmergencyStop",
+    "FaultStop",
     "JointCountError",
     "JointIndexError",
     "JointLimitError",
+    "JointStalled",
     "LineError",
     "LineTooLong",
     "MotionInterrupted",
     "NoGripper",
     "PathCollides",
+    "ProtectiveStop",
     "RobotError",
     "UnknownCommand",
     "UnknownMarker",
@@ -200,3 +204,39 @@ class NoGripper(C2rvizError):
             f"no gripper: {robot} has none (a gripper is finger joints in its URDF, or the "
             "ini's gripper = JOINT:CLOSED:OPEN ...)"
         )
+
+
+class FaultStop(C2rvizError):
+    """A move refused because a fault stopped the robot (``fault estop``, ``protective``)."""
+
+    def __init__(self, message: str, since_s: float) -> None:
+        self.since_s = since_s
+        super().__init__(message)
+
+
+class EmergencyStop(FaultStop):
+    """A move (or ``reset``) refused during an emergency stop; ``since_s`` is the world's
+    time of the stop [s since the server started]; ``released``: ``fault clear estop``
+    came, and only ``reset`` is missing."""
+
+    def __init__(self, since_s: float, released: bool) -> None:
+        self.released = released
+        hint = "reset to move again" if released else "fault clear estop, then reset"
+        super().__init__(f"emergency stop since t={since_s:.3f} ({hint})", since_s)
+
+
+class ProtectiveStop(FaultStop):
+    """A move refused during a protective stop (until ``reset``)."""
+
+    def __init__(self, since_s: float) -> None:
+        super().__init__(f"protective stop since t={since_s:.3f} (reset to move again)", since_s)
+
+
+class JointStalled(C2rvizError):
+    """A move that needed a stalled joint (``fault stall``) to move: it ended short."""
+
+    def __init__(self, joint: str, value: float, unit: str) -> None:
+        self.joint = joint
+        self.value = value
+        self.unit = unit
+        super().__init__(f"{joint} stalled at {value:.4g} {unit}")

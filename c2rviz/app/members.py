@@ -19,6 +19,7 @@ from ..robot.model import Robot
 from ..world.world import World
 from .cell import load_cell
 from .config import Settings
+from .ini_faults import IniFault, ini_faults, start_faults
 from .robot_options import IniObject, gripper_from, ini_objects, limits_from, tool_from
 
 __all__ = ["Member", "furnish", "members"]
@@ -36,6 +37,7 @@ class Member:
     limits: MotionLimits
     tool: pin.SE3 | None = None
     objects: tuple[IniObject, ...] = ()
+    faults: tuple[IniFault, ...] = ()
 
 
 def members(settings: Settings) -> tuple[list[Member], str | None]:
@@ -110,6 +112,7 @@ def furnish(world: World, member: Member) -> None:
             model.set_object(name, shape, size, placement, rgba, mesh)  # noqa: B023 (run now)
 
         world.edit_objects(member.name, add)
+    start_faults(world, member.name, member.faults)
 
 
 def _member(
@@ -132,4 +135,5 @@ def _member(
         limits_from(section, given, robot),
         tool_from(section, given),
         objects,
+        tuple(ini_faults(ini, name, robot, first)) if ini is not None else (),
     )

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, TypeVar
 
 from ..protocol.registry import VERBS
 from . import calls, records
+from . import fault_verbs as fault_calls
 from . import plan_verbs as plans
 from .calls import Call, speaks
 from .plan_verbs import PlanSummary
@@ -273,3 +274,29 @@ class Verbs:
         """Show this connection's targets and paths as a ghost on the page (``True``, the
         default); returns whether it does."""
         return self.call(plans.ghost(on))
+
+    # Faults on demand (docs/faults.md).
+
+    @speaks("fault")
+    def fault(
+        self, kind: str, *args: float | str, at: float | None = None, after: float | None = None
+    ) -> None:
+        """Make a fault happen on this robot: now, at the server's clock time ``at`` [s] or
+        ``after`` [s] from now. ``fault("estop")``, ``fault("stall", "joint_l")``,
+        ``fault("noise", 0.01)`` [rad, or deg], ``fault("latency", 50, 10)`` [ms]."""
+        return self.call(fault_calls.fault(kind, args, at, after))
+
+    @speaks("fault")
+    def clear_faults(self, kind: str = "all") -> None:
+        """End this robot's faults of ``kind`` (``all``: every one, scheduled ones too)."""
+        return self.call(fault_calls.clear_faults(kind))
+
+    @speaks("faults")
+    def faults(self) -> list[str]:
+        """This robot's faults: ``estop since 1.500``, ``noise 0.01 at 5.000`` [s]..."""
+        return self.call(fault_calls.FAULTS)
+
+    @speaks("reset")
+    def reset(self) -> None:
+        """Lift a stop (a protective one, or an emergency stop already cleared)."""
+        return self.call(fault_calls.RESET)

@@ -42,6 +42,7 @@ import numpy as np
 from ..protocol import replies
 from ..robot.frames import in_base, se3_pose, wxyz_se3
 from ..world.effects import Marker, Observer
+from ..world.faults import replay_line
 from ..world.world import World
 from .record_files import RecordFiles, cut_to_line, join_body
 from .recorded import FrameSink, Recorded
@@ -115,6 +116,7 @@ class Recorder(Observer):
         self._pending: Sequence[float] | None = None  # the latest state, not yet written
         self._written_us = 0  # time of the last line of the command file [us from t0]
         self._flushed = self.t0
+        self._faults: list[str] = []  # fault lines waiting for the arm to rest (`on_fault`)
         self._rgb = (1.0, 0.0, 0.0)  # a replaying session's marker style
         self._shape = "sphere"
         self._body: TextIO = self.files.open_text(".txt.part", BUFFER_BYTES)
@@ -143,12 +145,14 @@ class Recorder(Observer):
             return
         if t < self._due:  # the hot path: a flood of commands within one frame
             self._pending = q
-            return
-        self.flush_due(t)
-        if t >= self._due:
-            self._frame(q, t)
         else:
-            self._pending = q
+            self.flush_due(t)
+            if t >= self._due:
+                self._frame(q, t)
+            else:
+                self._pending = q
+        if self._faults and not self.world.moving(robot):  # a stop's braking has ended
+            self._write_faults()
 
     def on_marker(self, robot: str, marker: Marker) -> None:
         if robot == self.robot and not self.closed:
@@ -161,6 +165,25 @@ class Recorder(Observer):
             # `clear` also homes the arm: put it back at once where it is (the home move,
             # if this clear came with one, follows as frames).
             self._write(self._body, f"clear\njoints {_numbers(self.state.q)}\n")
+
+    def on_fault(self, robot: str, text: str) -> None:
+        """A fault's line goes after the frames it caused: at once, or (a protective stop
+        braking) once the arm rests, so a replay never refuses its own frames."""
+        line = replay_line(text)
+        if robot != self.robot or self.closed or line is None:
+            return
+        self._faults.append(line)
+        if not self.world.moving(robot):
+            self._write_faults()
+
+    def _write_faults(self) -> None:
+        now = self.world.clock.now()
+        if self._pending is not None:  # the arm as the fault found it comes first
+            pending, self._pending = self._pending, None
+            self._frame(pending, now)
+        self._sleep_to(now)
+        lines, self._faults = self._faults, []
+        self._write(self._body, "".join(f"{line}\n" for line in lines))
 
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         if accepted and source not in self.sources:

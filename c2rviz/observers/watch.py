@@ -10,6 +10,9 @@ A connection that sent ``watch [HZ]`` also receives, between its replies::
     event collision a~b,...  the colliding pairs changed (``none``: clear again), once
                              collisions are checked (an object, ``collisions``, ``guard on``)
     event record-stopped NAME: WHY
+    event fault KIND [ARGS]  a fault began (docs/faults.md; ARGS in SI, latency in ms)
+    event cleared KIND [ARGS]   it ended (``fault clear``)
+    event reset              ``reset`` lifted a stop
     event dropped N          N events were dropped for a reader too slow to take them
 
 A slow reader costs neither memory nor other clients: a stream keeps only the
@@ -211,6 +214,7 @@ class WatchStream:
             due = self._last_t + self.period_s
             if now >= due:
                 t = max(self._t, due)  # the state is the latest: the arm showed it at t
+                q = self.hub.world.faults.sensed(self.robot, q)  # encoder noise, if on
                 values = replies.numbers(self.session.from_si(q))
                 lines.append(f"state {t - self.hub.origin:.6f} {values}")
                 self._last_t = t
@@ -355,3 +359,6 @@ class WatchHub(Observer):
 
     def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
         self.event(f"collision {replies.pairs(pairs)}", robot)
+
+    def on_fault(self, robot: str, text: str) -> None:
+        self.event(text, robot)

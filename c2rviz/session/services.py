@@ -62,6 +62,7 @@ class Services:
 
     def __post_init__(self) -> None:
         self.watch = WatchHub(self.world)
+        self.world.faults.bind(self.rng.spawn(1)[0], self.watch.origin)  # rand's draws unchanged
         self.trails = TrailKeeper(self.world, self.trail_points)
         self.recordings = Recordings(self.world, self.record_dir, self.watch.event, self.exporters)
         self.worker = Worker()

@@ -149,6 +149,8 @@ class Session(UnitEdge, Modes):
                 return None
             self.listens = False
             reply = HANDLERS[command.__class__](self, command)
+            if self.world.faults.late and self.hangup is None:  # latency: the reply comes late
+                reply = self.world.faults.delayed(self.state.name, reply)
         except C2rvizError as exc:
             self.listens = False
             Said(self, line).refuse(exc)
@@ -163,7 +165,7 @@ class Session(UnitEdge, Modes):
         answered ``ok``, and their count is returned; else 0, and nothing changed: run the
         lines one by one (``run``), so every reply and error is exactly as if they had been.
         """
-        if self.motion != "off" or self.guard:
+        if self.motion != "off" or self.guard or self.world.faults.any(self.state.name):
             return 0
         texts: list[str] = []
         for line in itertools.islice(lines, start, None):

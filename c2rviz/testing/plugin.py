@@ -12,9 +12,10 @@ Options, from the nearest ``@pytest.mark.c2rviz(...)`` marks (class and module m
 the nearest winning) and then a fixture parameter (``indirect=True``, a dict): any flag of
 ``c2rviz`` by its name (``robot``, ``cell``, ``urdf``, ``clock``, ``motion``, ``speed``,
 ``guard``, ``hz``, ``max_objects``...), ``ini`` (a cmdinterpreter.ini), ``viewer=True``
-(the page, on a free port), ``doors=True`` (the other doors too, on free ports) and
-``record=False``. ``--c2rviz-clock`` (or the ini option ``c2rviz_clock``) sets every
-test's clock, e.g. ``virtual``.
+(the page, on a free port), ``doors=True`` (the other doors too, on free ports),
+``faults=["after 2 estop", ...]`` (``fault`` lines run on the first robot at the start,
+docs/faults.md) and ``record=False``. ``--c2rviz-clock`` (or the ini option
+``c2rviz_clock``) sets every test's clock, e.g. ``virtual``.
 
 Each test's run is recorded (``record NAME`` on its first robot, NAME from the test's
 id); when the test fails, NAME.txt, NAME.csv and NAME.html are kept in
@@ -64,7 +65,7 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers",
         "c2rviz(**options): the c2rviz_server this test gets (robot=, cell=, ini=, clock=, "
-        "viewer=, doors=, record=, and any c2rviz flag by its name)",
+        "viewer=, doors=, faults=, record=, and any c2rviz flag by its name)",
     )
     config.stash[_KEPT] = []
 

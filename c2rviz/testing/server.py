@@ -20,6 +20,8 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, TypeVar
 
+import numpy as np
+
 from .. import CommandServer  # the package's lazy name follows the text door's home
 from ..app.config import Settings, find_ini, load_settings
 from ..app.doors import Opened, close_doors, open_doors
@@ -38,7 +40,17 @@ __all__ = ["RUNTIME_OPTIONS", "TestServer"]
 
 T = TypeVar("T")
 
-RUNTIME_OPTIONS = ("clock", "viewer", "doors", "record", "motion", "speed", "guard", "lspeed")
+RUNTIME_OPTIONS = (
+    "clock",
+    "viewer",
+    "doors",
+    "record",
+    "motion",
+    "speed",
+    "guard",
+    "lspeed",
+    "faults",
+)
 """Options that do not change which robots are loaded (the rest key the robot cache)."""
 _START_TIMEOUT_S = 120.0
 _loaded: dict[str, tuple[list[Member], str | None]] = {}
@@ -49,7 +61,7 @@ def _settings(options: Mapping[str, Any]) -> Settings:
     """The program's settings for ``options``: flag names as keys (``robot``, ``cell``,
     ``ini``, ``clock``, ``motion``, ``max_objects``...), every port free, no page unless
     ``viewer=True``."""
-    given = {k: v for k, v in options.items() if k not in ("ini", "doors", "record")}
+    given = {k: v for k, v in options.items() if k not in ("ini", "doors", "record", "faults")}
     ports = {name: 0 for name in Settings.__dataclass_fields__ if name.endswith("port")}
     overrides: dict[str, Any] = {**ports, "viewer": False, **given}
     overrides["robot_flag"] = "robot" in given
@@ -227,12 +239,15 @@ class TestServer:
             world,
             limits=settings.limits,
             defaults=settings.session,
+            rng=np.random.default_rng(settings.session.plan_seed),  # as the program: --seed
             record_dir=settings.record_dir,
             trail_points=settings.trail_points,
             exporters=(self._page,),
         )
         for member in self.members:
             furnish(world, member)
+        for line in self.options.get("faults", ()):  # `fault` lines on the first robot, at start
+            Session(self.services, "test", self.members[0].name).run(f"fault {line}")
         servers = self._servers
         doors: Sequence[Opened] = []
         scene: Scene = NullScene()

@@ -63,7 +63,13 @@ class CommandServer:
         loop = asyncio.get_running_loop()
         self._server = await loop.create_server(lambda: Connection(self), host, port)
         bound = self._server.sockets[0].getsockname()
+        self.world.faults.listeners.append(self._fault)
         return bound[0], bound[1]
+
+    def _fault(self, robot: str, text: str) -> None:
+        if text == "fault disconnect":  # this robot's clients are cut off (they may come back)
+            for connection in [c for c in self.connections if c.session.state.name == robot]:
+                connection.drop()
 
     def request_quit(self) -> None:
         if not self.quit_requested:
@@ -75,6 +81,8 @@ class CommandServer:
     async def stop(self, grace_s: float = 1.0) -> None:
         """Stop accepting, answer and close every client, free the port."""
         self.stopping = True
+        if self._fault in self.world.faults.listeners:
+            self.world.faults.listeners.remove(self._fault)
         if self._server is not None:
             self._server.close()
         for connection in list(self.connections):

@@ -328,6 +328,14 @@ class Connection(asyncio.Protocol):
             self.closing = True
             self.transport.abort()
 
+    def drop(self) -> None:
+        """A fault cuts this client off (``fault disconnect``): close now, answering nothing
+        more."""
+        if not self.closing:
+            self._close()
+            if self.pending is not None:
+                self.pending.cancel()
+
     def _close_with(self, text: str) -> None:
         self._write([text])
         self._close()

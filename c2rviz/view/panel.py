@@ -66,6 +66,7 @@ class RobotPanel:
         marker: The readout of the marker clicked last (``chosen``).
         goto: The "Go to marker" button (runs ``moveto marker N``).
         chosen: The marker clicked last, until it is gone.
+        banner: The fault banner atop the folder (``fault``: a stop, or the faults on).
     """
 
     def __init__(self, gui: viser.GuiApi, state: RobotState, speed: float) -> None:
@@ -76,6 +77,7 @@ class RobotPanel:
         self.sliders: list[Any] = []
         self.folder: Any = gui.add_folder(state.name)
         with self.folder:
+            self.banner: Any = gui.add_markdown("", visible=False)  # a fault, when there is one
             for i, joint in enumerate(robot.joints):
                 if joint.prismatic:
                     low, high, step, unit = joint.lower, joint.upper, 0.001, "m"
@@ -200,6 +202,12 @@ class RobotPanel:
         else:
             x, y, z = (round(float(v), 3) + 0.0 for v in marker.position)
             self.marker.value = f"x {x:+.3f}  y {y:+.3f}  z {z:+.3f} m"
+
+    def show_faults(self, text: str) -> None:
+        """The fault banner says ``text`` (markdown); hidden when it is empty."""
+        if text:
+            self.banner.content = text
+        self.banner.visible = bool(text)
 
     def show_trail(self, on: bool) -> None:
         """The Trail checkbox to ``on`` (set by a ``trail`` line from anywhere)."""

@@ -32,11 +32,12 @@ import numpy as np
 import pinocchio as pin
 
 from ..collision.workcell import WorkcellObject
-from ..errors import C2rvizError
+from ..errors import C2rvizError, EmergencyStop
 from ..robot.visuals import LinkGeometry, load_link_geometry
 from ..session.services import Services
 from ..session.session import Session
 from ..world.effects import Marker, Scene
+from ..world.world import World
 from . import adapter
 from .handle import ToolHandles
 from .instruments import Instruments
@@ -260,6 +261,12 @@ class ViserScene(Scene):
         self._collisions[robot] = list(pairs)
         self.scheduler.request()
 
+    def on_fault(self, robot: str, text: str) -> None:
+        panel = self.panels.get(robot)
+        if panel is not None:
+            panel.show_faults(fault_banner(self.world, robot))
+            self.scheduler.request()
+
     def _pick(self, robot: str, shape: str, instance: int) -> None:
         """A marker clicked in a page (viser's thread): chosen in its robot's folder."""
         self.page_input.pick(robot, shape, instance)
@@ -403,6 +410,19 @@ class ViserScene(Scene):
         for view in self.views.values():
             view.show_collision(shown)
         self.server.flush()
+
+
+def fault_banner(world: World, robot: str) -> str:
+    """The page's banner for ``robot``'s faults (markdown; "" without any)."""
+    rules = world.faults
+    faults = rules.of(robot)
+    stop = faults.refusal(rules.origin)
+    if isinstance(stop, EmergencyStop):
+        return f"**EMERGENCY STOP** — `{stop}`"  # (no emoji: a page may have no font for it)
+    if stop is not None:
+        return f"**PROTECTIVE STOP** — `{stop}`"
+    active = [fault.text(faults.joint_names) for fault, _ in faults.active.values()]
+    return "**Faults:** " + ", ".join(f"`{text}`" for text in active) if active else ""
 
 
 def _check_host(host: str) -> None:

@@ -78,6 +78,11 @@ class Observer:
     def on_ghost(self, robot: str, shown: bool) -> None:
         """``robot``'s ghost (its target while it travels, its path) is now ``shown`` or not."""
 
+    def on_fault(self, robot: str, text: str) -> None:
+        """``robot``'s faults changed: ``text`` says how, as ``watch`` does after ``event``
+        (``fault estop``, ``fault stall joint_l``, ``cleared estop``, ``reset``, ``fault
+        disconnect``; values in SI, latency in ms)."""
+
 
 class Scene(Observer):
     """An observer that is a view: it starts with the world and stops with the program."""

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from ..errors import MotionInterrupted
 from ..protocol import replies
 from .clock import Clock, Timer
+from .move_rules import MoveRules
 from .state import RobotState
 
 __all__ = ["Grip", "Grips"]
@@ -64,6 +65,8 @@ class Grips:
         self.frame_s = frame_s
         self.by_robot: dict[str, Grip] = {}
         self._timer: Timer | None = None
+        self.rules = MoveRules()
+        """Faults' say in gripper moves (the world sets its ``FaultRules``: a stop refuses)."""
 
     def _grip(self, state: RobotState) -> Grip:
         grip = self.by_robot.get(state.name)
@@ -82,6 +85,7 @@ class Grips:
 
     def set(self, state: RobotState, opening: float, source: str) -> None:
         """Put the fingers at ``opening`` now (a move under way ends here)."""
+        self.rules.refuse(state)
         grip = self._grip(state)
         _interrupt(grip, f"preempted by {source}")
         grip.active = False
@@ -98,6 +102,7 @@ class Grips:
             another move or a stop takes over; else None.
         """
         assert state.robot.gripper is not None
+        self.rules.refuse(state)
         grip = self._grip(state)
         _interrupt(grip, f"preempted by {source}")
         t = self.clock.now()

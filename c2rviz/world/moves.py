@@ -20,9 +20,10 @@ from ..motion.path_play import PathPlay
 from ..motion.planner import Motion, MotionLimits
 from ..protocol import replies
 from .clock import Clock, Timer
+from .move_rules import MoveRules
 from .state import RobotState
 
-__all__ = ["TICK_ROBOTS", "Travel", "Travels"]
+__all__ = ["TICK_ROBOTS", "MoveRules", "Travel", "Travels"]
 
 TICK_ROBOTS = 8  # robots sampled in one turn of the loop (64 robots: ~0.6 ms a turn)
 
@@ -84,6 +85,8 @@ class Travels:
         self.frame_s = frame_s
         self.planned = planned
         self.by_robot: dict[str, Travel] = {}
+        self.rules = MoveRules()
+        """Faults' say in moves (the world sets its ``FaultRules``)."""
         self._timer: Timer | None = None
         self._round: list[Travel] = []  # the frame's robots still to sample
         self._due = math.inf  # the next frame [s], as far as this frame's robots say
@@ -112,6 +115,7 @@ class Travels:
             With ``wait``, a reply that comes on arrival (``ok``) or when the move is
             preempted or stopped (an error); else None (``motion follow``).
         """
+        self.rules.refuse(state)
         travel = self.by_robot[state.name]
         self._interrupt(travel, f"preempted by {source}")
         t = self.clock.now()
@@ -137,7 +141,7 @@ class Travels:
         arrival: asyncio.Future[str] = self.clock.future()  # settled, its client is busy
         travel.arrivals.append(arrival)
         if not travel.active:  # already there: nothing to wait for
-            _settle(travel.arrivals, replies.OK)
+            self._arrived(travel)
         return arrival
 
     def play(
@@ -148,6 +152,7 @@ class Travels:
         Returns:
             As ``go``: with ``wait`` a reply on arrival, else None.
         """
+        self.rules.refuse(state)
         travel = self.by_robot[state.name]
         self._interrupt(travel, f"preempted by {source}")
         travel.path = path
@@ -183,6 +188,30 @@ class Travels:
         self._planned(travel)
         return self.rest(state)
 
+    def halt(self, state: RobotState, why: str) -> None:
+        """Stop the arm where it is, in this instant (an emergency stop); the move's
+        waiters hear ``why``."""
+        travel = self.by_robot[state.name]
+        if not travel.active:
+            return
+        q = self.now(state)
+        self._interrupt(travel, why)
+        travel.active = False
+        travel.synced = False
+        travel.path = None
+        state.target = q
+        self.publish(state, q, self.clock.now())
+        self._planned(travel)
+        self.rested(state, True)
+        _settle(travel.rests, replies.OK)
+
+    def resync(self, state: RobotState) -> None:
+        """The arm's joints may stand apart from its planner's (a stall began or ended):
+        the next move starts from where they stand."""
+        travel = self.by_robot[state.name]
+        if not travel.active:
+            travel.synced = False
+
     def rest(self, state: RobotState) -> asyncio.Future[str] | None:
         """The reply that comes when the arm is at rest (None: it is now)."""
         travel = self.by_robot[state.name]
@@ -206,8 +235,8 @@ class Travels:
         if not travel.active:
             return state.q
         if travel.path is not None:
-            return travel.path.sample(self.clock.now())
-        return travel.motion.sample(self.clock.now())[0]
+            return self.rules.follow(state, travel.path.sample(self.clock.now()))
+        return self.rules.follow(state, travel.motion.sample(self.clock.now())[0])
 
     def stop_all(self) -> None:
         """The program stops: no more frames."""
@@ -257,12 +286,12 @@ class Travels:
                 end = travel.motion.arrival()
                 if not travel.motion.moving(t):
                     travel.active = False
-            self.publish(travel.state, q, t)
+            self.publish(travel.state, self.rules.follow(travel.state, q), t)
             if travel.active:
                 self._due = min(self._due, t + self.frame_s, end)
             else:
                 self.rested(travel.state, travel.stopping)
-                _settle(travel.arrivals, replies.OK)
+                self._arrived(travel)
                 _settle(travel.rests, replies.OK)
         if self._round:
             self._timer = self.clock.call_later(0.0, self._turn)
@@ -270,6 +299,18 @@ class Travels:
             # (one set going since the frame began waits for the next frame)
             due = self._due if self._due < math.inf else t + self.frame_s
             self._timer = self.clock.call_at(max(due, self.clock.now()), self._tick)
+
+    def _arrived(self, travel: Travel) -> None:
+        """The move came to rest at its target: ``ok``, unless a fault kept it short."""
+        error = self.rules.arrival_error(travel.state)
+        if error is None:
+            _settle(travel.arrivals, replies.OK)
+            return
+        travel.synced = False  # the planner stands at the target, the arm does not
+        waiting, travel.arrivals = travel.arrivals, []
+        for future in waiting:
+            if not future.done():
+                future.set_exception(error)
 
     @staticmethod
     def _interrupt(travel: Travel, why: str) -> None:

@@ -24,6 +24,7 @@ from ..robot.frames import se3_wxyz
 from ..robot.model import Robot
 from .clock import Clock
 from .effects import Observer
+from .fault_rules import FaultRules
 from .grips import Grips
 from .live_collisions import Contacts
 from .moves import Travel, Travels
@@ -86,6 +87,9 @@ class World:
             self.travels.add(state, (limits or {}).get(name) or motion_limits(state.robot))
         self.grips = Grips(self._show_opening, self.clock, self.frame_s)
         """The grippers' moves (a robot's ``robot.gripper``; checked by the session)."""
+        self.faults = FaultRules(self.robots, self.clock, self.travels, self._tell_fault)
+        """Every robot's faults (``fault``), which every move from every door meets."""
+        self.travels.rules = self.grips.rules = self.faults
 
     def state(self, name: str | None = None) -> RobotState:
         """The robot called ``name`` (the default robot for None)."""
@@ -132,13 +136,26 @@ class World:
         """Put a chain at ``q`` [rad or m] now, already checked against the limits.
 
         A move running on that robot is preempted (its waiter is told by ``source``).
+
+        Raises:
+            FaultStop: a stop holds the robot (nothing changes).
+            JointStalled: a stalled joint stayed where it was (the others moved).
         """
         state = self.robots[self.default if robot is None else robot]
+        faults = self.faults.robots[state.name]
+        if faults.latch is not None:
+            self.faults.refuse(state)
         travel = self.travels.by_robot[state.name]
         if travel.active:
             self.travels.preempt(travel, source)
         travel.synced = False
         state.target = q = tuple(q)
+        if faults.held:
+            self._show(state, faults.follow(q), self.clock.now())
+            stalled = faults.stalled(q)
+            if stalled is not None:
+                raise stalled
+            return
         self._show(state, q, self.clock.now())
 
     def _show(self, state: RobotState, q: tuple[float, ...], t: float) -> None:
@@ -203,6 +220,7 @@ class World:
 
     def clear(self, robot: str | None = None) -> None:
         """Remove every marker of the robot, and home it at once."""
+        self.faults.refuse(self.state(robot))  # a stopped robot keeps its markers too
         self.clear_markers(robot)
         self.set_q(self.state(robot).robot.home, robot)
 
@@ -230,6 +248,7 @@ class World:
         """The program stops: no more frames, checks or solves."""
         self.travels.stop_all()
         self.grips.stop_all()
+        self.faults.close()
         self.contacts.stop()
 
     # The workcell and collisions.
@@ -256,6 +275,10 @@ class World:
             for name, state in self.robots.items()
             if name != robot
         ]
+
+    def _tell_fault(self, robot: str, text: str) -> None:
+        for observer in list(self.observers):  # (the TCP door may close clients)
+            observer.on_fault(robot, text)
 
     def _tell_collisions(self, robot: str, pairs: list[Pair]) -> None:
         for observer in self.observers:

@@ -16,6 +16,7 @@ from c2rviz.protocol.grammar import ForeignProtocol, parse_line
 from c2rviz.protocol.verbs.cartesian import Ik, LinearSpeed, MoveL, MoveTo, Tool
 from c2rviz.protocol.verbs.cell import RobotChoice, RobotsList
 from c2rviz.protocol.verbs.connection import Bye, Quit, Sleep
+from c2rviz.protocol.verbs.faults import Faults, FaultSpec, FaultVerb, Reset
 from c2rviz.protocol.verbs.gripper import Grip
 from c2rviz.protocol.verbs.joints import Home, Joints, Move, Rand, Units
 from c2rviz.protocol.verbs.markers import Clear, Color, Mark, MarkerShape
@@ -140,6 +141,22 @@ GOOD = [
     ("grip 0", Grip(0.0), "grip-closed"),
     ("GRIP 1", Grip(1.0), "grip-open"),
     ("grip .25", Grip(0.25), "grip-quarter"),
+    # faults (docs/faults.md)
+    ("fault estop", FaultVerb(FaultSpec("estop")), "fault-estop"),
+    ("FAULT Protective", FaultVerb(FaultSpec("protective")), "fault-protective"),
+    ("fault stall joint_l", FaultVerb(FaultSpec("stall", "joint_l")), "fault-stall-name"),
+    ("fault stall 1", FaultVerb(FaultSpec("stall", "1")), "fault-stall-index"),
+    ("fault noise 0.01", FaultVerb(FaultSpec("noise", values=(0.01,))), "fault-noise"),
+    ("fault latency 50", FaultVerb(FaultSpec("latency", values=(50.0, 0.0))), "fault-latency"),
+    ("fault latency 50,10", FaultVerb(FaultSpec("latency", values=(50.0, 10.0))), "fault-jitter"),
+    ("fault disconnect", FaultVerb(FaultSpec("disconnect")), "fault-disconnect"),
+    ("fault at 2.5 estop", FaultVerb(FaultSpec("estop"), at_s=2.5), "fault-at"),
+    ("fault after 0 protective", FaultVerb(FaultSpec("protective"), after_s=0.0), "fault-after"),
+    ("fault clear", FaultVerb(clear="all"), "fault-clear"),
+    ("fault clear estop", FaultVerb(clear="estop"), "fault-clear-kind"),
+    ("fault clear ALL", FaultVerb(clear="all"), "fault-clear-all"),
+    ("faults", Faults(), "faults"),
+    ("reset", Reset(), "reset"),
 ]
 
 
@@ -277,6 +294,38 @@ BAD = [
     ("fly to HTTP/1.1x", UnknownCommand, "unknown command 'fly'", "http-not-at-the-end"),
     ("where:", UnknownCommand, "unknown command 'where:'", "typo-with-colon-is-not-http"),
     ("home: now", UnknownCommand, "unknown command 'home:'", "verb-colon-is-not-http"),
+    ("fault", BadArguments, "fault: needs a fault: estop, protective, stall", "fault-none"),
+    (
+        "fault bogus",
+        BadArguments,
+        "unknown fault 'bogus'; faults: estop, protective",
+        "fault-unknown",
+    ),
+    ("fault estop now", BadArguments, "estop takes no argument, got 'now'", "fault-estop-arg"),
+    ("fault stall", BadArguments, "stall needs one joint", "fault-stall-none"),
+    ("fault stall 1 2", BadArguments, "stall needs one joint", "fault-stall-two"),
+    ("fault noise 0", BadArguments, "noise SIGMA 0 is outside (0, 100]", "fault-noise-zero"),
+    ("fault noise -1", BadArguments, "noise SIGMA -1 is outside", "fault-noise-negative"),
+    ("fault noise nan", BadArguments, "bad number 'nan'", "fault-noise-nan"),
+    ("fault noise 1,2", BadArguments, "noise needs one SIGMA", "fault-noise-two"),
+    ("fault latency -5", BadArguments, "latency MS -5 is outside 0..60000 ms", "fault-latency-neg"),
+    ("fault latency 5,-1", BadArguments, "latency JITTER -1 is outside", "fault-jitter-neg"),
+    ("fault latency 1,2,3", BadArguments, "latency needs MS[,JITTER]", "fault-latency-three"),
+    (
+        "fault after -1 estop",
+        BadArguments,
+        "S '-1' is not a time within 0..1e+06 s",
+        "fault-after-neg",
+    ),
+    ("fault after 1e7 estop", BadArguments, "is not a time within", "fault-after-huge"),
+    ("fault at x estop", BadArguments, "bad number 'x'", "fault-at-word"),
+    ("fault at 1", BadArguments, "needs a fault", "fault-at-no-kind"),
+    ("fault after", BadArguments, "after needs a time", "fault-after-no-time"),
+    ("fault at 1 bogus", BadArguments, "unknown fault 'bogus'", "fault-at-unknown"),
+    ("fault clear x", BadArguments, "cannot clear 'x'", "fault-clear-unknown"),
+    ("fault clear a b", BadArguments, "clear takes at most one KIND", "fault-clear-two"),
+    ("faults now", BadArguments, "faults: takes no arguments", "faults-arg"),
+    ("reset all", BadArguments, "reset: takes no arguments", "reset-arg"),
 ]
 
 

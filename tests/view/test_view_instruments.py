@@ -311,3 +311,21 @@ def test_the_readout_shows_the_joints_the_motion_and_an_escaped_error(harness) -
     h.until(lambda: "last error | &lt;b" in readout.text, "the error, escaped")
     row = readout.text.splitlines()[-1]
     assert "<b>" not in row and r"\*x\*" in row and r"\|" in row
+
+
+def test_a_fault_shows_a_banner_atop_the_robots_folder(harness) -> None:
+    h = harness()
+    h.tab()
+    banner = h.scene.panels[h.world.default].banner
+    assert not banner.visible
+    session = Session(h.services, source="tcp 1")
+    assert run(h, session, "fault estop") == "ok"
+    h.until(lambda: banner.visible and "EMERGENCY STOP" in banner.content, "the estop banner")
+    assert "emergency stop since t=" in banner.content
+    for line in ("fault clear estop", "reset", "fault stall joint_l"):
+        assert run(h, session, line) == "ok"
+    h.until(lambda: "**Faults:** `stall joint_l`" in banner.content, "the faults on")
+    assert run(h, session, "fault protective") == "ok"
+    h.until(lambda: "PROTECTIVE STOP" in banner.content, "the protective stop")
+    assert run(h, session, "reset") == "ok" and run(h, session, "fault clear") == "ok"
+    h.until(lambda: not banner.visible, "no banner without faults")

@@ -9,12 +9,14 @@ from . import joints, markers, queries, connection  # the seed's verbs
 from . import cartesian, cell, motion, observe, record, workcell
 from . import planning
 from . import gripper
+from . import faults
 # isort: on
 
 __all__ = [
     "cartesian",
     "cell",
     "connection",
+    "faults",
     "gripper",
     "joints",
     "markers",

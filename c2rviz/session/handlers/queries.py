@@ -18,7 +18,8 @@ __all__: list[str] = []
 
 @handler(Where)
 def where(session: Session, command: Where) -> str:
-    return replies.ok(replies.numbers(session.from_si(session.now())))
+    q = session.world.faults.sensed(session.state.name, session.now())  # encoder noise, if on
+    return replies.ok(replies.numbers(session.from_si(q)))
 
 
 @handler(Pose)

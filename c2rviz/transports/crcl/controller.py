@@ -25,6 +25,8 @@ does; motions are ``motions``' jobs). The rules:
   another door (its ``stop``, the page) is ``CRCL_Error`` naming who.
 - **The world** hears of every command through the session (``Session.said``): taken
   or refused, and how it ended (``ok`` and its StateDescription, or the error).
+- **Faults**: while a stop holds the robot (``fault estop``, ``fault protective``,
+  docs/faults.md) every status is ``CRCL_Error`` with the stop as its description.
 
 Values in and out are in the connection's units; the session sees SI, its angles in
 the connection's angle unit (so its limit errors speak it).
@@ -297,7 +299,11 @@ class Controller:
     def status(self, report: Report, full: bool) -> CrclStatus:
         """A status about ``report``: full (every part the reports ask for) or compact."""
         self._status_id += 1
-        description = report.description
+        state, description = report.state, report.description
+        faults = self.session.world.faults
+        stop = faults.of(self.session.state.name).refusal(faults.origin)
+        if stop is not None:  # a stop (fault estop, protective) holds the arm: every status says so
+            state, description = ERROR, str(stop)
         if description is not None:
             description = xml_safe_text(description)[
                 : MAX_DESCRIPTION if full else PUSHED_DESCRIPTION
@@ -306,7 +312,7 @@ class Controller:
         command = CommandStatus(
             command_id=report.command_id,
             status_id=self._status_id,
-            state=report.state,
+            state=state,
             description=description,
             program_file=program_file[:PUSHED_DESCRIPTION] if program_file else program_file,
             program_index=report.program_index,

@@ -142,7 +142,7 @@ def joint_statuses(
     if reports is None and configured_only:
         return None
     factors = settings.joint_factors(session.robot.prismatic)
-    q = session.now()
+    q = session.world.faults.sensed(session.state.name, session.now())  # encoder noise, if on
     velocity = _velocity(session) if session.travel.active else None
     statuses = []
     for index, value in enumerate(q):
@@ -253,8 +253,8 @@ class StatusParts:
     def _at_rest(self) -> object:
         """What the arm's parts depend on while it rests (None: it moves)."""
         session = self.session
-        if session.travel.active:
-            return None
+        if session.travel.active or session.world.faults.any(session.state.name):
+            return None  # (a fault's noise is drawn for each status)
         return (session.state.q, id(session.state.tool), self.settings.revision)
 
     def pose(self) -> PoseStatus:

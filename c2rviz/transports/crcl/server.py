@@ -111,12 +111,23 @@ class CrclServer:
         self._server = await asyncio.start_server(self._accept, host, port)
         bound = self._server.sockets[0].getsockname()
         self.address = (str(bound[0]), int(bound[1]))
+        self.services.world.faults.listeners.append(self._fault)
         return self.address
+
+    def _fault(self, robot: str, text: str) -> None:
+        """``fault disconnect`` on this door's robot: its clients are cut off now."""
+        world = self.services.world
+        if text == "fault disconnect" and robot == (self.robot or world.default):
+            for connection in list(self._served):
+                connection.shutdown()
 
     async def stop(self) -> None:
         """Stop listening and close every connection (commands under way are dropped)."""
         if self._server is None:
             return
+        listeners = self.services.world.faults.listeners
+        if self._fault in listeners:
+            listeners.remove(self._fault)
         self._server.close()
         for connection in list(self._open):
             connection.shutdown()

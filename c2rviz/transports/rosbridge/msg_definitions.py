@@ -66,6 +66,15 @@ DEFINITIONS: dict[str, str] = {
         "bool mesh_use_embedded_materials\n"
     ),
     "visualization_msgs/MarkerArray": "visualization_msgs/Marker[] markers\n",
+    "diagnostic_msgs/KeyValue": "string key\nstring value\n",
+    "diagnostic_msgs/DiagnosticStatus": (
+        "byte OK=0\nbyte WARN=1\nbyte ERROR=2\nbyte STALE=3\n\n"
+        "byte level\nstring name\nstring message\nstring hardware_id\n"
+        "diagnostic_msgs/KeyValue[] values\n"
+    ),
+    "diagnostic_msgs/DiagnosticArray": (
+        "std_msgs/Header header\ndiagnostic_msgs/DiagnosticStatus[] status\n"
+    ),
 }
 """Each type's ``.msg`` text, by ``package/Name``."""
 

@@ -13,6 +13,7 @@ topic                              type                                 when
 ``[NS]/c2rviz/events``             ``std_msgs/msg/String``              each ``watch`` event
 ``[NS]/visualization_marker_array`` ``visualization_msgs/msg/MarkerArray`` markers, objects
 ``[NS]/c2rviz/reply``              ``std_msgs/msg/String``              each command's reply
+``/diagnostics``                   ``diagnostic_msgs/msg/DiagnosticArray`` faults change
 =================================  ===================================  ===============
 
 What it takes: ``[NS]/c2rviz/command`` (``std_msgs/msg/String``, one line of
@@ -35,6 +36,7 @@ from ...errors import C2rvizError
 from ...ros.messages import string
 from ...session.services import Services
 from .command_lines import CommandLines
+from .diagnostics import DIAGNOSTIC_ARRAY, DIAGNOSTICS_TOPIC
 from .joint_inputs import joint_command, joint_trajectory
 from .messages import COMMAND_SERVICE_TYPE, command_request, command_response, string_data
 from .messages import joint_positions as read_joint_positions
@@ -79,6 +81,7 @@ class RobotBridge:
         self.lines = CommandLines(services, on_quit or (lambda: None))
         self._taken: dict[str, tuple[str, str]] = {}
         self._types: list[tuple[str, str]] = [(TF_TOPIC, TF_MESSAGE), (TF_STATIC_TOPIC, TF_MESSAGE)]
+        self._types.append((DIAGNOSTICS_TOPIC, DIAGNOSTIC_ARRAY))
         for topics in self.robots.values():
             self._types += topics.published()
         for name, topics in self.robots.items():

@@ -17,6 +17,7 @@ that changed and only for topics someone reads:
   half of those left, then all sent again), and the workcell objects as a whole
   when they changed.
 
+``/diagnostics`` carries every robot's faults whenever they change (``diagnostics.py``);
 ``/tf_static`` and ``[NS]/robot_description`` are latched from the start;
 events (``watch``'s texts) go out on ``[NS]/c2rviz/events`` as they happen.
 New subscribers of joints, TF and markers get the state now at once; a marker
@@ -38,6 +39,7 @@ from ...ros.messages import Msg, string, tf_message, transforms
 from ...world.clock import Timer
 from ...world.effects import MAX_MARKERS, Marker, Observer
 from ...world.world import World
+from .diagnostics import DIAGNOSTICS_TOPIC, diagnostics
 from .robot_topics import RobotTopics
 from .topic_hub import TopicHub
 
@@ -104,6 +106,7 @@ class WorldFeed(Observer):
         hub.add_topic(TF_TOPIC, self._tf_now)
         hub.add_topic(TF_STATIC_TOPIC)
         hub.latch(TF_STATIC_TOPIC, tf_message(statics))
+        hub.add_topic(DIAGNOSTICS_TOPIC, self._diagnostics_now)
 
     def close(self) -> None:
         """Stop: no more flushes, no more listening."""
@@ -117,7 +120,12 @@ class WorldFeed(Observer):
     # What a new subscriber gets at once.
 
     def _joints_now(self, topics: RobotTopics) -> Msg:
-        return topics.joint_state(self.world.state(topics.name).q, self.world.clock.now())
+        q = self.world.faults.sensed(topics.name, self.world.state(topics.name).q)
+        return topics.joint_state(q, self.world.clock.now())
+
+    def _diagnostics_now(self) -> Msg:
+        faults = self.world.faults
+        return diagnostics(self.world.clock.now(), faults.robots, faults.origin)
 
     def _tf_now(self) -> Msg:
         return self._tf(self.world.clock.now())
@@ -158,6 +166,10 @@ class WorldFeed(Observer):
             feed.markers.clear()
             feed.cleared = feed.markers_changed = True
             self._schedule()
+
+    def on_fault(self, robot: str, text: str) -> None:
+        if self.hub.wanted(DIAGNOSTICS_TOPIC):  # every robot's status, as it is now
+            self.hub.publish(DIAGNOSTICS_TOPIC, self._diagnostics_now())
 
     def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
         feed = self.robots.get(robot)
@@ -203,6 +215,7 @@ class WorldFeed(Observer):
                 moved_at = t if moved_at is None else max(moved_at, t)
                 topics = feed.topics
                 if hub.wanted(topics.joint_states):
+                    q = self.world.faults.sensed(topics.name, q)  # encoder noise, if on
                     hub.publish(topics.joint_states, topics.joint_state(q, t))
             if feed.markers_changed or feed.objects_changed:
                 self._flush_markers(feed)

@@ -255,3 +255,39 @@ def test_a_marker_flood_leaves_a_subscriber_with_the_newest_thousand(
     until(markers, apply)
     assert sorted(shown) == list(range(500, 1500))
     assert shown[1499] == pytest.approx(1.499)
+
+
+def test_diagnostics_tell_the_faults(world_server: WorldServer, ros_world: roslibpy.Ros) -> None:
+    diagnostics = listen(ros_world, "/diagnostics", "diagnostic_msgs/msg/DiagnosticArray")
+    greeting = diagnostics.get(timeout=WAIT_S)["status"]
+    assert [(s["name"], s["level"], s["message"], s["values"]) for s in greeting] == [
+        ("c2rviz/motoman_sia20d", 0, "ok", [])
+    ]
+    service = command_service(ros_world)
+    assert ask(service, "fault estop")["ok"]
+    stopped = until(diagnostics, lambda m: m["status"][0]["level"] == 2)["status"][0]
+    assert stopped["message"].startswith("emergency stop since t=")
+    assert stopped["hardware_id"] == "motoman_sia20d"
+    assert [v["key"] for v in stopped["values"]] == ["estop"]
+    reply = ask(service, "joints " + ",".join(map(str, Q1)))  # refused on this door too
+    assert not reply["ok"] and reply["reply"].startswith("error: emergency stop since t=")
+    assert ask(service, "fault clear estop")["ok"] and ask(service, "reset")["ok"]
+    assert ask(service, "fault noise 0.01")["ok"]
+    noisy = until(diagnostics, lambda m: m["status"][0]["level"] == 1)["status"][0]
+    assert noisy["message"] == "faults: noise 0.01"
+    assert ask(service, "fault clear")["ok"]
+    assert (
+        until(diagnostics, lambda m: m["status"][0]["level"] == 0)["status"][0]["message"] == "ok"
+    )
+
+
+def test_joint_states_carry_the_noise(world_server: WorldServer, ros_world: roslibpy.Ros):
+    states = listen(ros_world, "/joint_states", "sensor_msgs/JointState")
+    assert states.get(timeout=WAIT_S)["position"] == [0.0] * 7
+    service = command_service(ros_world)
+    assert ask(service, "fault noise 0.01")["ok"]
+    assert ask(service, "joints " + ",".join(map(str, Q1)))["ok"]
+    msg = until(states, lambda m: m["position"] != [0.0] * 7)
+    assert msg["position"] != Q1
+    assert msg["position"] == pytest.approx(Q1, abs=0.06)
+    assert ask(service, "target")["reply"] == "ok " + ",".join(map(str, Q1))

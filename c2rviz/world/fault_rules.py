@@ -1,0 +1,206 @@
+"""Faults on the world: the model (``faults.RobotFaults``) run on the world's clock.
+
+``FaultRules`` belongs to the ``World`` (``world.faults``), so every door meets a fault
+alike: a move from any door reaches ``World.set_q`` or ``Travels.go``/``play``, which ask
+``refuse``; a moving arm's samples pass through ``follow`` and its arrival through
+``arrival_error``. What a door reports of the joints passes through ``sensed``, and a
+session's replies through ``delayed``. A fault that begins, ends or is lifted is told
+to every observer (``Observer.on_fault``: ``watch`` streams, rosbridge's
+``/diagnostics``, the page) and listener (the TCP door, for ``disconnect``).
+
+Scheduled faults are timers on the world's clock, so virtual time runs them exactly.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import itertools
+from collections.abc import Awaitable, Callable, Mapping
+
+import numpy as np
+
+from ..errors import C2rvizError
+from .clock import Clock, Timer
+from .faults import Fault, RobotFaults, Scheduled
+from .move_rules import MoveRules
+from .moves import Travels
+from .state import RobotState
+
+__all__ = ["FaultRules"]
+
+
+class FaultRules(MoveRules):
+    """Every robot's faults, applied to one world. Used from the asyncio thread only.
+
+    Attributes:
+        origin: Clock time [s] that fault times count from (the server's start: the
+            ``watch`` stream's origin, once the services bind it).
+        rng: The noise and jitter draws (the services give a child of ``--seed``'s).
+        late: Some robot has a latency fault (``Session.run`` looks before anything else).
+    """
+
+    def __init__(
+        self,
+        robots: Mapping[str, RobotState],
+        clock: Clock,
+        travels: Travels,
+        tell: Callable[[str, str], None],
+    ) -> None:
+        """Set up for the world's ``robots``, ``clock`` and ``travels``; ``tell(robot, text)``
+        hands a change to every observer (``Observer.on_fault``)."""
+        self.states = robots
+        self.clock = clock
+        self.travels = travels
+        self.tell = tell
+        self.origin = clock.now()
+        self.rng = np.random.default_rng()
+        self.late = False
+        self.robots = {
+            name: RobotFaults(state.robot.joint_names, state.robot.prismatic)
+            for name, state in robots.items()
+        }
+        self._numbers = itertools.count()
+        self._timers: dict[str, Timer] = {}
+        self.listeners: list[Callable[[str, str], None]] = []
+        """Called as observers are (``listener(robot, text)``), by what is no observer: the
+        TCP door, which closes a robot's clients on ``fault disconnect``."""
+
+    def bind(self, rng: np.random.Generator, origin: float) -> None:
+        """Draw from ``rng`` and count times from ``origin`` [s] from now on."""
+        self.rng = rng
+        self.origin = origin
+
+    def of(self, robot: str) -> RobotFaults:
+        return self.robots[robot]
+
+    def any(self, robot: str) -> bool:
+        """A fault changes what ``robot``'s commands do (fast paths must not skip it)."""
+        return self.robots[robot].any
+
+    # What moves ask (Travels and World.set_q).
+
+    def refuse(self, state: RobotState) -> None:
+        """Raise why a move of ``state`` is refused now (a stop), if it is."""
+        faults = self.robots[state.name]
+        if faults.latch is not None:
+            error = faults.refusal(self.origin)
+            if error is not None:
+                raise error
+
+    def follow(self, state: RobotState, q: tuple[float, ...]) -> tuple[float, ...]:
+        """Where ``state``'s joints are when commanded to ``q``."""
+        return self.robots[state.name].follow(q)
+
+    def arrival_error(self, state: RobotState) -> C2rvizError | None:
+        """The error a move of ``state`` that came to rest at its target ends with."""
+        faults = self.robots[state.name]
+        return faults.stalled(state.target) if faults.held else None
+
+    # What doors ask.
+
+    def sensed(self, robot: str, q: tuple[float, ...]) -> tuple[float, ...]:
+        """``robot``'s joints ``q`` as its encoders report them (noise, if on)."""
+        faults = self.robots[robot]
+        return faults.sensed(q, self.rng) if faults.active else q
+
+    def delayed(self, robot: str, reply: str | Awaitable[str]) -> str | Awaitable[str]:
+        """``reply`` to a client of ``robot``, late by its latency fault (if on)."""
+        delay = self.robots[robot].delay_s(self.rng)
+        if delay <= 0.0:
+            return reply
+        clock = self.clock
+        if isinstance(reply, str):
+            future: asyncio.Future[str] = clock.future()  # its client waits on the clock
+            clock.call_later(delay, _settle, future, reply)
+            return future
+        return _later(reply, delay, clock)
+
+    # What the verbs do.
+
+    def start(self, robot: str, fault: Fault) -> None:
+        """``fault`` begins on ``robot`` now."""
+        state = self.states[robot]
+        travels = self.travels
+        faults = self.robots[robot]
+        events = faults.start(fault, self.clock.now(), travels.now(state))
+        if fault.kind == "estop":
+            travels.halt(state, str(faults.refusal(self.origin)))
+        elif fault.kind == "protective":
+            travels.stop(state, "", str(faults.refusal(self.origin)))
+        elif fault.kind == "stall":
+            travels.resync(state)
+        elif fault.kind == "disconnect":  # after this reply is written
+            self.clock.call_later(0.0, self._tell, robot, events)
+            return
+        self.late = any("latency" in f.active for f in self.robots.values())
+        self._tell(robot, events)
+
+    def schedule(self, robot: str, fault: Fault, due: float) -> None:
+        """``fault`` begins on ``robot`` at clock time ``due`` [s].
+
+        Raises:
+            TooManyScheduled: too many wait already (nothing changes).
+        """
+        self.robots[robot].add_scheduled(Scheduled(due, next(self._numbers), fault))
+        self._arm(robot)
+
+    def clear(self, robot: str, what: str) -> None:
+        """End ``robot``'s faults of kind ``what`` (``all``: all, scheduled ones too)."""
+        faults = self.robots[robot]
+        stalled = bool(faults.held)
+        events = faults.clear(what)
+        if stalled and not faults.held:
+            self.travels.resync(self.states[robot])
+        self.late = any("latency" in f.active for f in self.robots.values())
+        self._arm(robot)
+        self._tell(robot, events)
+
+    def reset(self, robot: str) -> None:
+        """Lift ``robot``'s stop.
+
+        Raises:
+            EmergencyStop: the estop is still engaged.
+        """
+        self._tell(robot, self.robots[robot].reset(self.origin))
+
+    def close(self) -> None:
+        """The program stops: no scheduled fault fires."""
+        for timer in self._timers.values():
+            timer.cancel()
+        self._timers.clear()
+
+    # Inside.
+
+    def _arm(self, robot: str) -> None:
+        """A timer for ``robot``'s soonest scheduled fault (none: no timer)."""
+        timer = self._timers.pop(robot, None)
+        if timer is not None:
+            timer.cancel()
+        scheduled = self.robots[robot].scheduled
+        if scheduled:
+            self._timers[robot] = self.clock.call_at(scheduled[0].due, self._fire, robot)
+
+    def _fire(self, robot: str) -> None:
+        self._timers.pop(robot, None)
+        for entry in self.robots[robot].due_now(self.clock.now()):
+            self.start(robot, entry.fault)
+        self._arm(robot)
+
+    def _tell(self, robot: str, events: list[str]) -> None:
+        for text in events:
+            self.tell(robot, text)
+            for listener in list(self.listeners):
+                listener(robot, text)
+
+
+def _settle(future: asyncio.Future[str], reply: str) -> None:
+    if not future.done():
+        future.set_result(reply)
+
+
+async def _later(reply: Awaitable[str], delay: float, clock: Clock) -> str:
+    """``reply`` once it comes, ``delay`` [s] later on ``clock``."""
+    text = await reply
+    future: asyncio.Future[str] = clock.future()
+    clock.call_later(delay, _settle, future, text)
+    return await future
