@@ -33,6 +33,7 @@ import pinocchio as pin
 from c2rviz.collision import CheckGeometry, CollisionModel, Pair, PlacedShape
 from c2rviz.errors import PathCollides
 
+from .cancel import Cancel
 from .edge_resolution import EdgeResolution
 from .errors import GoalCollides, NoPathFound, NoWayAround, PlanningError
 from .ompl_planner import PlannedPath, plan_for
@@ -67,6 +68,7 @@ class MoveRequest:
         plan: ``never``, ``blocked`` (plan around a blocked straight path) or ``always``.
         timeout_s: Most time a plan may search [s].
         seed: The planner's seed (None: a fresh one).
+        cancel: Stops a plan's search when set (None: only its time limit does).
     """
 
     collision: CollisionModel
@@ -82,6 +84,7 @@ class MoveRequest:
     plan: str = "never"
     timeout_s: float = 1.0
     seed: int | None = None
+    cancel: Cancel | None = None
 
 
 @dataclass(frozen=True)
@@ -141,6 +144,7 @@ class MoveChecker:
             PathCollides: the goal or the path collides (naming the pair and where).
             NoWayAround: blocked, and no plan around it (``plan="blocked"``).
             PlanningError: ``plan="always"`` found no path (an end collides, none in time).
+            PlanCancelled: ``request.cancel`` was set before a plan was found.
         """
         checker = self.checker(request)
         start = np.asarray(request.start, dtype=float)
@@ -191,12 +195,19 @@ class MoveChecker:
         states, searched = 0, False
         collided: GoalCollides | None = None
         for goal in request.goals:
+            if request.cancel is not None:
+                request.cancel.check()
             left = request.timeout_s - (time.perf_counter() - began)
             if left <= 0:
                 break
             try:
                 path = plan_for(
-                    checker, request.start, goal, timeout_s=max(left, 1e-3), seed=request.seed
+                    checker,
+                    request.start,
+                    goal,
+                    timeout_s=max(left, 1e-3),
+                    seed=request.seed,
+                    cancel=request.cancel,
                 )
             except GoalCollides as exc:
                 collided = collided or exc

@@ -7,10 +7,12 @@ With ``guard on`` (or ``plan``) a joint-space move goes like this:
    a guarded arm never blends into a new move off its checked paths.
 2. A snapshot of what the move is checked against is taken on the loop
    (``planning.MoveRequest``: the robot's checks, the other robots where they
-   stand, the start: where the arm comes to rest) and checked on the worker's
-   thread (``planning.MoveChecker``): the goal alone for a move shown at once,
-   else the straight joint-space path (``guard plan``: planned around when it
-   is blocked; ``plan``: always planned, the direct edge first).
+   stand, the start: where the arm comes to rest) and checked off the loop
+   (``planning.MoveChecker``): the goal alone for a move shown at once, else the
+   straight joint-space path, on the worker's work lane; or, when it may plan
+   (``guard plan``: planned around when it is blocked; ``plan``: always planned,
+   the direct edge first), on its plan lane, where ``stop``, the client closing or
+   a newer move of the session cancel it (``planning.cancel``).
 3. Back on the loop the world may have changed meanwhile: the workcell must be the
    one checked (its revision), and every other robot that stood still stand where
    it stood; else the move is checked again, up to ``TRIES`` times, and then
@@ -25,6 +27,7 @@ from __future__ import annotations
 
 import asyncio
 import functools
+import threading
 from collections.abc import Sequence
 from typing import Protocol
 
@@ -40,6 +43,7 @@ from ..planning import (
     TimedPath,
     time_path,
 )
+from ..planning.cancel import Cancel
 from ..protocol import replies
 from ..world.moves import Travel
 from ..world.state import RobotState
@@ -53,6 +57,7 @@ __all__ = [
     "WorldChanged",
     "checked_move",
     "guarded_go",
+    "plan_checked",
     "guarded_rand",
     "play_checked",
     "GuardedSession",
@@ -80,6 +85,7 @@ class GuardedSession(Protocol):
     plan_around: bool
     plan_timeout_s: float
     plan_seed: int | None
+    last_plan: np.ndarray | None
 
     @property
     def resolution(self) -> EdgeResolution: ...
@@ -98,12 +104,23 @@ class WorldChanged(C2rvizError):
         )
 
 
+_PLAN_LANE = threading.local()  # a plan lane thread's own move checker
+
+
 def checker_of(worker: Worker) -> MoveChecker:
-    """The worker's move checker (kept in its cache, used on its thread)."""
+    """The worker's move checker (kept in its cache, used on its work lane's thread)."""
     checker = worker.cache.get("moves")
     if not isinstance(checker, MoveChecker):
         checker = worker.cache["moves"] = MoveChecker()
     return checker
+
+
+def plan_checked(asked: MoveRequest) -> CheckedMove:
+    """``MoveChecker.check`` on a plan lane thread, with that thread's own checker."""
+    checker = getattr(_PLAN_LANE, "moves", None)
+    if checker is None:
+        checker = _PLAN_LANE.moves = MoveChecker()
+    return checker.check(asked)
 
 
 def request(
@@ -114,6 +131,7 @@ def request(
     path: np.ndarray | None = None,
     target_only: bool = False,
     plan: str = "never",
+    cancel: Cancel | None = None,
 ) -> MoveRequest:
     """What a move of ``session``'s robot is checked against now, with its settings."""
     return world_request(
@@ -127,6 +145,7 @@ def request(
         plan=plan,
         timeout_s=session.plan_timeout_s,
         seed=session.plan_seed,
+        cancel=cancel,
     )
 
 
@@ -162,6 +181,7 @@ async def checked_move(
 
     Raises:
         PathCollides, PlanningError: refused (nothing moved).
+        PlanCancelled: its plan was cancelled (nothing moved).
         WorldChanged: the world changed under each of ``TRIES`` checks.
     """
     worker = session.services.worker
@@ -175,10 +195,19 @@ async def checked_move(
         start = tuple(session.state.target if session.travel.active else session.state.q)
         if at_once:
             start = session.now()
-        asked = request(session, start, goals, path=path_from, target_only=at_once, plan=plan)
-        checked = await worker.run(
-            functools.partial(checker.check, asked), key=("move", id(session))
-        )
+        key = ("move", id(session))
+        if plan == "never" or at_once:  # (a move shown at once checks its goal alone)
+            asked = request(session, start, goals, path=path_from, target_only=at_once, plan=plan)
+            job = worker.run(functools.partial(checker.check, asked), key=key, owner=session)
+        else:
+            cancel = Cancel()
+            asked = request(
+                session, start, goals, path=path_from, target_only=at_once, plan=plan, cancel=cancel
+            )
+            job = worker.plan(
+                functools.partial(plan_checked, asked), key=key, owner=session, cancel=cancel
+            )
+        checked = await job
         if not at_once:
             if session.travel.active and not session.travel.stopping:
                 raise ArmMoved(_TAKEN)  # not our brake: another command took the arm
@@ -218,6 +247,8 @@ async def guarded_go(
     once checked)."""
     plan = "blocked" if session.plan_around else "never"
     checked, at_once = await checked_move(session, goals, plan=plan)
+    if session.plan_around:
+        session.last_plan = checked.waypoints  # what `plan` shows: the path this move takes
     if at_once:
         session.world.set_q(checked.goal, session.state.name, session.source)
         return replies.OK
@@ -243,5 +274,5 @@ async def guarded_rand(session: GuardedSession) -> str:
             raise NoFreeConfiguration(name, DRAWS, batch.lasting(rng))
         return found
 
-    goals = await worker.run(draw, key=("move", id(session)))
+    goals = await worker.run(draw, key=("move", id(session)), owner=session)
     return await guarded_go(session, goals, speed)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from ...planning.cancel import STOPPED
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
 from ...protocol.verbs.motion import MotionMode, Speed, Status, Stop, Target, Wait
@@ -32,6 +33,7 @@ def speed(session: Session, command: Speed) -> str:
 
 @handler(Stop)
 def stop(session: Session, command: Stop) -> Reply:
+    session.services.worker.cancel(session, STOPPED)  # its plans searching, if any
     at_rest = session.world.travels.stop(session.state, session.source)
     return replies.OK if at_rest is None else at_rest
 
