@@ -36,6 +36,7 @@ plan ends with ``PlanCancelled``.
 from __future__ import annotations
 
 import logging
+import os
 import secrets
 import threading
 import time
@@ -72,6 +73,16 @@ _SWEEPS = 4  # most passes of corner sliding
 _RANGE_RAD = 1.0  # [rad] RRT-Connect's longest extension (OMPL's default: a fifth of the box)
 _LOCK = threading.Lock()  # OMPL's seed generator and log level are process-wide
 _quiet = [0, ou.LOG_INFO]  # plans running, OMPL's log level before the first (under _LOCK)
+
+
+def _after_fork() -> None:
+    """A forked child (a plan's process) starts with a lock of its own, not a copy."""
+    global _LOCK
+    _LOCK = threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_after_fork)
 
 EdgeCheck = Callable[[np.ndarray, np.ndarray], tuple[bool, int]]
 """``(q0, q1) -> (free, configurations checked)``; ``q0`` is taken as already checked."""

@@ -49,6 +49,7 @@ from ..world.moves import Travel
 from ..world.state import RobotState
 from ..world.world import World
 from .move_requests import world_request
+from .plan_process import in_child
 from .services import Services
 from .worker import Worker
 
@@ -116,11 +117,12 @@ def checker_of(worker: Worker) -> MoveChecker:
 
 
 def plan_checked(asked: MoveRequest) -> CheckedMove:
-    """``MoveChecker.check`` on a plan lane thread, with that thread's own checker."""
+    """``MoveChecker.check`` on the plan lane (in its own process, or on a plan lane
+    thread with that thread's own checker)."""
     checker = getattr(_PLAN_LANE, "moves", None)
     if checker is None:
         checker = _PLAN_LANE.moves = MoveChecker()
-    return checker.check(asked)
+    return checker.check(in_child(asked))
 
 
 def request(

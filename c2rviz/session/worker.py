@@ -13,6 +13,8 @@ every other client goes on). Two lanes (``lanes.Lane``) do the work:
   an IK solve or a guarded check behind it, and the plans of several clients
   search side by side, one per client at a time. A plan can be cancelled
   (``cancel(owner)``: ``stop``; its client closing; a newer plan with its key).
+  Each plan runs in a child process its thread forks (``plan_process``): OMPL's
+  bindings hold the interpreter's lock in their C++, which would stall the loop.
 
 In each lane a job belongs to an owner (``owner=session``: one connection); every
 owner has its own queue and the lane serves them in turn, so one client's long
@@ -28,13 +30,14 @@ waits for a worker thread until its call returns and the interpreter hands the
 lock over; the worker lowers that hand-over interval to ``SWITCH_S`` (the
 interpreter's default is 5 ms) and the checks run in small chunks
 (``collision.batch.CHUNK``), so a bystander waits about a millisecond at most.
-OMPL's search calls back into Python for every check, so plans on threads share
-the interpreter too: docs/limits.md has the measured figures.
+docs/limits.md has the measured figures.
 """
 
 from __future__ import annotations
 
 import asyncio
+import functools
+import os
 import sys
 from collections.abc import Callable, Hashable
 from typing import Any, TypeVar
@@ -43,6 +46,7 @@ from ..ik.solver import IkSolver
 from ..planning.cancel import Cancel
 from ..world.state import RobotState
 from .lanes import Job, Lane, Superseded, WorkerBusy
+from .plan_process import run_forked
 
 __all__ = [
     "MAX_PER_OWNER",
@@ -59,19 +63,28 @@ T = TypeVar("T")
 MAX_QUEUE = 256  # jobs waiting for a lane at most (4 per client at the default 64 clients)
 MAX_PER_OWNER = 16  # jobs of one owner (connection) waiting for a lane at most
 PLAN_THREADS = 10  # plans searching at once (one per client), see docs/limits.md
+PLAN_PROCESSES = hasattr(os, "fork")  # each plan in a child process (see plan_process.py)
 SWITCH_S = 0.0005  # [s] the interpreter's thread switch interval while a worker exists
 
 
 class Worker:
     """The work lane and the plan lane, and each robot's IK solver (see the module)."""
 
-    def __init__(self, max_queue: int = MAX_QUEUE, plan_threads: int = PLAN_THREADS) -> None:
+    def __init__(
+        self,
+        max_queue: int = MAX_QUEUE,
+        plan_threads: int = PLAN_THREADS,
+        plan_processes: bool = PLAN_PROCESSES,
+    ) -> None:
         """Start the lanes' threads; lower the interpreter's switch interval (see the module).
 
         Args:
             max_queue: Jobs waiting for each lane at most (the running ones not counted).
             plan_threads: Plans searching at once.
+            plan_processes: Run each plan in a child process forked by its plan lane
+                thread (``plan_process.run_forked``), else on that thread.
         """
+        self.plan_processes = plan_processes
         self.work = Lane("work", 1, max_queue, MAX_PER_OWNER)
         self.plans = Lane("plan", plan_threads, max_queue, MAX_PER_OWNER, one_per_owner=True)
         self._solvers: dict[str, IkSolver] = {}
@@ -133,8 +146,9 @@ class Worker:
         """Queue ``fn``, a plan, for the plan lane; await the returned future on the loop.
 
         Args:
-            fn: The plan (it runs on one of the plan lane's threads; it keeps no state
-                between runs, or keeps it per thread).
+            fn: The plan (it runs in a child process forked by one of the plan lane's
+                threads, or on that thread: it keeps no state between runs, or keeps it
+                per thread; its result and errors must pickle).
             key: A newer job with this key replaces this one, waiting or running.
             owner: Whose plan (a session): one plan of each owner searches at a time.
             cancel: What ``fn`` watches to stop early (``cancel(owner)``, a newer plan
@@ -143,6 +157,8 @@ class Worker:
         Raises:
             WorkerBusy: the lane's or the owner's queue is full (nothing is queued).
         """
+        if self.plan_processes:
+            fn = functools.partial(run_forked, fn, cancel)
         return self._submit(self.plans, fn, key, False, owner, cancel)
 
     def _submit(

@@ -103,7 +103,7 @@ def test_each_owner_and_the_lane_are_bounded() -> None:
 
 def test_a_plan_holds_no_work_behind_it() -> None:
     async def main() -> None:
-        worker = Worker()
+        worker = Worker(plan_processes=False)
         gate = threading.Event()
         plan = worker.plan(gate.wait, owner="a")
         assert await worker.run(lambda: "ik", owner="b") == "ik"
@@ -118,7 +118,7 @@ def test_a_plan_holds_no_work_behind_it() -> None:
 
 def test_plans_of_several_owners_run_side_by_side_one_per_owner() -> None:
     async def main() -> None:
-        worker = Worker(plan_threads=3)
+        worker = Worker(plan_threads=3, plan_processes=False)
         started = {name: threading.Event() for name in ("a1", "a2", "b1", "c1")}
         gate = threading.Event()
 
@@ -143,7 +143,7 @@ def test_plans_of_several_owners_run_side_by_side_one_per_owner() -> None:
 
 def test_cancel_stops_an_owners_running_and_waiting_plans() -> None:
     async def main() -> None:
-        worker = Worker()
+        worker = Worker(plan_processes=False)
         running, waiting, others = Cancel(), Cancel(), Cancel()
 
         def search(cancel: Cancel) -> str:
@@ -171,7 +171,7 @@ def test_cancel_stops_an_owners_running_and_waiting_plans() -> None:
 
 def test_a_plans_cancel_is_set_when_its_awaiting_reply_is_cancelled() -> None:
     async def main() -> None:
-        worker = Worker()
+        worker = Worker(plan_processes=False)
         cancel = Cancel()
         started = threading.Event()
 
