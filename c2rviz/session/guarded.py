@@ -9,10 +9,11 @@ With ``guard on`` (or ``plan``) a joint-space move goes like this:
    (``planning.MoveRequest``: the robot's checks, the other robots where they
    stand, the start: where the arm comes to rest) and checked off the loop
    (``planning.MoveChecker``): the goal alone for a move shown at once, else the
-   straight joint-space path, on the worker's work lane; or, when it may plan
-   (``guard plan``: planned around when it is blocked; ``plan``: always planned,
-   the direct edge first), on its plan lane, where ``stop``, the client closing or
-   a newer move of the session cancel it (``planning.cancel``).
+   straight joint-space path, on the worker's work lane; a plan (``guard plan``:
+   planned around when the straight path is blocked; ``plan``: always planned, the
+   direct edge first) searches on its plan lane, in a process of its own, where
+   ``stop``, the client closing or a newer move of the session cancel it
+   (``planning.cancel``).
 3. Back on the loop the world may have changed meanwhile: the workcell must be the
    one checked (its revision), and every other robot that stood still stand where
    it stood; else the move is checked again, up to ``TRIES`` times, and then
@@ -34,7 +35,7 @@ from typing import Protocol
 import numpy as np
 
 from ..collision.model import NoFreeConfiguration
-from ..errors import ArmMoved, C2rvizError
+from ..errors import ArmMoved, C2rvizError, PathCollides
 from ..planning import (
     CheckedMove,
     EdgeResolution,
@@ -186,8 +187,6 @@ async def checked_move(
         PlanCancelled: its plan was cancelled (nothing moved).
         WorldChanged: the world changed under each of ``TRIES`` checks.
     """
-    worker = session.services.worker
-    checker = checker_of(worker)
     at_once = session.motion == "off" and plan != "always" and path_from is None
     for _ in range(TRIES):
         if not at_once and session.travel.active:  # brake on the checked path first
@@ -197,19 +196,7 @@ async def checked_move(
         start = tuple(session.state.target if session.travel.active else session.state.q)
         if at_once:
             start = session.now()
-        key = ("move", id(session))
-        if plan == "never" or at_once:  # (a move shown at once checks its goal alone)
-            asked = request(session, start, goals, path=path_from, target_only=at_once, plan=plan)
-            job = worker.run(functools.partial(checker.check, asked), key=key, owner=session)
-        else:
-            cancel = Cancel()
-            asked = request(
-                session, start, goals, path=path_from, target_only=at_once, plan=plan, cancel=cancel
-            )
-            job = worker.plan(
-                functools.partial(plan_checked, asked), key=key, owner=session, cancel=cancel
-            )
-        checked = await job
+        asked, checked = await _check(session, start, goals, path_from, at_once, plan)
         if not at_once:
             if session.travel.active and not session.travel.stopping:
                 raise ArmMoved(_TAKEN)  # not our brake: another command took the arm
@@ -221,6 +208,36 @@ async def checked_move(
         if unchanged(session, asked, at_rest=not at_once):
             return checked, at_once
     raise WorldChanged(TRIES)
+
+
+async def _check(
+    session: GuardedSession,
+    start: tuple[float, ...],
+    goals: Sequence[Sequence[float]],
+    path_from: np.ndarray | None,
+    at_once: bool,
+    plan: str,
+) -> tuple[MoveRequest, CheckedMove]:
+    """One check of a move, off the loop; what it was checked against, and the answer.
+
+    The straight path (or the goal, or the path given) is checked on the worker's work
+    lane; a plan (``plan="always"``, or ``"blocked"`` when the straight path is blocked)
+    searches on its plan lane, where it can be cancelled.
+    """
+    worker, key = session.services.worker, ("move", id(session))
+    if plan != "always":
+        straight = "never" if plan == "blocked" else plan
+        asked = request(session, start, goals, path=path_from, target_only=at_once, plan=straight)
+        check = functools.partial(checker_of(worker).check, asked)
+        try:
+            return asked, await worker.run(check, key=key, owner=session)
+        except PathCollides:
+            if plan != "blocked" or at_once or path_from is not None:
+                raise
+    cancel = Cancel()
+    asked = request(session, start, goals, path=path_from, plan=plan, cancel=cancel)
+    job = functools.partial(plan_checked, asked)
+    return asked, await worker.plan(job, key=key, owner=session, cancel=cancel)
 
 
 def play_checked(
