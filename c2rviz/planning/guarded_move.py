@@ -69,6 +69,8 @@ class MoveRequest:
         timeout_s: Most time a plan may search [s].
         seed: The planner's seed (None: a fresh one).
         cancel: Stops a plan's search when set (None: only its time limit does).
+        spent: A search of this move before this one: its seconds and states, counted
+            in the time limit and in the states a refusal reports.
     """
 
     collision: CollisionModel
@@ -85,6 +87,7 @@ class MoveRequest:
     timeout_s: float = 1.0
     seed: int | None = None
     cancel: Cancel | None = None
+    spent: tuple[float, int] = (0.0, 0)
 
 
 @dataclass(frozen=True)
@@ -191,8 +194,8 @@ class MoveChecker:
         self, checker: ValidityChecker, request: MoveRequest, allowed: frozenset[Pair]
     ) -> CheckedMove:
         """A plan to the first of ``request.goals`` that plans within the time limit."""
-        began = time.perf_counter()
-        states, searched = 0, False
+        began = time.perf_counter() - request.spent[0]
+        states, searched = request.spent[1], request.spent[1] > 0
         collided: GoalCollides | None = None
         for goal in request.goals:
             if request.cancel is not None:

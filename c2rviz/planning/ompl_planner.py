@@ -75,6 +75,11 @@ _LOCK = threading.Lock()  # OMPL's seed generator and log level are process-wide
 _quiet = [0, ou.LOG_INFO]  # plans running, OMPL's log level before the first (under _LOCK)
 
 
+def fork_lock() -> threading.Lock:
+    """Hold it around a ``fork``: no thread is drawing OMPL's seeds meanwhile."""
+    return _LOCK
+
+
 def _after_fork() -> None:
     """A forked child (a plan's process) starts with a lock of its own, not a copy."""
     global _LOCK

@@ -27,8 +27,10 @@ With ``guard on`` (or ``plan``) a joint-space move goes like this:
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import functools
 import threading
+import time
 from collections.abc import Sequence
 from typing import Protocol
 
@@ -45,12 +47,13 @@ from ..planning import (
     time_path,
 )
 from ..planning.cancel import Cancel
+from ..planning.errors import NoPathFound, NoWayAround
 from ..protocol import replies
 from ..world.moves import Travel
 from ..world.state import RobotState
 from ..world.world import World
 from .move_requests import world_request
-from .plan_process import in_child
+from .plan_process import in_child, run_forked
 from .services import Services
 from .worker import Worker
 
@@ -107,6 +110,8 @@ class WorldChanged(C2rvizError):
 
 
 _PLAN_LANE = threading.local()  # a plan lane thread's own move checker
+THREAD_S = 0.25  # [s] a plan's search on its thread before the rest goes to a process
+GRACE_S = 10.0  # [s] a plan's process answers this long after its time limit, or is killed
 
 
 def checker_of(worker: Worker) -> MoveChecker:
@@ -115,6 +120,27 @@ def checker_of(worker: Worker) -> MoveChecker:
     if not isinstance(checker, MoveChecker):
         checker = worker.cache["moves"] = MoveChecker()
     return checker
+
+
+def plan_job(asked: MoveRequest, processes: bool) -> CheckedMove:
+    """A plan on its lane's thread: the first ``THREAD_S`` of search there (most plans
+    end within it), the rest (``processes``) in a forked child, where OMPL's C++ holds
+    no lock of the server's (see ``plan_process``). A seeded search starts again the
+    same in the child, so it finds the same path as one long search."""
+    if not processes or asked.timeout_s <= THREAD_S:
+        return plan_checked(asked)
+    began = time.perf_counter()
+    try:
+        return plan_checked(dataclasses.replace(asked, timeout_s=THREAD_S))
+    except (NoPathFound, NoWayAround) as exc:
+        searched = exc.__cause__ if isinstance(exc, NoWayAround) else exc
+        if not isinstance(searched, NoPathFound):
+            raise
+        states = searched.states
+    rest = dataclasses.replace(asked, spent=(time.perf_counter() - began, states))
+    return run_forked(
+        functools.partial(plan_checked, rest), asked.cancel, asked.timeout_s + GRACE_S
+    )
 
 
 def plan_checked(asked: MoveRequest) -> CheckedMove:
@@ -236,7 +262,7 @@ async def _check(
                 raise
     cancel = Cancel()
     asked = request(session, start, goals, path=path_from, plan=plan, cancel=cancel)
-    job = functools.partial(plan_checked, asked)
+    job = functools.partial(plan_job, asked, worker.plan_processes)
     return asked, await worker.plan(job, key=key, owner=session, cancel=cancel)
 
 

@@ -4,10 +4,11 @@ OMPL's Python bindings keep the interpreter's lock through ``solve``: between it
 calls back into Python its C++ holds it, and as a search's trees grow (hundreds of
 thousands of states) their rebuilds hold it for tens to hundreds of milliseconds,
 during which no other thread of the server runs: not the event loop, not the IK.
-So each plan runs in a child forked from the plan lane's thread: the child has
-the request (the robot's collision model, the workcell, the other robots) as the
-parent had it, at no cost of copying, searches with its own interpreter lock, and
-sends back the result (or the error) through a pipe, pickled. The parent's thread
+So a plan that searches long (``guarded.plan_job``) goes on in a child forked
+from the plan lane's thread: the child has the request (the robot's collision
+model, the workcell, the other robots) as the parent had it, at no cost of
+copying, searches with its own interpreter lock, and sends back the result (or
+the error) through a pipe, pickled. The parent's thread
 waits on that pipe, looking at the plan's ``Cancel`` meanwhile: when it is set
 (``stop``, the client gone, a newer plan) the child is killed at once.
 
@@ -20,16 +21,19 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import math
 import os
 import pickle
 import select
 import signal
+import time
 import warnings
 from collections.abc import Callable
 from typing import Any, TypeVar
 
 from ..planning.cancel import Cancel, PlanCancelled
 from ..planning.guarded_move import MoveRequest
+from ..planning.ompl_planner import fork_lock
 
 __all__ = ["POLL_S", "ParentGone", "in_child", "run_forked"]
 
@@ -59,15 +63,23 @@ def in_child(request: MoveRequest) -> MoveRequest:
     return dataclasses.replace(request, cancel=ParentGone()) if CHILD else request
 
 
-def run_forked(fn: Callable[[], T], cancel: Cancel | None = None) -> T:
+def run_forked(
+    fn: Callable[[], T], cancel: Cancel | None = None, deadline_s: float = math.inf
+) -> T:
     """``fn()`` run in a forked child; its result, or its exception raised here.
+
+    Args:
+        fn: What the child runs (its result and errors must pickle).
+        cancel: Kills the child when set.
+        deadline_s: Kills the child if it has not answered within this [s].
 
     Raises:
         PlanCancelled: ``cancel`` was set while the child ran (it was killed).
+        RuntimeError: the child died, or did not answer within ``deadline_s``.
     """
     read_fd, write_fd = os.pipe()
-    with warnings.catch_warnings():  # (Python 3.12 warns of fork in a threaded process)
-        warnings.simplefilter("ignore", DeprecationWarning)
+    with fork_lock(), warnings.catch_warnings():  # (no thread draws OMPL's seeds meanwhile)
+        warnings.simplefilter("ignore", DeprecationWarning)  # (3.12: fork with threads)
         pid = os.fork()
     if pid == 0:  # the child: run, answer, leave without running the parent's cleanups
         global CHILD
@@ -82,7 +94,7 @@ def run_forked(fn: Callable[[], T], cancel: Cancel | None = None) -> T:
         os._exit(status)
     os.close(write_fd)
     try:
-        data = _read(read_fd, pid, cancel)
+        data = _read(read_fd, pid, cancel, time.monotonic() + deadline_s)
     finally:
         os.close(read_fd)
         _reap(pid)
@@ -116,7 +128,7 @@ def _answer(fn: Callable[[], Any]) -> bytes:
         return pickle.dumps(("error", _portable(RuntimeError(f"plan answer: {exc!r}"))))
 
 
-def _read(fd: int, pid: int, cancel: Cancel | None) -> bytes:
+def _read(fd: int, pid: int, cancel: Cancel | None, deadline: float) -> bytes:
     chunks: list[bytes] = []
     while True:
         ready, _, _ = select.select([fd], [], [], POLL_S)
@@ -128,6 +140,9 @@ def _read(fd: int, pid: int, cancel: Cancel | None) -> bytes:
         elif cancel is not None and cancel():
             os.kill(pid, signal.SIGKILL)
             raise PlanCancelled(cancel.why)
+        elif time.monotonic() > deadline:
+            os.kill(pid, signal.SIGKILL)
+            raise RuntimeError("the plan's process did not answer in time (killed)")
 
 
 def _reap(pid: int) -> None:

@@ -13,8 +13,9 @@ every other client goes on). Two lanes (``lanes.Lane``) do the work:
   an IK solve or a guarded check behind it, and the plans of several clients
   search side by side, one per client at a time. A plan can be cancelled
   (``cancel(owner)``: ``stop``; its client closing; a newer plan with its key).
-  Each plan runs in a child process its thread forks (``plan_process``): OMPL's
-  bindings hold the interpreter's lock in their C++, which would stall the loop.
+  A plan that searches longer than ``guarded.THREAD_S`` goes on in a child
+  process its thread forks (``plan_process``): OMPL's bindings hold the
+  interpreter's lock in their C++, and its trees' rebuilds would stall the loop.
 
 In each lane a job belongs to an owner (``owner=session``: one connection); every
 owner has its own queue and the lane serves them in turn, so one client's long
@@ -36,7 +37,6 @@ docs/limits.md has the measured figures.
 from __future__ import annotations
 
 import asyncio
-import functools
 import os
 import sys
 from collections.abc import Callable, Hashable
@@ -46,7 +46,6 @@ from ..ik.solver import IkSolver
 from ..planning.cancel import Cancel
 from ..world.state import RobotState
 from .lanes import Job, Lane, Superseded, WorkerBusy
-from .plan_process import run_forked
 
 __all__ = [
     "MAX_PER_OWNER",
@@ -81,8 +80,8 @@ class Worker:
         Args:
             max_queue: Jobs waiting for each lane at most (the running ones not counted).
             plan_threads: Plans searching at once.
-            plan_processes: Run each plan in a child process forked by its plan lane
-                thread (``plan_process.run_forked``), else on that thread.
+            plan_processes: Let a plan that searches long go on in a child process
+                forked by its plan lane thread (``guarded.plan_job``), else on that thread.
         """
         self.plan_processes = plan_processes
         self.work = Lane("work", 1, max_queue, MAX_PER_OWNER)
@@ -146,9 +145,8 @@ class Worker:
         """Queue ``fn``, a plan, for the plan lane; await the returned future on the loop.
 
         Args:
-            fn: The plan (it runs in a child process forked by one of the plan lane's
-                threads, or on that thread: it keeps no state between runs, or keeps it
-                per thread; its result and errors must pickle).
+            fn: The plan (it runs on one of the plan lane's threads, which may fork a
+                process for it: it keeps no state between runs, or keeps it per thread).
             key: A newer job with this key replaces this one, waiting or running.
             owner: Whose plan (a session): one plan of each owner searches at a time.
             cancel: What ``fn`` watches to stop early (``cancel(owner)``, a newer plan
@@ -157,8 +155,6 @@ class Worker:
         Raises:
             WorkerBusy: the lane's or the owner's queue is full (nothing is queued).
         """
-        if self.plan_processes:
-            fn = functools.partial(run_forked, fn, cancel)
         return self._submit(self.plans, fn, key, False, owner, cancel)
 
     def _submit(
