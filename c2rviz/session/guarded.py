@@ -13,7 +13,7 @@ With ``guard on`` (or ``plan``) a joint-space move goes like this:
    planned around when the straight path is blocked; ``plan``: always planned, the
    direct edge first) searches on its plan lane, in a process of its own, where
    ``stop``, the client closing or a newer move of the session cancel it
-   (``planning.cancel``).
+   (``planning.cancel``; ``plan_process``).
 3. Back on the loop the world may have changed meanwhile: the workcell must be the
    one checked (its revision), and every other robot that stood still stand where
    it stood; else the move is checked again, up to ``TRIES`` times, and then
@@ -27,10 +27,7 @@ With ``guard on`` (or ``plan``) a joint-space move goes like this:
 from __future__ import annotations
 
 import asyncio
-import dataclasses
 import functools
-import threading
-import time
 from collections.abc import Sequence
 from typing import Protocol
 
@@ -47,13 +44,12 @@ from ..planning import (
     time_path,
 )
 from ..planning.cancel import Cancel
-from ..planning.errors import NoPathFound, NoWayAround
 from ..protocol import replies
 from ..world.moves import Travel
 from ..world.state import RobotState
 from ..world.world import World
 from .move_requests import world_request
-from .plan_process import in_child, run_forked
+from .plan_process import plan_job
 from .services import Services
 from .worker import Worker
 
@@ -62,7 +58,6 @@ __all__ = [
     "WorldChanged",
     "checked_move",
     "guarded_go",
-    "plan_checked",
     "guarded_rand",
     "play_checked",
     "GuardedSession",
@@ -109,47 +104,12 @@ class WorldChanged(C2rvizError):
         )
 
 
-_PLAN_LANE = threading.local()  # a plan lane thread's own move checker
-THREAD_S = 0.25  # [s] a plan's search on its thread before the rest goes to a process
-GRACE_S = 10.0  # [s] a plan's process answers this long after its time limit, or is killed
-
-
 def checker_of(worker: Worker) -> MoveChecker:
     """The worker's move checker (kept in its cache, used on its work lane's thread)."""
     checker = worker.cache.get("moves")
     if not isinstance(checker, MoveChecker):
         checker = worker.cache["moves"] = MoveChecker()
     return checker
-
-
-def plan_job(asked: MoveRequest, processes: bool) -> CheckedMove:
-    """A plan on its lane's thread: the first ``THREAD_S`` of search there (most plans
-    end within it), the rest (``processes``) in a forked child, where OMPL's C++ holds
-    no lock of the server's (see ``plan_process``). A seeded search starts again the
-    same in the child, so it finds the same path as one long search."""
-    if not processes or asked.timeout_s <= THREAD_S:
-        return plan_checked(asked)
-    began = time.perf_counter()
-    try:
-        return plan_checked(dataclasses.replace(asked, timeout_s=THREAD_S))
-    except (NoPathFound, NoWayAround) as exc:
-        searched = exc.__cause__ if isinstance(exc, NoWayAround) else exc
-        if not isinstance(searched, NoPathFound):
-            raise
-        states = searched.states
-    rest = dataclasses.replace(asked, spent=(time.perf_counter() - began, states))
-    return run_forked(
-        functools.partial(plan_checked, rest), asked.cancel, asked.timeout_s + GRACE_S
-    )
-
-
-def plan_checked(asked: MoveRequest) -> CheckedMove:
-    """``MoveChecker.check`` on the plan lane (in its own process, or on a plan lane
-    thread with that thread's own checker)."""
-    checker = getattr(_PLAN_LANE, "moves", None)
-    if checker is None:
-        checker = _PLAN_LANE.moves = MoveChecker()
-    return checker.check(in_child(asked))
 
 
 def request(

@@ -1,10 +1,10 @@
-"""A plan searched in a child process of its own: ``run_forked(fn, cancel)``.
+"""A plan on the plan lane: ``plan_job``, on its thread and then in a forked child.
 
 OMPL's Python bindings keep the interpreter's lock through ``solve``: between its
 calls back into Python its C++ holds it, and as a search's trees grow (hundreds of
 thousands of states) their rebuilds hold it for tens to hundreds of milliseconds,
 during which no other thread of the server runs: not the event loop, not the IK.
-So a plan that searches long (``guarded.plan_job``) goes on in a child forked
+So a plan that searches long (``plan_job``) goes on in a child forked
 from the plan lane's thread: the child has the request (the robot's collision
 model, the workcell, the other robots) as the parent had it, at no cost of
 copying, searches with its own interpreter lock, and sends back the result (or
@@ -21,25 +21,40 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import math
 import os
 import pickle
 import select
 import signal
+import threading
 import time
 import warnings
 from collections.abc import Callable
 from typing import Any, TypeVar
 
 from ..planning.cancel import Cancel, PlanCancelled
-from ..planning.guarded_move import MoveRequest
+from ..planning.errors import NoPathFound, NoWayAround
+from ..planning.guarded_move import CheckedMove, MoveChecker, MoveRequest
 from ..planning.ompl_planner import fork_lock
 
-__all__ = ["POLL_S", "ParentGone", "in_child", "run_forked"]
+__all__ = [
+    "GRACE_S",
+    "POLL_S",
+    "THREAD_S",
+    "ParentGone",
+    "in_child",
+    "plan_checked",
+    "plan_job",
+    "run_forked",
+]
 
 T = TypeVar("T")
 
 POLL_S = 0.01  # [s] how often a waiting parent looks at the plan's cancel flag
+_PLAN_LANE = threading.local()  # a plan lane thread's own move checker
+THREAD_S = 0.25  # [s] a plan's search on its thread before the rest goes to a process
+GRACE_S = 10.0  # [s] a plan's process answers this long after its time limit, or is killed
 CHILD = False  # True in a plan's child process
 MAX_FD = 1 << 20  # descriptors a child closes (above it: none open here)
 
@@ -61,6 +76,36 @@ def in_child(request: MoveRequest) -> MoveRequest:
     """``request`` as a plan's child should run it: with the child's own cancel flag (the
     parent's cannot reach it); unchanged in the server's own process."""
     return dataclasses.replace(request, cancel=ParentGone()) if CHILD else request
+
+
+def plan_job(asked: MoveRequest, processes: bool) -> CheckedMove:
+    """A plan on its lane's thread: the first ``THREAD_S`` of search there (most plans
+    end within it), the rest (``processes``) in a forked child, where OMPL's C++ holds
+    no lock of the server's (see ``plan_process``). A seeded search starts again the
+    same in the child, so it finds the same path as one long search."""
+    if not processes or asked.timeout_s <= THREAD_S:
+        return plan_checked(asked)
+    began = time.perf_counter()
+    try:
+        return plan_checked(dataclasses.replace(asked, timeout_s=THREAD_S))
+    except (NoPathFound, NoWayAround) as exc:
+        searched = exc.__cause__ if isinstance(exc, NoWayAround) else exc
+        if not isinstance(searched, NoPathFound):
+            raise
+        states = searched.states
+    rest = dataclasses.replace(asked, spent=(time.perf_counter() - began, states))
+    return run_forked(
+        functools.partial(plan_checked, rest), asked.cancel, asked.timeout_s + GRACE_S
+    )
+
+
+def plan_checked(asked: MoveRequest) -> CheckedMove:
+    """``MoveChecker.check`` on the plan lane (in its own process, or on a plan lane
+    thread with that thread's own checker)."""
+    checker = getattr(_PLAN_LANE, "moves", None)
+    if checker is None:
+        checker = _PLAN_LANE.moves = MoveChecker()
+    return checker.check(in_child(asked))
 
 
 def run_forked(

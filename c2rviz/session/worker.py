@@ -13,7 +13,7 @@ every other client goes on). Two lanes (``lanes.Lane``) do the work:
   an IK solve or a guarded check behind it, and the plans of several clients
   search side by side, one per client at a time. A plan can be cancelled
   (``cancel(owner)``: ``stop``; its client closing; a newer plan with its key).
-  A plan that searches longer than ``guarded.THREAD_S`` goes on in a child
+  A plan that searches longer than ``plan_process.THREAD_S`` goes on in a child
   process its thread forks (``plan_process``): OMPL's bindings hold the
   interpreter's lock in their C++, and its trees' rebuilds would stall the loop.
 
@@ -81,7 +81,7 @@ class Worker:
             max_queue: Jobs waiting for each lane at most (the running ones not counted).
             plan_threads: Plans searching at once.
             plan_processes: Let a plan that searches long go on in a child process
-                forked by its plan lane thread (``guarded.plan_job``), else on that thread.
+                forked by its plan lane thread (``plan_process.plan_job``), else on that thread.
         """
         self.plan_processes = plan_processes
         self.work = Lane("work", 1, max_queue, MAX_PER_OWNER)

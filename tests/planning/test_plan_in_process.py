@@ -1,5 +1,5 @@
 """A plan that searches past its thread's share goes on in a forked child
-(``session.guarded.plan_job``): the same seed finds the same path as one search."""
+(``session.plan_process.plan_job``): the same seed finds the same path as one search."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from support import Client, ServerThread
 
 from c2rviz.collision import CollisionModel
 from c2rviz.protocol.replies import numbers
-from c2rviz.session import SessionDefaults, guarded
+from c2rviz.session import SessionDefaults, plan_process
 from c2rviz.session.settings import ServerLimits
 
 
@@ -21,8 +21,8 @@ def test_a_seeded_plan_that_goes_on_in_a_process_finds_the_path_of_one_search(
     robot = load("kuka_lwr")
     (scene,) = blocked_scenes(CollisionModel(robot), 1, seed=5)
     paths = []
-    for processes, thread_s in ((False, guarded.THREAD_S), (True, 1e-4)):
-        monkeypatch.setattr(guarded, "THREAD_S", thread_s)
+    for processes, thread_s in ((False, plan_process.THREAD_S), (True, 1e-4)):
+        monkeypatch.setattr(plan_process, "THREAD_S", thread_s)
         server = ServerThread(robot, ServerLimits()).start()
         try:
             server.services.defaults = SessionDefaults(plan_seed=1234)
