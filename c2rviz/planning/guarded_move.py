@@ -33,6 +33,7 @@ import pinocchio as pin
 from c2rviz.collision import CheckGeometry, CollisionModel, Pair, PlacedShape
 from c2rviz.errors import PathCollides
 
+from .cancel import Cancel
 from .edge_resolution import EdgeResolution
 from .errors import GoalCollides, NoPathFound, NoWayAround, PlanningError
 from .ompl_planner import PlannedPath, plan_for
@@ -67,6 +68,9 @@ class MoveRequest:
         plan: ``never``, ``blocked`` (plan around a blocked straight path) or ``always``.
         timeout_s: Most time a plan may search [s].
         seed: The planner's seed (None: a fresh one).
+        cancel: Stops a plan's search when set (None: only its time limit does).
+        spent: A search of this move before this one: its seconds and states, counted
+            in the time limit and in the states a refusal reports.
     """
 
     collision: CollisionModel
@@ -82,6 +86,8 @@ class MoveRequest:
     plan: str = "never"
     timeout_s: float = 1.0
     seed: int | None = None
+    cancel: Cancel | None = None
+    spent: tuple[float, int] = (0.0, 0)
 
 
 @dataclass(frozen=True)
@@ -141,6 +147,7 @@ class MoveChecker:
             PathCollides: the goal or the path collides (naming the pair and where).
             NoWayAround: blocked, and no plan around it (``plan="blocked"``).
             PlanningError: ``plan="always"`` found no path (an end collides, none in time).
+            PlanCancelled: ``request.cancel`` was set before a plan was found.
         """
         checker = self.checker(request)
         start = np.asarray(request.start, dtype=float)
@@ -187,16 +194,23 @@ class MoveChecker:
         self, checker: ValidityChecker, request: MoveRequest, allowed: frozenset[Pair]
     ) -> CheckedMove:
         """A plan to the first of ``request.goals`` that plans within the time limit."""
-        began = time.perf_counter()
-        states, searched = 0, False
+        began = time.perf_counter() - request.spent[0]
+        states, searched = request.spent[1], request.spent[1] > 0
         collided: GoalCollides | None = None
         for goal in request.goals:
+            if request.cancel is not None:
+                request.cancel.check()
             left = request.timeout_s - (time.perf_counter() - began)
             if left <= 0:
                 break
             try:
                 path = plan_for(
-                    checker, request.start, goal, timeout_s=max(left, 1e-3), seed=request.seed
+                    checker,
+                    request.start,
+                    goal,
+                    timeout_s=max(left, 1e-3),
+                    seed=request.seed,
+                    cancel=request.cancel,
                 )
             except GoalCollides as exc:
                 collided = collided or exc

@@ -23,13 +23,20 @@ both edges stay free (smoothing without adding corners).
 Seeded randomness: OMPL draws every sampler's seed from one process-wide seed
 generator; ``plan_path`` reseeds it before it builds the planner, so a seed and
 the same checks give the same path whatever ran before. The search stops at its
-first solution, so the time limit does not change the path. One plan runs at a
-time in a process (a lock); OMPL's log is silenced meanwhile.
+first solution, so the time limit does not change the path. Several plans may
+search at once (each on its own thread): a lock is held while a plan's random
+sources are drawn from that generator (its seeding, the sampler, the
+simplifier), not while it searches; OMPL's log is silenced while any plan runs.
+
+Cancellation: the search also stops when ``cancel`` (a ``cancel.Cancel``) is set,
+looked at between RRT-Connect's steps (OMPL's termination condition), and the
+plan ends with ``PlanCancelled``.
 """
 
 from __future__ import annotations
 
 import logging
+import os
 import secrets
 import threading
 import time
@@ -41,6 +48,7 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
+from .cancel import Cancel
 from .edge_resolution import EdgeResolution, coarse_first
 from .errors import (
     BadPlanningSetting,
@@ -64,6 +72,22 @@ _SLIDES = (1.0, 0.5, 0.25)  # fractions of the way to the neighbours' midpoint t
 _SWEEPS = 4  # most passes of corner sliding
 _RANGE_RAD = 1.0  # [rad] RRT-Connect's longest extension (OMPL's default: a fifth of the box)
 _LOCK = threading.Lock()  # OMPL's seed generator and log level are process-wide
+_quiet = [0, ou.LOG_INFO]  # plans running, OMPL's log level before the first (under _LOCK)
+
+
+def fork_lock() -> threading.Lock:
+    """Hold it around a ``fork``: no thread is drawing OMPL's seeds meanwhile."""
+    return _LOCK
+
+
+def _after_fork() -> None:
+    """A forked child (a plan's process) starts with a lock of its own, not a copy."""
+    global _LOCK
+    _LOCK = threading.Lock()
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_after_fork)
 
 EdgeCheck = Callable[[np.ndarray, np.ndarray], tuple[bool, int]]
 """``(q0, q1) -> (free, configurations checked)``; ``q0`` is taken as already checked."""
@@ -164,6 +188,7 @@ def plan_path(
     describe: Callable[[np.ndarray], tuple[str, str] | None] | None = None,
     timeout_s: float = 1.0,
     seed: int | None = None,
+    cancel: Cancel | None = None,
 ) -> PlannedPath:
     """A collision-free path from ``start`` to ``goal`` within ``lower..upper``.
 
@@ -180,6 +205,7 @@ def plan_path(
         describe: The first colliding pair at a configuration (for the errors).
         timeout_s: Most time RRT-Connect searches [s], in (0, 60].
         seed: Seed of the search (a fresh one if None; the result says which).
+        cancel: Stops the search when set (see the module).
 
     Raises:
         BadPlanningSetting: a NaN, non-positive or huge timeout, step or seed,
@@ -187,6 +213,7 @@ def plan_path(
         OutOfLimits: the start or goal is outside the bounds.
         StartCollides, GoalCollides: either end is in collision (names the pair).
         NoPathFound: RRT-Connect found nothing in ``timeout_s``.
+        PlanCancelled: ``cancel`` was set before a path was found.
         PathCheckFailed: the shortened path failed its final check (not expected).
     """
     began = time.perf_counter()
@@ -214,9 +241,10 @@ def plan_path(
     if checks.edge(a, b):
         waypoints = np.array([a, b])
     else:
-        with _LOCK:
-            found = _rrt_connect(a, b, low, high, checks, timeout, chosen)
+        found = _rrt_connect(a, b, low, high, checks, timeout, chosen, cancel)
         if found is None:  # raised here, so that no OMPL object lives on in its traceback
+            if cancel is not None:
+                cancel.check()
             raise NoPathFound(timeout, checks.count)
         waypoints = _shorten(found, checks)
         failed = _first_failed_edge(waypoints, checks)
@@ -237,13 +265,38 @@ def _rrt_connect(
     checks: _Counted,
     timeout_s: float,
     seed: int,
+    cancel: Cancel | None = None,
 ) -> np.ndarray | None:
     """RRT-Connect's path from ``start`` to ``goal`` after OMPL's shortcutting (rows), or
-    None if it found none in ``timeout_s``."""
+    None if it found none in ``timeout_s`` (or ``cancel`` was set)."""
     n = len(start)
-    level = ou.getLogLevel()
-    ou.setLogLevel(ou.LOG_NONE)
+    with _LOCK:
+        if _quiet[0] == 0:
+            _quiet[1] = ou.getLogLevel()
+            ou.setLogLevel(ou.LOG_NONE)
+        _quiet[0] += 1
     try:
+        return _search(start, goal, lower, upper, checks, timeout_s, seed, cancel, n)
+    finally:
+        with _LOCK:
+            _quiet[0] -= 1
+            if _quiet[0] == 0:
+                ou.setLogLevel(_quiet[1])
+
+
+def _search(
+    start: np.ndarray,
+    goal: np.ndarray,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    checks: _Counted,
+    timeout_s: float,
+    seed: int,
+    cancel: Cancel | None,
+    n: int,
+) -> np.ndarray | None:
+    """``_rrt_connect``'s search, with OMPL's log silenced."""
+    with _LOCK:  # every random source of this plan drawn in order from the seed
         ou.RNG.setSeed(seed + 1)  # OMPL's seeds start at 1; before any sampler exists
         space = ob.RealVectorStateSpace(n)
         bounds = ob.RealVectorBounds(n)
@@ -264,17 +317,23 @@ def _rrt_connect(
         planner = og.RRTConnect(info)
         planner.setRange(_RANGE_RAD)  # local detours, shorter paths (see the benchmark)
         setup.setPlanner(planner)
-        setup.solve(timeout_s)
-        if not setup.haveExactSolutionPath():
-            return None
-        path = setup.getSolutionPath()
-        simplifier = og.PathSimplifier(info)
-        simplifier.reduceVertices(path)
-        simplifier.partialShortcutPath(path)
-        simplifier.collapseCloseVertices(path)
-        rows = [path.getState(k)[0:n] for k in range(path.getStateCount())]
-    finally:
-        ou.setLogLevel(level)
+        setup.solve(ob.PlannerTerminationCondition(lambda: True))  # its sampler: no search
+        simplifier = og.PathSimplifier(info)  # (drawn after the sampler, as before)
+    began = time.perf_counter()
+    timed = ob.timedPlannerTerminationCondition(timeout_s)
+    if cancel is None:
+        setup.solve(timed)
+    else:
+        stop = ob.PlannerTerminationCondition(cancel)
+        setup.solve(ob.plannerOrTerminationCondition(timed, stop))
+    log.debug("planning: searched %.3f s", time.perf_counter() - began)
+    if not setup.haveExactSolutionPath():
+        return None
+    path = setup.getSolutionPath()
+    simplifier.reduceVertices(path)
+    simplifier.partialShortcutPath(path)
+    simplifier.collapseCloseVertices(path)
+    rows = [path.getState(k)[0:n] for k in range(path.getStateCount())]
     waypoints = np.clip(np.array(rows, dtype=float), lower, upper)  # a zero-width joint
     waypoints[0], waypoints[-1] = start, goal  # exact ends, not OMPL's copies
     return waypoints
@@ -323,6 +382,7 @@ def plan_for(
     *,
     timeout_s: float = 1.0,
     seed: int | None = None,
+    cancel: Cancel | None = None,
 ) -> PlannedPath:
     """``plan_path`` for one robot: ``checker``'s bounds, state and edge checks, and pairs."""
     lower, upper = checker.bounds(start, goal)
@@ -336,4 +396,5 @@ def plan_for(
         describe=checker.describe,
         timeout_s=timeout_s,
         seed=seed,
+        cancel=cancel,
     )

@@ -22,6 +22,7 @@ from ..ik.target import Target
 from ..motion.trajectory import PlannedTrajectory
 from ..motion.trajectory_play import TrajectoryPlay
 from ..planning import MoveChecker, MoveRequest, first_blocked, path_points
+from ..planning.cancel import STOPPED
 from ..protocol import replies
 from ..protocol.registry import Reply
 from .guarded import checker_of, request
@@ -183,7 +184,8 @@ def grip(session: Session, opening: float) -> Reply:
 
 
 def brake(session: Session, fingers: bool) -> Reply:
-    """``Session.stop``: see there."""
+    """``Session.stop``: see there. A plan this session is searching stops too."""
+    session.services.worker.cancel(session, STOPPED)
     if fingers:
         session.world.grips.stop(session.state, session.source)
     rest = session.world.travels.stop(session.state, session.source)

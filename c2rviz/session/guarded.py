@@ -7,10 +7,13 @@ With ``guard on`` (or ``plan``) a joint-space move goes like this:
    a guarded arm never blends into a new move off its checked paths.
 2. A snapshot of what the move is checked against is taken on the loop
    (``planning.MoveRequest``: the robot's checks, the other robots where they
-   stand, the start: where the arm comes to rest) and checked on the worker's
-   thread (``planning.MoveChecker``): the goal alone for a move shown at once,
-   else the straight joint-space path (``guard plan``: planned around when it
-   is blocked; ``plan``: always planned, the direct edge first).
+   stand, the start: where the arm comes to rest) and checked off the loop
+   (``planning.MoveChecker``): the goal alone for a move shown at once, else the
+   straight joint-space path, on the worker's work lane; a plan (``guard plan``:
+   planned around when the straight path is blocked; ``plan``: always planned, the
+   direct edge first) searches on its plan lane, in a process of its own, where
+   ``stop``, the client closing or a newer move of the session cancel it
+   (``planning.cancel``; ``plan_process``).
 3. Back on the loop the world may have changed meanwhile: the workcell must be the
    one checked (its revision), and every other robot that stood still stand where
    it stood; else the move is checked again, up to ``TRIES`` times, and then
@@ -31,7 +34,7 @@ from typing import Protocol
 import numpy as np
 
 from ..collision.model import NoFreeConfiguration
-from ..errors import ArmMoved, C2rvizError
+from ..errors import ArmMoved, C2rvizError, PathCollides
 from ..planning import (
     CheckedMove,
     EdgeResolution,
@@ -40,11 +43,13 @@ from ..planning import (
     TimedPath,
     time_path,
 )
+from ..planning.cancel import Cancel
 from ..protocol import replies
 from ..world.moves import Travel
 from ..world.state import RobotState
 from ..world.world import World
 from .move_requests import world_request
+from .plan_process import plan_job
 from .services import Services
 from .worker import Worker
 
@@ -80,6 +85,7 @@ class GuardedSession(Protocol):
     plan_around: bool
     plan_timeout_s: float
     plan_seed: int | None
+    last_plan: np.ndarray | None
 
     @property
     def resolution(self) -> EdgeResolution: ...
@@ -99,7 +105,7 @@ class WorldChanged(C2rvizError):
 
 
 def checker_of(worker: Worker) -> MoveChecker:
-    """The worker's move checker (kept in its cache, used on its thread)."""
+    """The worker's move checker (kept in its cache, used on its work lane's thread)."""
     checker = worker.cache.get("moves")
     if not isinstance(checker, MoveChecker):
         checker = worker.cache["moves"] = MoveChecker()
@@ -114,6 +120,7 @@ def request(
     path: np.ndarray | None = None,
     target_only: bool = False,
     plan: str = "never",
+    cancel: Cancel | None = None,
 ) -> MoveRequest:
     """What a move of ``session``'s robot is checked against now, with its settings."""
     return world_request(
@@ -127,6 +134,7 @@ def request(
         plan=plan,
         timeout_s=session.plan_timeout_s,
         seed=session.plan_seed,
+        cancel=cancel,
     )
 
 
@@ -162,10 +170,9 @@ async def checked_move(
 
     Raises:
         PathCollides, PlanningError: refused (nothing moved).
+        PlanCancelled: its plan was cancelled (nothing moved).
         WorldChanged: the world changed under each of ``TRIES`` checks.
     """
-    worker = session.services.worker
-    checker = checker_of(worker)
     at_once = session.motion == "off" and plan != "always" and path_from is None
     for _ in range(TRIES):
         if not at_once and session.travel.active:  # brake on the checked path first
@@ -175,10 +182,7 @@ async def checked_move(
         start = tuple(session.state.target if session.travel.active else session.state.q)
         if at_once:
             start = session.now()
-        asked = request(session, start, goals, path=path_from, target_only=at_once, plan=plan)
-        checked = await worker.run(
-            functools.partial(checker.check, asked), key=("move", id(session))
-        )
+        asked, checked = await _check(session, start, goals, path_from, at_once, plan)
         if not at_once:
             if session.travel.active and not session.travel.stopping:
                 raise ArmMoved(_TAKEN)  # not our brake: another command took the arm
@@ -190,6 +194,36 @@ async def checked_move(
         if unchanged(session, asked, at_rest=not at_once):
             return checked, at_once
     raise WorldChanged(TRIES)
+
+
+async def _check(
+    session: GuardedSession,
+    start: tuple[float, ...],
+    goals: Sequence[Sequence[float]],
+    path_from: np.ndarray | None,
+    at_once: bool,
+    plan: str,
+) -> tuple[MoveRequest, CheckedMove]:
+    """One check of a move, off the loop; what it was checked against, and the answer.
+
+    The straight path (or the goal, or the path given) is checked on the worker's work
+    lane; a plan (``plan="always"``, or ``"blocked"`` when the straight path is blocked)
+    searches on its plan lane, where it can be cancelled.
+    """
+    worker, key = session.services.worker, ("move", id(session))
+    if plan != "always":
+        straight = "never" if plan == "blocked" else plan
+        asked = request(session, start, goals, path=path_from, target_only=at_once, plan=straight)
+        check = functools.partial(checker_of(worker).check, asked)
+        try:
+            return asked, await worker.run(check, key=key, owner=session)
+        except PathCollides:
+            if plan != "blocked" or at_once or path_from is not None:
+                raise
+    cancel = Cancel()
+    asked = request(session, start, goals, path=path_from, plan=plan, cancel=cancel)
+    job = functools.partial(plan_job, asked, worker.plan_processes)
+    return asked, await worker.plan(job, key=key, owner=session, cancel=cancel)
 
 
 def play_checked(
@@ -218,6 +252,8 @@ async def guarded_go(
     once checked)."""
     plan = "blocked" if session.plan_around else "never"
     checked, at_once = await checked_move(session, goals, plan=plan)
+    if session.plan_around:
+        session.last_plan = checked.waypoints  # what `plan` shows: the path this move takes
     if at_once:
         session.world.set_q(checked.goal, session.state.name, session.source)
         return replies.OK
@@ -243,5 +279,5 @@ async def guarded_rand(session: GuardedSession) -> str:
             raise NoFreeConfiguration(name, DRAWS, batch.lasting(rng))
         return found
 
-    goals = await worker.run(draw, key=("move", id(session)))
+    goals = await worker.run(draw, key=("move", id(session)), owner=session)
     return await guarded_go(session, goals, speed)

@@ -15,6 +15,7 @@ import numpy as np
 from ..collision.batch import PlacedShape
 from ..collision.other_robots import placed_shapes
 from ..planning import EdgeResolution, MoveRequest
+from ..planning.cancel import Cancel
 from ..planning.guarded_move import OtherAt
 from ..world.world import World
 
@@ -34,9 +35,11 @@ def world_request(
     timeout_s: float = 1.0,
     seed: int | None = None,
     still_only: bool = False,
+    cancel: Cancel | None = None,
 ) -> MoveRequest:
     """What a move of ``robot`` is checked against now (on the loop): its checks, and the
-    other robots where they are (``still_only``: only those standing still)."""
+    other robots where they are (``still_only``: only those standing still); ``cancel``
+    stops its plan, if it plans."""
     state = world.state(robot)
     model = world.collision_model(robot)
     shapes: list[PlacedShape] = []
@@ -62,4 +65,5 @@ def world_request(
         plan,
         timeout_s,
         seed,
+        cancel,
     )

@@ -93,7 +93,7 @@ async def plan_straight(
     first, tool_offset = tuple(state.q if start is None else start), state.tool
     worker = session.services.worker
     solver = worker.ik_solver(state)
-    line = await worker.run(lambda: plan_line(solver, first, goal, tool_offset))
+    line = await worker.run(lambda: plan_line(solver, first, goal, tool_offset), owner=session)
     if start is None and (state.q != first or session.travel.active):
         raise ArmMoved("the arm moved while the line was planned: send movel again")
     waypoints = [waypoint.q for waypoint in line.waypoints]
@@ -151,7 +151,7 @@ async def solve(
     state, worker = session.state, session.services.worker
     first, tool_offset = (session.now() if seed is None else seed), state.tool
     solver = worker.ik_solver(state)
-    return await worker.run(lambda: solver.solve(target, first, tool_offset))
+    return await worker.run(lambda: solver.solve(target, first, tool_offset), owner=session)
 
 
 async def _reply(reply: Reply) -> str:

@@ -1,7 +1,8 @@
 """What ``plan`` does: a path around obstacles to joint values or a tool pose, its settings.
 
-The search runs on the worker's thread (``guarded.checked_move`` with
-``plan="always"``: the direct edge first, then RRT-Connect and shortening), the
+The search runs on the worker's plan lane (``guarded.checked_move`` with
+``plan="always"``: the direct edge first, then RRT-Connect and shortening; ``stop``,
+the client closing or a newer move cancel it), the
 path is timed within the joints' limits at the connection's speed and played on
 the world's clock (``motion on``: the reply waits for the arrival; ``follow``: it
 comes as the arm leaves; ``off``: the arm is shown at the goal at once), and the
@@ -33,7 +34,7 @@ MIN_TIMEOUT_S = 0.001  # [s] shortest search a connection may set
 @handler(Plan)
 def plan(session: Session, command: Plan) -> Reply:
     what, values = command.what, command.values
-    if what == "show":
+    if what == "show":  # the path of the last `plan`, or of the last `guard plan` move
         if session.last_plan is None:
             return replies.ok("none")
         return replies.ok(";".join(replies.numbers(session.from_si(q)) for q in session.last_plan))
@@ -64,7 +65,7 @@ def plan(session: Session, command: Plan) -> Reply:
 async def _plan_pose(session: Session, target: Target) -> str:
     state, worker = session.state, session.services.worker
     solver, near, tool = worker.ik_solver(state), session.now(), state.tool
-    goals = await worker.run(lambda: goal_candidates(solver, target, near, tool))
+    goals = await worker.run(lambda: goal_candidates(solver, target, near, tool), owner=session)
     return await _plan_to(session, goals)
 
 
