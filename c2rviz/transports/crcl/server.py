@@ -11,7 +11,8 @@ Bad input never costs the server or another client (every case gets a ``CRCL_Err
 status whose ``StateDescription`` says what was wrong):
 
 - a malformed or invalid document, text or markup between documents: that error, and
-  the connection goes on with the next document;
+  the connection goes on with the next document (so does a document a bug in c2rviz
+  fails on: ``INTERNAL_ERROR``, and the traceback in the log);
 - a document that stalls half-sent for ``stall_timeout_s``: its bytes are dropped,
   that error, and the connection goes on;
 - what the stream cannot be re-synchronised after (a document over
@@ -53,6 +54,8 @@ TURN_S: Final = 0.002
 """Work per client per event-loop turn [s]: then the other clients go first."""
 LINGER_S: Final = 2.0
 """After the close is decided, how long a client's input is read and dropped [s]."""
+INTERNAL_ERROR: Final = "internal error reading the document (see the server log)"
+"""The description of a document a bug in c2rviz could not run (the connection goes on)."""
 
 
 @dataclass(frozen=True)
@@ -241,7 +244,11 @@ class _Connection:
             if isinstance(item, CrclFramingError):
                 self.controller.refuse_document(item)
             else:
-                self.controller.receive(item)
+                try:
+                    self.controller.receive(item)
+                except Exception:  # a bug costs this document, never the connection
+                    log.exception("internal error reading a CRCL document")
+                    self.controller.refuse_document(CrclError(INTERNAL_ERROR))
             if time.perf_counter() - started > TURN_S:
                 await asyncio.sleep(0)  # the other clients' turn
                 started = time.perf_counter()

@@ -1,0 +1,77 @@
+"""Issue 39's faults at the CRCL door (2, 3, 4): each a CRCL_Error status that names what
+was wrong, and the connection goes on."""
+
+from __future__ import annotations
+
+import pytest
+from crcl_support import DONE, ERROR, command, move_to
+
+INIT = command("InitCanon", 1)
+STILL_HERE = command("Message", 3, "<Message>still here</Message>")
+
+
+@pytest.mark.parametrize(
+    ("axes", "words"),
+    [
+        ({"x_axis": (1e300, 0, 0)}, "EndPosition/XAxis/I: 1e+300 is out of range"),
+        ({"z_axis": (0, 0, -1e300)}, "EndPosition/ZAxis/K: -1e+300 is out of range"),
+        ({"x_axis": (1e300, 1e300, 1e300)}, "EndPosition/XAxis/I: 1e+300 is out of range"),
+    ],
+    ids=["x-axis-i", "z-axis-k", "x-axis-all"],
+)
+def test_a_huge_axis_component_is_an_error_and_the_next_document_runs(
+    crcl_server, crcl_connect, axes: dict, words: str
+) -> None:
+    """39.2: it raised OverflowError, closed the connection and lost the next document."""
+    client = crcl_connect(crcl_server)
+    assert client.run(INIT, 1).command_status.state == DONE
+    client.send(move_to(2, (0.5, 0.0, 0.8), **axes) + STILL_HERE)  # one write
+    refused = client.until(2).command_status
+    assert refused.state == ERROR and words in refused.description, refused.description
+    assert client.until(3).command_status.state == DONE
+    assert crcl_server.q == (0.0,) * 7
+
+
+def test_a_bug_reading_a_document_costs_that_document_only(
+    crcl_server, crcl_connect, monkeypatch
+) -> None:
+    """Whatever a document raises, the client hears an error and the connection goes on
+    (an unexpected exception used to end it with no status: "Unhandled exception in
+    client_connected_cb")."""
+    from c2rviz.transports.crcl import motion_commands
+    from c2rviz.transports.crcl.server import INTERNAL_ERROR
+
+    def boom(self: object) -> None:
+        raise ArithmeticError("a bug")
+
+    client = crcl_connect(crcl_server)
+    assert client.run(INIT, 1).command_status.state == DONE
+    monkeypatch.setattr(motion_commands.MoveTo, "_check", boom)
+    client.send(move_to(2, (0.5, 0.0, 0.8)))
+    refused = client.status().command_status
+    assert refused.state == ERROR and refused.description == INTERNAL_ERROR
+    monkeypatch.undo()
+    assert client.run(STILL_HERE, 3).command_status.state == DONE
+
+
+def test_play_check_refuses_a_huge_axis_in_one_line(tmp_path, capsys) -> None:
+    """39.2 in a program: ``c2rviz-play --check`` printed a traceback and exited 1."""
+    from c2rviz.clients import player
+
+    program = tmp_path / "huge.xml"
+    program.write_text(
+        '<?xml version="1.0" encoding="UTF-8"?>\n'
+        '<CRCLProgram xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance">\n'
+        "  <InitCanon><CommandID>1</CommandID></InitCanon>\n"
+        '  <MiddleCommand xsi:type="MoveToType"><CommandID>2</CommandID>\n'
+        "    <MoveStraight>false</MoveStraight>\n"
+        "    <EndPosition><Point><X>0.5</X><Y>0</Y><Z>0.8</Z></Point>\n"
+        "      <XAxis><I>1</I><J>0</J><K>0</K></XAxis>\n"
+        "      <ZAxis><I>0</I><J>0</J><K>-1e300</K></ZAxis></EndPosition>\n"
+        "  </MiddleCommand>\n"
+        "  <EndCanon><CommandID>3</CommandID></EndCanon>\n"
+        "</CRCLProgram>\n"
+    )
+    assert player.main([str(program), "--check"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "EndPosition/ZAxis/K: -1e+300 is out of range" in err
