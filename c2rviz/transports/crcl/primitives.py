@@ -38,6 +38,7 @@ from .scalars import (
 
 __all__ = [
     "AXIS_COMPONENT_LIMIT",
+    "POSITION_LIMIT",
     "MIN_AXIS_NORM",
     "ORTHOGONALITY_TOLERANCE",
     "POSE",
@@ -69,6 +70,10 @@ __all__ = [
 MIN_AXIS_NORM: Final = 1e-6
 AXIS_COMPONENT_LIMIT: Final = 1e6
 """The largest magnitude of a direction's component (``XAxis``, ``ZAxis``)."""
+POSITION_LIMIT: Final = 1e6
+"""The largest magnitude of a point's coordinate in any length unit: the text port's
+1000 m (``protocol.ranges.POSITION_M``) in millimeters, the finest CRCL length unit.
+``units.pose_to_matrix`` holds a point to 1000 m in the connection's own unit."""
 ORTHOGONALITY_TOLERANCE: Final = 1e-3
 
 
@@ -80,6 +85,14 @@ class Point(Record):
     x: float = one("X", DOUBLE)
     y: float = one("Y", DOUBLE)
     z: float = one("Z", DOUBLE)
+
+    def _check(self) -> None:
+        for label, value in zip("XYZ", (self.x, self.y, self.z)):
+            if not abs(value) <= POSITION_LIMIT:
+                raise CrclValueError(
+                    f"{value!r} is out of range: a position lies within 1000 m of the "
+                    f"origin (-{POSITION_LIMIT:g}..{POSITION_LIMIT:g} in millimeters)"
+                ).within(label)
 
 
 @dataclass(frozen=True)

@@ -75,3 +75,32 @@ def test_play_check_refuses_a_huge_axis_in_one_line(tmp_path, capsys) -> None:
     assert player.main([str(program), "--check"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "EndPosition/ZAxis/K: -1e+300 is out of range" in err
+
+
+@pytest.mark.parametrize(
+    ("units", "point", "words"),
+    [
+        ("meter", (1e308, 0.0, 0.8), "EndPosition/Point/X: 1e+308 is out of range"),
+        ("meter", (0.5, -1e308, 0.8), "EndPosition/Point/Y: -1e+308 is out of range"),
+        ("millimeter", (500.0, 0.0, 2e6), "EndPosition/Point/Z: 2000000.0 is out of range"),
+        ("meter", (2000.0, 0.0, 0.8), "Point/X: 2000 meter is out of range"),
+        ("inch", (0.0, 50000.0, 0.8), "Point/Y: 50000 inch is out of range"),
+    ],
+    ids=["1e308-m", "-1e308-m", "2e6-mm", "2000-m", "50000-inch"],
+)
+def test_a_position_past_1000_m_is_refused_with_the_text_ports_range(
+    crcl_server, crcl_connect, units: str, point: tuple, words: str
+) -> None:
+    """39.3: 1e308 was accepted, then refused as "target is inf m" (numpy's overflow
+    warning besides); the range is the text port's, ±1000 m."""
+    client = crcl_connect(crcl_server)
+    assert client.run(INIT, 1).command_status.state == DONE
+    unit = f"<UnitName>{units}</UnitName>"
+    assert client.run(command("SetLengthUnits", 2, unit), 2).command_status.state == DONE
+    client.send(move_to(4, point) + STILL_HERE)
+    refused = client.until(4).command_status
+    assert refused.state == ERROR and words in refused.description, refused.description
+    assert "-1000..1000 m" in refused.description or "1000 m of the origin" in refused.description
+    assert "inf" not in refused.description
+    assert client.until(3).command_status.state == DONE
+    assert crcl_server.q == (0.0,) * 7
