@@ -42,7 +42,15 @@ from .errors import CrclError, CrclFramingError
 from .framing import DocumentSplitter
 from .hardened import MAX_DOCUMENT_BYTES
 
-__all__ = ["DEFAULT_PORT", "LINGER_S", "READ_BYTES", "TURN_S", "CrclLimits", "CrclServer"]
+__all__ = [
+    "DEFAULT_PORT",
+    "LINGER_S",
+    "READ_BYTES",
+    "REFUSALS_SUMMED_S",
+    "TURN_S",
+    "CrclLimits",
+    "CrclServer",
+]
 
 log = logging.getLogger("c2rviz.crcl")
 
@@ -54,6 +62,8 @@ TURN_S: Final = 0.002
 """Work per client per event-loop turn [s]: then the other clients go first."""
 LINGER_S: Final = 2.0
 """After the close is decided, how long a client's input is read and dropped [s]."""
+REFUSALS_SUMMED_S: Final = 60.0
+"""Refused connections after the first are logged as one count per this interval [s]."""
 INTERNAL_ERROR: Final = "internal error reading the document (see the server log)"
 """The description of a document a bug in c2rviz could not run (the connection goes on)."""
 
@@ -95,6 +105,7 @@ class CrclServer:
         self._open: set[_Connection] = set()
         self._served: set[_Connection] = set()
         self._door = f"crcl {id(self)}"
+        self._refusals = _RefusalLog()
         self.refused = 0
         """Connections turned away (over ``max_connections``, or while stopping)."""
         self.address: tuple[str, int] | None = None
@@ -127,6 +138,7 @@ class CrclServer:
             await asyncio.wait(list(self._tasks), timeout=5.0)
         await self._server.wait_closed()
         self._server = None
+        self._refusals.flush(final=True)
 
     async def _accept(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         task = asyncio.current_task()
@@ -151,7 +163,7 @@ class CrclServer:
     async def _connection(self, connection: _Connection, where: str) -> None:
         if self._server is None or len(self._served) >= self.limits.max_connections:
             self.refused += 1
-            log.warning("refused CRCL client %s: %d served already", where, len(self._served))
+            self._refusals.refused(where, len(self._served), self.limits.max_connections)
             limit = self.limits.max_connections
             connection.controller.refuse_document(
                 CrclError(f"too many CRCL connections (limit {limit}); closing")
@@ -167,6 +179,42 @@ class CrclServer:
             self._served.discard(connection)
             self.services.count_clients(self._door, len(self._served))
             log.info("CRCL client %s left", where)
+
+
+class _RefusalLog:
+    """Logs the first connection refused, then how many more each ``REFUSALS_SUMMED_S``
+    (a storm of clients over the cap costs a line a minute, not a line each)."""
+
+    def __init__(self) -> None:
+        self._more = 0
+        self._timer: asyncio.TimerHandle | None = None
+
+    def refused(self, where: str, served: int, limit: int) -> None:
+        if self._timer is None:
+            log.warning(
+                "refused CRCL client %s: %d served already (limit %d); further refusals "
+                "are counted every %g s",
+                where, served, limit, REFUSALS_SUMMED_S,
+            )  # fmt: skip
+            self._timer = asyncio.get_running_loop().call_later(REFUSALS_SUMMED_S, self.flush)
+        else:
+            self._more += 1
+
+    def flush(self, final: bool = False) -> None:
+        """Log the refusals counted since the last line; go on counting unless there were
+        none or this is the ``final`` line (the server stops)."""
+        if self._timer is not None:
+            self._timer.cancel()
+            self._timer = None
+        if self._more:
+            log.warning(
+                "refused %d more CRCL clients (too many connections) in the last %g s at most",
+                self._more, REFUSALS_SUMMED_S,
+            )  # fmt: skip
+            self._more = 0
+            if not final:
+                loop = asyncio.get_running_loop()
+                self._timer = loop.call_later(REFUSALS_SUMMED_S, self.flush)
 
 
 class _Connection:
@@ -200,14 +248,19 @@ class _Connection:
     async def run(self) -> None:
         loop = asyncio.get_running_loop()
         splitter, limits = self.splitter, self.limits
-        resumed = loop.time()  # the stall clock runs only while we read
+        # The stall clock runs from a document's first byte, however many reads bring the
+        # rest; the time we spend on our own work meanwhile is added (``owed``), since the
+        # client's bytes may be waiting unread in the socket while we work.
+        pending_since: float | None = None
+        owed = 0.0
         try:
             while not self.closing:
                 timeout = None
-                if splitter.pending_bytes:
-                    started = splitter.started_at
-                    began = resumed if started is None else max(started, resumed)
-                    timeout = max(began + limits.stall_timeout_s - loop.time(), 0.0)
+                started = splitter.started_at
+                if splitter.pending_bytes and started is not None:
+                    if started != pending_since:
+                        pending_since, owed = started, 0.0
+                    timeout = max(started + owed + limits.stall_timeout_s - loop.time(), 0.0)
                 try:
                     data = await asyncio.wait_for(self.reader.read(READ_BYTES), timeout)
                 except asyncio.TimeoutError:
@@ -225,8 +278,12 @@ class _Connection:
                     break
                 if not data:
                     break
-                await self._take(splitter.feed(data, loop.time()))
-                resumed = loop.time()
+                fed = loop.time()
+                await self._take(splitter.feed(data, fed))
+                if splitter.started_at is not None:
+                    if splitter.started_at != pending_since:
+                        pending_since, owed = splitter.started_at, 0.0
+                    owed += loop.time() - fed
                 if splitter.closed:
                     await self.close()
         finally:

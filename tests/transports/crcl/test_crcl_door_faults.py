@@ -3,6 +3,9 @@ was wrong, and the connection goes on."""
 
 from __future__ import annotations
 
+import logging
+import select
+
 import pytest
 from crcl_support import DONE, ERROR, command, move_to
 
@@ -104,3 +107,41 @@ def test_a_position_past_1000_m_is_refused_with_the_text_ports_range(
     assert "inf" not in refused.description
     assert client.until(3).command_status.state == DONE
     assert crcl_server.q == (0.0,) * 7
+
+
+def test_the_stall_clock_runs_from_a_documents_first_byte(start_crcl, crcl_connect) -> None:
+    """39.4: each read restarted the clock, so a byte every 6 s kept a document half-sent
+    for 36 s (and would forever). Here a byte comes every half timeout: the document is
+    dropped all the same, long before the trickle ends."""
+    server = start_crcl(stall_timeout_s=0.6)
+    client = crcl_connect(server)
+    doc = command("InitCanon", 1)
+    client.send(doc[:20])
+    stalled = None
+    for byte in doc[20:60]:  # 40 bytes, one each 0.3 s: 12 s, twenty timeouts
+        readable, _, _ = select.select([client.sock], [], [], 0.3)
+        if readable:
+            stalled = client.status().command_status
+            break
+        client.send(bytes([byte]))
+    assert stalled is not None, "a document trickled byte by byte was never dropped"
+    assert stalled.state == ERROR and "stalled for 0.6 s: dropped" in stalled.description
+    assert client.run(doc, 1).command_status.state == DONE
+
+
+def test_refused_connections_are_logged_as_a_count(start_crcl, crcl_connect, caplog) -> None:
+    """39.4: each refused connection logged a warning line (184 for 200 connections)."""
+    server = start_crcl(max_connections=1)
+    served = crcl_connect(server)
+    assert served.run(INIT, 1).command_status.state == DONE
+    with caplog.at_level(logging.WARNING, logger="c2rviz.crcl"):
+        for _ in range(30):
+            refused = crcl_connect(server)
+            assert "too many CRCL connections" in refused.status().command_status.description
+            assert refused.closed_by_server()
+        server.call_async(server.crcl.stop())  # the count so far is logged as it stops
+    lines = [r.getMessage() for r in caplog.records if "refused" in r.getMessage()]
+    assert len(lines) == 2, lines
+    assert lines[0].startswith("refused CRCL client 127.0.0.1:")
+    assert lines[1].startswith("refused 29 more CRCL clients (too many connections)")
+    assert server.crcl.refused == 30
