@@ -189,7 +189,10 @@ class _Reader:
     def number(self, value: object, field: str) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise self.error(field, "must be a number")
-        number = float(value)
+        try:
+            number = float(value)
+        except OverflowError:  # an integer of hundreds of digits: JSON allows it
+            raise self.error(field, "is an integer too large for a float64") from None
         if not math.isfinite(number):
             raise self.error(field, f"is not finite ({number})")
         return number
