@@ -190,6 +190,7 @@ class Connection:
             server.stats,
             server.sent_probe,
             snapshot=lambda: self.bridge.snapshot(name),
+            unthrottled_length=self.policy.max_queue_length,
         )
         outbox.request(op.id, op.throttle_rate_ms, length)
         outbox.handle = self.bridge.subscribe(name, outbox.deliver)

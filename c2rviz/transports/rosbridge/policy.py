@@ -48,7 +48,10 @@ class RosbridgePolicy:
         max_subscriptions: Subscriptions (by id) per connection, and as many
             advertised topics; one more is answered with a status error.
         max_queue_length: Largest ``queue_length`` a subscription gets; a
-            larger request is cut to it (with a status warning).
+            larger request is cut to it (with a status warning). A subscription
+            without a ``throttle_rate`` is sent every message (its
+            ``queue_length`` ignored, as rosbridge does) and holds this many for
+            a slow reader.
         compression: Offer permessage-deflate; off by default (it costs CPU
             per subscriber and frames are small on loopback).
     """

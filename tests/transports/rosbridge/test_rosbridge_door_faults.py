@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import json
 import queue
 from typing import Any
 
 import pytest
 import roslibpy
+from rosbridge_support import CounterBridge, ServerThread
 from support import load_robot
+from websockets.sync.client import connect
 from world_support import WAIT_S, WorldServer, ask, command_service
 
 from c2rviz.transports.rosbridge.messages import MessageError, joint_positions, joint_trajectory
@@ -79,3 +82,31 @@ def test_a_huge_integer_through_the_door_is_a_status_naming_the_field(
     assert f"{field} is an integer too large for a float64" in status["msg"], status["msg"]
     assert world_server.q() == load_robot("motoman_sia20d").home
     assert ask(command_service(ros_world), "where")["ok"]  # the connection goes on
+
+
+def test_without_a_throttle_every_message_is_sent(
+    rosbridge: ServerThread, bridge: CounterBridge
+) -> None:
+    """39.5: roslibpy's default (``throttle_rate`` 0, ``queue_length`` 0) kept one message
+    and dropped the rest; rosbridge_suite applies ``queue_length`` only with a throttle."""
+    with connect(rosbridge.url, open_timeout=WAIT_S) as client:
+        subscribe = {"op": "subscribe", "id": "c", "topic": "/counter", "throttle_rate": 0}
+        client.send(json.dumps(subscribe | {"queue_length": 0}))
+        assert bridge.subscribed.get(timeout=WAIT_S) == "/counter"
+        rosbridge.call(bridge.tick, 8)  # eight before the outbox can send one
+        got = [json.loads(client.recv(timeout=WAIT_S))["msg"]["data"] for _ in range(8)]
+        assert got == [str(n) for n in range(1, 9)]
+        assert rosbridge.server.stats["thinned"] == 0
+
+
+def test_roslibpy_gets_every_reply(world_server: WorldServer, ros_world: roslibpy.Ros) -> None:
+    """39.5 as it was seen: eight commands published at once, four replies arrived."""
+    replies: queue.Queue[dict[str, Any]] = queue.Queue()
+    roslibpy.Topic(ros_world, "/c2rviz/reply", "std_msgs/String").subscribe(replies.put)
+    ask(command_service(ros_world), "help")  # the subscription is in place once this returns
+    command = roslibpy.Topic(ros_world, "/c2rviz/command", "std_msgs/msg/String")
+    for i in range(8):
+        command.publish(roslibpy.Message({"data": f"joints {i / 100},0,0,0,0,0,0"}))
+    command.publish(roslibpy.Message({"data": "where"}))
+    got = [replies.get(timeout=WAIT_S)["data"] for _ in range(9)]
+    assert got == ["ok"] * 8 + ["ok 0.07,0,0,0,0,0,0"]
