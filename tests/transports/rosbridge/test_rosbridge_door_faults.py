@@ -110,3 +110,36 @@ def test_roslibpy_gets_every_reply(world_server: WorldServer, ros_world: roslibp
     command.publish(roslibpy.Message({"data": "where"}))
     got = [replies.get(timeout=WAIT_S)["data"] for _ in range(9)]
     assert got == ["ok"] * 8 + ["ok 0.07,0,0,0,0,0,0"]
+
+
+def test_an_error_reaches_a_roslibpy_user_on_the_reply_topic(
+    world_server: WorldServer, ros_world: roslibpy.Ros
+) -> None:
+    """39.6: roslibpy drops ``status`` frames ("No handler registered for operation
+    status"), so a refused publish was never seen; it is on /c2rviz/reply too now."""
+    replies: queue.Queue[dict[str, Any]] = queue.Queue()
+    roslibpy.Topic(ros_world, "/c2rviz/reply", "std_msgs/String").subscribe(replies.put)
+    ask(command_service(ros_world), "help")  # the subscription is in place once this returns
+    joints = roslibpy.Topic(ros_world, "/joint_command", "sensor_msgs/msg/JointState")
+    joints.publish(roslibpy.Message({"name": ["joint_s", "elbow"], "position": [0.5, 0.5]}))
+    refused = replies.get(timeout=WAIT_S)["data"]
+    assert refused.startswith("error: publish /joint_command: ")
+    assert "'elbow' is not a joint of motoman_sia20d's chain" in refused
+    nowhere = roslibpy.Topic(ros_world, "/no_such_topic", "std_msgs/msg/String")
+    nowhere.publish(roslibpy.Message({"data": "x"}))  # roslibpy advertises it first
+    assert replies.get(timeout=WAIT_S)["data"].startswith("error: advertise: no topic /no_such")
+    assert replies.get(timeout=WAIT_S)["data"].startswith("error: publish /no_such_topic: ")
+    command = roslibpy.Topic(ros_world, "/c2rviz/command", "std_msgs/msg/String")
+    command.publish(roslibpy.Message({"data": "joints 9,9,9,9,9,9,9"}))  # the line's own reply
+    command.publish(roslibpy.Message({"data": "where"}))
+    assert replies.get(timeout=WAIT_S)["data"].startswith("error: joint_s (index 0) = 9 rad")
+    assert replies.get(timeout=WAIT_S)["data"].startswith("ok ")  # said once, not twice
+    assert world_server.q() == load_robot("motoman_sia20d").home
+
+
+def test_a_failed_service_call_raises_in_roslibpy(ros_world: roslibpy.Ros) -> None:
+    """39.6, the other place a roslibpy user reads: the service response (result false)."""
+    with pytest.raises(roslibpy.core.ServiceException, match="command is missing"):
+        command_service(ros_world).call(roslibpy.ServiceRequest({}), timeout=WAIT_S)
+    answer = ask(command_service(ros_world), "fly away")
+    assert answer["ok"] is False and answer["reply"].startswith("error: unknown command 'fly'")
