@@ -13,7 +13,9 @@ from support import load_robot
 from websockets.sync.client import connect
 from world_support import WAIT_S, WorldServer, ask, command_service
 
+from c2rviz.transports.rosbridge import RosbridgePolicy
 from c2rviz.transports.rosbridge.messages import MessageError, joint_positions, joint_trajectory
+from c2rviz.transports.rosbridge.server import CLOSE_TIMEOUT_S
 
 HUGE = 10**400  # 401 digits: JSON allows it, a float64 cannot hold it
 POINT = {"positions": [0.0] * 7, "time_from_start": {"sec": 1, "nanosec": 0}}
@@ -143,3 +145,30 @@ def test_a_failed_service_call_raises_in_roslibpy(ros_world: roslibpy.Ros) -> No
         command_service(ros_world).call(roslibpy.ServiceRequest({}), timeout=WAIT_S)
     answer = ask(command_service(ros_world), "fly away")
     assert answer["ok"] is False and answer["reply"].startswith("error: unknown command 'fly'")
+
+
+def server_side(server: ServerThread) -> Any:
+    """The server's websocket of its one connection."""
+    return server.call(lambda: next(iter(server.server._connections)).websocket)
+
+
+def test_a_client_that_never_reads_holds_the_stop_for_the_close_timeout_only() -> None:
+    """39.9: a client that never reads held the program's stop 12.5-20 s (a send blocked on
+    it holds websockets' close until its keepalive gives up); now the closing handshake
+    may take ``CLOSE_TIMEOUT_S`` (the text port's 1 s), then the connection is dropped,
+    and the stop goes through with such a client connected (its time: docs/limits.md)."""
+    server = ServerThread(CounterBridge(), RosbridgePolicy())
+    stuck = connect(server.url, open_timeout=WAIT_S, max_queue=1, close_timeout=60)
+    try:
+        stuck.send(json.dumps({"op": "subscribe", "topic": "/counter"}))
+        assert server.bridge.subscribed.get(timeout=WAIT_S) == "/counter"
+        ticks = 0
+        while server.server.stats["thinned"] == 0:  # until the socket buffers are full
+            server.call(server.bridge.tick, 1, 65_536)
+            ticks += 1
+            assert ticks < 20_000, "the outbox never thinned"
+        assert server_side(server).close_timeout == CLOSE_TIMEOUT_S == 1.0
+    finally:
+        server.stop()  # returns once the stuck client is dropped
+        stuck.close_socket()
+    assert server.server.connections == 0
