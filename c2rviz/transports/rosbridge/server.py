@@ -20,7 +20,9 @@ Every error is answered with a ``status`` naming the problem and the request's
 ``id``; the connection goes on. Frames over ``max_frame_bytes`` close the
 connection with code 1009, one connection over ``max_connections`` is closed
 with 1013. Binary frames are answered with a status: c2rviz speaks JSON text.
-A client that does not let its connection close (it never reads) is dropped
+A connection is read at most ``max_read_ahead`` frames ahead of the one served
+(then reading it stops until it catches up: the client's sends wait, as TCP
+makes them). A client that does not let its connection close (it never reads) is dropped
 after ``CLOSE_TIMEOUT_S``.
 """
 
@@ -94,6 +96,7 @@ class RosbridgeServer:
             port,
             process_request=self._screen,
             max_size=self.policy.max_frame_bytes,
+            max_queue=self.policy.max_read_ahead,
             close_timeout=CLOSE_TIMEOUT_S,
             compression="deflate" if self.policy.compression else None,
         )

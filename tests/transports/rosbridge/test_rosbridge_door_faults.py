@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import queue
+import threading
+import time
 from typing import Any
 
 import pytest
@@ -172,3 +174,42 @@ def test_a_client_that_never_reads_holds_the_stop_for_the_close_timeout_only() -
         server.stop()  # returns once the stuck client is dropped
         stuck.close_socket()
     assert server.server.connections == 0
+
+
+def test_frames_sent_while_a_call_waits_are_read_ahead_a_bounded_few(
+    rosbridge: ServerThread, bridge: CounterBridge
+) -> None:
+    """39.8: while a service call waited, websockets read ahead 16 frames (16 MiB at
+    1 MiB each, per connection). Now reading stops past ``max_read_ahead`` frames and
+    resumes when the connection catches up; every frame is still served, in order."""
+    rosbridge.call(bridge.release.clear)  # "hold" waits until released
+    frames = 12
+    with connect(rosbridge.url, open_timeout=WAIT_S, max_size=None) as client:
+        hold = {"op": "call_service", "id": "h", "service": "/c2rviz/command"}
+        client.send(json.dumps(hold | {"args": {"command": "hold"}}))
+        assert bridge.calls.get(timeout=WAIT_S) == "hold"
+        big = {"op": "publish", "topic": "/inbox"}
+        sender = threading.Thread(
+            target=lambda: [
+                client.send(json.dumps(big | {"msg": {"data": f"{i} " + "x" * 500_000}}))
+                for i in range(frames)
+            ],
+            daemon=True,
+        )
+        sender.start()
+        websocket = server_side(rosbridge)
+        deadline = time.monotonic() + WAIT_S
+        while not rosbridge.call(lambda: websocket.recv_messages.paused):
+            assert time.monotonic() < deadline, "the server never stopped reading"
+            time.sleep(0.01)
+        queued = rosbridge.call(lambda: len(websocket.recv_messages.frames))
+        limit = rosbridge.server.policy.max_read_ahead
+        assert limit == 2 and queued <= limit + 1  # the limit, and the frame that passed it
+        rosbridge.call(bridge.release.set)
+        sender.join(WAIT_S)
+        got = [bridge.published.get(timeout=WAIT_S)[2].split(" ", 1)[0] for _ in range(frames)]
+        assert got == [str(i) for i in range(frames)]
+        assert json.loads(client.recv(timeout=WAIT_S))["values"] == {
+            "reply": "did hold",
+            "ok": True,
+        }
