@@ -23,7 +23,10 @@ status whose ``StateDescription`` says what was wrong):
 - statuses left unread past ``max_unread``: the connection is reset.
 
 A long run of documents in one read is worked through ``TURN_S`` at a time, so one
-client's flood delays the others by no more than that.
+client's flood delays the others by no more than that; a document too large to parse
+in that time (over ``PARSE_ON_LOOP_BYTES``) is parsed on the door's one parsing
+thread (lxml lets go of the interpreter's lock while it parses), big documents of
+every client in the order they came, while the loop serves the others.
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Final
 
@@ -38,6 +42,7 @@ from ...session.services import Services
 from ...session.session import Session
 from .actions import ACTIONS
 from .controller import Controller
+from .documents import CommandInstance, parse_instance
 from .errors import CrclError, CrclFramingError
 from .framing import DocumentSplitter
 from .hardened import MAX_DOCUMENT_BYTES
@@ -45,8 +50,10 @@ from .hardened import MAX_DOCUMENT_BYTES
 __all__ = [
     "DEFAULT_PORT",
     "LINGER_S",
+    "PARSE_ON_LOOP_BYTES",
     "READ_BYTES",
     "REFUSALS_SUMMED_S",
+    "SPLIT_BYTES",
     "TURN_S",
     "CrclLimits",
     "CrclServer",
@@ -64,6 +71,14 @@ LINGER_S: Final = 2.0
 """After the close is decided, how long a client's input is read and dropped [s]."""
 REFUSALS_SUMMED_S: Final = 60.0
 """Refused connections after the first are logged as one count per this interval [s]."""
+SPLIT_BYTES: Final = 16384
+"""Bytes of a read cut into documents at once [bytes]: the splitter scans every tag
+(about 0.5 ms for this many), so a read of ``READ_BYTES`` goes in slices, the other
+clients served between them."""
+PARSE_ON_LOOP_BYTES: Final = 16384
+"""The largest document parsed on the event loop [bytes]: a larger one (a parse runs at
+about 10 MB/s, so past a turn's ``TURN_S``) is parsed on the door's parsing thread
+while the other clients go on, and this client's next documents wait for it."""
 INTERNAL_ERROR: Final = "internal error reading the document (see the server log)"
 """The description of a document a bug in c2rviz could not run (the connection goes on)."""
 
@@ -106,6 +121,7 @@ class CrclServer:
         self._served: set[_Connection] = set()
         self._door = f"crcl {id(self)}"
         self._refusals = _RefusalLog()
+        self._parsing: ThreadPoolExecutor | None = None
         self.refused = 0
         """Connections turned away (over ``max_connections``, or while stopping)."""
         self.address: tuple[str, int] | None = None
@@ -122,6 +138,7 @@ class CrclServer:
         Raises:
             OSError: the address cannot be listened on.
         """
+        self._parsing = ThreadPoolExecutor(1, thread_name_prefix="c2rviz-crcl-parse")
         self._server = await asyncio.start_server(self._accept, host, port)
         bound = self._server.sockets[0].getsockname()
         self.address = (str(bound[0]), int(bound[1]))
@@ -139,6 +156,9 @@ class CrclServer:
         await self._server.wait_closed()
         self._server = None
         self._refusals.flush(final=True)
+        if self._parsing is not None:
+            self._parsing.shutdown(wait=False, cancel_futures=True)
+            self._parsing = None
 
     async def _accept(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         task = asyncio.current_task()
@@ -153,7 +173,7 @@ class CrclServer:
         peer = writer.get_extra_info("peername")
         where = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
         session = Session(self.services, f"crcl {where}", self.robot)
-        connection = _Connection(self, reader, writer, session)
+        connection = _Connection(self, reader, writer, session, self._parsing)
         self._open.add(connection)
         try:
             await self._connection(connection, where)
@@ -179,6 +199,14 @@ class CrclServer:
             self._served.discard(connection)
             self.services.count_clients(self._door, len(self._served))
             log.info("CRCL client %s left", where)
+
+
+def _parse(doc: bytes) -> CommandInstance | CrclError:
+    """``parse_instance`` on the parsing thread: the document, or why it is refused."""
+    try:
+        return parse_instance(doc)
+    except CrclError as error:
+        return error
 
 
 class _RefusalLog:
@@ -226,8 +254,10 @@ class _Connection:
         reader: asyncio.StreamReader,
         writer: asyncio.StreamWriter,
         session: Session,
+        parsing: ThreadPoolExecutor | None = None,
     ) -> None:
         self.limits = server.limits
+        self.parsing = parsing
         self.reader, self.writer = reader, writer
         self.splitter = DocumentSplitter(self.limits.max_document_bytes)
         self.controller = Controller(session, self.send, ACTIONS)
@@ -279,7 +309,12 @@ class _Connection:
                 if not data:
                     break
                 fed = loop.time()
-                await self._take(splitter.feed(data, fed))
+                for start in range(0, len(data), SPLIT_BYTES):
+                    if start:
+                        await asyncio.sleep(0)  # the other clients' turn between slices
+                    if self.closing or splitter.closed:
+                        break
+                    await self._take(splitter.feed(data[start : start + SPLIT_BYTES], fed))
                 if splitter.started_at is not None:
                     if splitter.started_at != pending_since:
                         pending_since, owed = splitter.started_at, 0.0
@@ -293,19 +328,31 @@ class _Connection:
                 self.writer.close()
 
     async def _take(self, items: list[bytes | CrclFramingError]) -> None:
-        """Run the documents (and report the errors) of one read, a turn's work at a time."""
+        """Run the documents (and report the errors) of one read, a turn's work at a time;
+        a document over ``PARSE_ON_LOOP_BYTES`` is parsed off the loop meanwhile."""
         started = time.perf_counter()
         for item in items:
             if self.closing:
                 return
             if isinstance(item, CrclFramingError):
                 self.controller.refuse_document(item)
-            else:
-                try:
+                continue
+            try:
+                if len(item) > PARSE_ON_LOOP_BYTES and self.parsing is not None:
+                    loop = asyncio.get_running_loop()
+                    parsed = await loop.run_in_executor(self.parsing, _parse, item)
+                    started = time.perf_counter()  # the others had the loop meanwhile
+                    if self.closing:
+                        return
+                    if isinstance(parsed, CrclError):
+                        self.controller.refuse_document(parsed)
+                    else:
+                        self.controller.receive(parsed)
+                else:
                     self.controller.receive(item)
-                except Exception:  # a bug costs this document, never the connection
-                    log.exception("internal error reading a CRCL document")
-                    self.controller.refuse_document(CrclError(INTERNAL_ERROR))
+            except Exception:  # a bug costs this document, never the connection
+                log.exception("internal error reading a CRCL document")
+                self.controller.refuse_document(CrclError(INTERNAL_ERROR))
             if time.perf_counter() - started > TURN_S:
                 await asyncio.sleep(0)  # the other clients' turn
                 started = time.perf_counter()
