@@ -11,8 +11,9 @@ beside the goal (issue 35: p99 <= 5 ms), and beside the same bystander with no f
    refused before InitCanon, so the cost is the parse), back to back, reading their
    statuses.
 2. rosbridge trajectory: 4 clients each send ``/joint_trajectory`` frames of 8000 points
-   (about 1 MB; refused after the decode and the check: the arm is not where point 0
-   is), one after the other.
+   (about 1 MB), one after the other: refused at a joint name the arm lacks (the cost
+   is the decode and the message's read), then refused by the plan's limit check (its
+   first point too far for the time given: the decode, the read and the plan).
 
 Figures only: nothing here passes or fails. The machine is shared: its load average
 is printed first.
@@ -57,9 +58,12 @@ def crcl_document(waypoints: int = 7000) -> bytes:
     ).encode()
 
 
-def trajectory_frame(points: int = 8000) -> str:
-    """A /joint_trajectory publish of ``points`` points (about 1 MB), far from the arm."""
+def trajectory_frame(points: int = 8000, unknown_joint: bool = False) -> str:
+    """A /joint_trajectory publish of ``points`` points (about 1 MB), far from the arm
+    (refused by its plan's check), or naming a joint the arm lacks (refused before it)."""
     names = ["joint_s", "joint_l", "joint_e", "joint_u", "joint_r", "joint_b", "joint_t"]
+    if unknown_joint:
+        names[-1] = "joint_x"
     raw = [
         {
             "positions": [round(0.3 + i * 1e-4, 4)] * 7,
@@ -118,10 +122,10 @@ def flood_crcl(port: int, seconds: float) -> None:
     sock.close()
 
 
-def flood_rosbridge(port: int, seconds: float) -> None:
+def flood_rosbridge(port: int, seconds: float, unknown_joint: bool = False) -> None:
     from websockets.sync.client import connect
 
-    frame = trajectory_frame()
+    frame = trajectory_frame(unknown_joint=unknown_joint)
     with connect(f"ws://127.0.0.1:{port}/", max_size=None) as ws:
         stop = time.monotonic() + seconds
         while time.monotonic() < stop:
@@ -130,6 +134,10 @@ def flood_rosbridge(port: int, seconds: float) -> None:
                                 "args": {"command": "where"}}))  # fmt: skip
             while json.loads(ws.recv(timeout=60)).get("op") != "service_response":
                 pass  # a status about the refused trajectory
+
+
+def flood_rosbridge_names(port: int, seconds: float) -> None:
+    flood_rosbridge(port, seconds, unknown_joint=True)
 
 
 def bystander(port: int, seconds: float) -> list[float]:
@@ -186,8 +194,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             result = measure(text, flood_crcl, crcl, args.seconds)
             print(f"bystander, 4 x 1 MiB CRCL flood: {result}")
         if args.only in (None, "rosbridge"):
+            result = measure(text, flood_rosbridge_names, ros, args.seconds)
+            print(f"bystander, 4 x 8000-point traj. refused at a joint name: {result}")
             result = measure(text, flood_rosbridge, ros, args.seconds)
-            print(f"bystander, 4 x 8000-point traj.: {result}")
+            print(f"bystander, 4 x 8000-point traj. refused by its check:    {result}")
     finally:
         popen.terminate()
         popen.wait(10)

@@ -15,23 +15,28 @@ import asyncio
 import logging
 from collections import Counter
 from collections.abc import Callable
+from concurrent.futures import Executor
 from typing import Any, Protocol
 
 from websockets.asyncio.server import ServerConnection
 from websockets.exceptions import ConnectionClosed
 
 from ...errors import C2rvizError
-from . import protocol, rosapi
+from . import messages, protocol, rosapi
 from .bridge import Bridge
 from .command_lines import CommandRefused
 from .outbox import Outbox
 from .policy import RosbridgePolicy
 from .protocol import LEVELS, SUPPORTED_OPS, FrameId, RosbridgeError, resolve_name
 
-__all__ = ["Connection", "Host"]
+__all__ = ["DECODE_ON_LOOP_BYTES", "Connection", "Host"]
 
 log = logging.getLogger("c2rviz.rosbridge")
 
+DECODE_ON_LOOP_BYTES = 16384
+"""The largest frame decoded on the event loop [bytes]; a larger one (a trajectory of
+thousands of points) is decoded and its message read on the server's decoding thread,
+the other clients served meanwhile, this client's next frames after it."""
 REPLY_TOPIC = "/c2rviz/reply"
 """The reply topic's name under each robot's namespace (``[NS]/c2rviz/reply``)."""
 
@@ -43,10 +48,22 @@ class Host(Protocol):
     policy: RosbridgePolicy
     stats: Counter[str]
     sent_probe: Callable[[float], None] | None
+    decoding: Executor | None
 
     def graph(self) -> rosapi.Graph: ...
 
     def encode(self, spelling: str, msg: dict[str, Any]) -> str | None: ...
+
+
+def _decode(text: str, topics: dict[str, str]) -> tuple[protocol.Op, object]:
+    """Off the loop: the frame's request and, for a publish to a topic whose message
+    c2rviz reads (a trajectory, a joint state), that reading (``messages.read_ahead``)."""
+    op = protocol.parse_frame(text)
+    if isinstance(op, protocol.Publish):
+        kind = topics.get(resolve_name(op.topic))
+        if kind is not None:
+            return op, messages.read_ahead(kind, op.msg)
+    return op, None
 
 
 class Connection:
@@ -120,9 +137,19 @@ class Connection:
 
     async def handle_text(self, text: str) -> None:
         op: protocol.Op | None = None
+        reading: object = None
         try:
-            op = protocol.parse_frame(text)
-            await self.serve(op)
+            decoding = self.server.decoding
+            if len(text) > DECODE_ON_LOOP_BYTES and decoding is not None:
+                topics = dict(self.server.graph().topics)
+                loop = asyncio.get_running_loop()
+                decoded, reading = await loop.run_in_executor(decoding, _decode, text, topics)
+            else:
+                decoded = protocol.parse_frame(text)
+            op = decoded
+            if reading is not None and isinstance(decoded, protocol.Publish):
+                messages.remember(decoded.msg, reading)
+            await self.serve(decoded)
         except (asyncio.CancelledError, ConnectionClosed):
             raise
         except RosbridgeError as error:
@@ -132,6 +159,9 @@ class Connection:
         except Exception:
             log.exception("rosbridge: %s failed on %s", self.source, text[:200])
             await self.refuse(C2rvizError("internal error in c2rviz (see its log)"), op)
+        finally:
+            if reading is not None and isinstance(op, protocol.Publish):
+                messages.forget(op.msg)
 
     async def serve(self, op: protocol.Op) -> None:
         if isinstance(op, protocol.Subscribe):

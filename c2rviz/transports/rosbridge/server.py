@@ -32,6 +32,7 @@ import asyncio
 import logging
 from collections import Counter
 from collections.abc import Callable
+from concurrent.futures import Executor, ThreadPoolExecutor
 from http import HTTPStatus
 from typing import Any
 
@@ -87,9 +88,13 @@ class RosbridgeServer:
         self._server: Server | None = None
         self._connections: set[Connection] = set()
         self._encoded: dict[str, tuple[dict[str, Any], str]] = {}
+        self.decoding: Executor | None = None
+        """The thread large frames are decoded on (``connection.DECODE_ON_LOOP_BYTES``),
+        one for every client, in the order they came; while the server runs."""
 
     async def start(self, host: str = "127.0.0.1", port: int = 9090) -> tuple[str, int]:
         """Listen on ``host:port`` (0: any free port); return the address bound."""
+        self.decoding = ThreadPoolExecutor(1, thread_name_prefix="c2rviz-rosbridge-decode")
         self._server = await serve(
             self._handle,
             host,
@@ -122,6 +127,9 @@ class RosbridgeServer:
                     websocket.transport.abort()
                 await closed
             self._server = None
+        if self.decoding is not None:
+            self.decoding.shutdown(wait=False, cancel_futures=True)
+            self.decoding = None
 
     async def __aenter__(self) -> RosbridgeServer:
         return self

@@ -213,3 +213,72 @@ def test_frames_sent_while_a_call_waits_are_read_ahead_a_bounded_few(
             "reply": "did hold",
             "ok": True,
         }
+
+
+def test_a_large_frame_is_decoded_off_the_loop_and_others_go_on(
+    rosbridge: ServerThread, bridge: CounterBridge, monkeypatch
+) -> None:
+    """Issue 35, stall 3: a 1 MB frame was decoded and read on the event loop (0.7 s for a
+    trajectory of 8000 points). Here the decode of a large frame is held until the test
+    lets it go: meanwhile another client is answered (with the decode on the loop it
+    would wait for it); the large frame's client keeps its order."""
+    from c2rviz.transports.rosbridge import protocol
+    from c2rviz.transports.rosbridge.connection import DECODE_ON_LOOP_BYTES
+
+    entered, gate = threading.Event(), threading.Event()
+    parse_frame = protocol.parse_frame
+
+    def held(text: str) -> Any:
+        if len(text) > DECODE_ON_LOOP_BYTES:
+            entered.set()
+            gate.wait(WAIT_S)
+        return parse_frame(text)
+
+    monkeypatch.setattr(protocol, "parse_frame", held)
+    call = {"op": "call_service", "service": "/c2rviz/command"}
+    with connect(rosbridge.url, open_timeout=WAIT_S) as big, connect(rosbridge.url) as other:
+        data = "y" * (4 * DECODE_ON_LOOP_BYTES)
+        big.send(json.dumps({"op": "publish", "topic": "/inbox", "msg": {"data": data}}))
+        big.send(json.dumps(call | {"id": "after", "args": {"command": "after"}}))
+        assert entered.wait(WAIT_S)  # the large frame is being decoded
+        other.send(json.dumps(call | {"id": "o", "args": {"command": "meanwhile"}}))
+        try:
+            answer = json.loads(other.recv(timeout=10))
+            assert answer["values"] == {"reply": "did meanwhile", "ok": True}
+            assert not gate.is_set()
+        finally:
+            gate.set()
+        assert json.loads(big.recv(timeout=WAIT_S))["values"]["reply"] == "did after"
+        assert bridge.published.get(timeout=WAIT_S)[2] == data  # before "after" was served
+
+
+def test_a_large_message_is_read_once_off_the_loop(
+    rosbridge: ServerThread, bridge: CounterBridge, monkeypatch
+) -> None:
+    """The message of a large frame is read (checked) on the decoding thread, and the
+    bridge's reader, called with it on the loop, takes that reading: one read, not two;
+    an error found there is the one the client hears."""
+    from c2rviz.transports.rosbridge import messages
+
+    reads: list[str] = []
+    real = messages._Reader
+
+    class Counted(real):  # type: ignore[misc, valid-type]
+        def __init__(self, type_name: str) -> None:
+            reads.append(threading.current_thread().name)
+            super().__init__(type_name)
+
+    monkeypatch.setattr(messages, "_Reader", Counted)
+    names = [f"joint_{i}" for i in range(3000)]
+    with connect(rosbridge.url, open_timeout=WAIT_S) as client:
+        msg = {"name": names, "position": [0.25] * 3000}
+        client.send(json.dumps({"op": "publish", "topic": "/joint_command", "msg": msg}))
+        taken = bridge.published.get(timeout=WAIT_S)[2]
+        assert taken.names == tuple(names) and taken.positions == (0.25,) * 3000
+        assert len(reads) == 1 and reads[0].startswith("c2rviz-rosbridge-decode")
+        msg["position"][2999] = HUGE
+        client.send(json.dumps({"op": "publish", "id": "p", "topic": "/joint_command", "msg": msg}))
+        status = json.loads(client.recv(timeout=WAIT_S))
+        assert status["op"] == "status" and status["id"] == "p"
+        assert "position[2999] is an integer too large for a float64" in status["msg"]
+        assert len(reads) == 2
