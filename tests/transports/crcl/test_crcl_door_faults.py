@@ -9,6 +9,8 @@ import threading
 
 import pytest
 from crcl_support import DONE, ERROR, command, move_to
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from support import Client
 
 INIT = command("InitCanon", 1)
@@ -183,3 +185,44 @@ def test_a_large_document_is_parsed_off_the_loop_and_others_go_on(
     assert big_client.until(2).command_status.state == DONE
     assert big_client.until(3).command_status.state == DONE
     assert big_client.states(3) == [DONE] and big_client.states(2) == [DONE]
+
+
+_PIECES = st.sampled_from(
+    [
+        "<a>", "</a>", "<b/>", "<c x='1'>", '<d y="a>b"/>', "</c>", "text", " a > b ",
+        "a/>b", "< 1", "<!-- </CRCLCommandInstance> -->", "<![CDATA[</x>]]>", "<?pi ?>",
+        "<CRCLCommandInstance>", "</CRCLCommandInstance>", "<p:q>", "</p:q>", "<e\n/>",
+        "</e >", "<<f>", "it's",
+    ]
+)  # fmt: skip
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    body=st.lists(_PIECES, max_size=40),
+    cuts=st.lists(st.integers(1, 50), min_size=1, max_size=8),
+)
+def test_the_plain_skim_cuts_as_the_tag_by_tag_skim(body: list[str], cuts: list[int]) -> None:
+    """Issue 35, stall 4: the splitter steps over plain tags in C now (``_skim_plain``);
+    whatever the bytes and however they are cut, it gives what the tag-by-tag skim gave."""
+    from c2rviz.transports.crcl.framing import DocumentSplitter
+
+    data = ("<CRCLCommandInstance>" + "".join(body) + "</CRCLCommandInstance> <x/>").encode()
+    data = data * 2
+
+    def split(plain: bool) -> list[object]:
+        splitter = DocumentSplitter(max_bytes=4096)
+        if not plain:
+            splitter._skim_plain = lambda out: False  # type: ignore[method-assign]
+        out: list[object] = []
+        start, turn = 0, 0
+        while start < len(data):
+            size = cuts[turn % len(cuts)]
+            out += [
+                x if isinstance(x, bytes) else str(x)
+                for x in splitter.feed(data[start : start + size])
+            ]
+            start, turn = start + size, turn + 1
+        return [*out, splitter.pending_bytes]
+
+    assert split(plain=True) == split(plain=False)
