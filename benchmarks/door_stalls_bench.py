@@ -1,6 +1,7 @@
 """Does one client's big document or frame stall the others? (issue 35, stalls 3 and 4)
 
-Usage: ``python benchmarks/door_stalls_bench.py [--seconds S] [--only crcl|rosbridge]``.
+Usage: ``python benchmarks/door_stalls_bench.py [--seconds S] [--quick] [--only crcl|rosbridge]``
+(``--quick``: one second a row).
 
 The program runs as a subprocess (``python -m c2rviz --no-viewer``, the motoman, every
 door on a free port). While flooders in other processes send big input, a bystander on
@@ -184,8 +185,11 @@ def measure(text_port: int, flood: Callable[[int, float], None] | None, port: in
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=5.0)
+    parser.add_argument("--quick", action="store_true", help="one second a row")
     parser.add_argument("--only", choices=("crcl", "rosbridge"))
     args = parser.parse_args(argv)
+    if args.quick:
+        args.seconds = 1.0
     print(machine())
     popen, text, crcl, ros = start_program()
     try:
