@@ -171,12 +171,13 @@ def forget(msg: Mapping[str, Any]) -> None:
     _READ_AHEAD.pop(id(msg), None)
 
 
-def _known(msg: Mapping[str, Any], kind: type) -> Any:
-    """The reading ``remember`` kept for this very message, if of ``kind``; else None."""
+def _known(msg: Mapping[str, Any], kind: type, type_name: str) -> Any:
+    """The reading ``remember`` kept for this very message as ``type_name`` (a ``kind``,
+    or its ``MessageError``, raised); else None."""
     kept = _READ_AHEAD.get(id(msg))
     if kept is None or kept[0] is not msg:
         return None
-    if isinstance(kept[1], MessageError):
+    if isinstance(kept[1], MessageError) and kept[1].type_name == type_name:
         raise kept[1]
     return kept[1] if isinstance(kept[1], kind) else None
 
@@ -286,7 +287,7 @@ def joint_positions(msg: Mapping[str, Any]) -> JointPositions:
     ``name`` and ``position`` are needed and of one length; ``velocity`` and
     ``effort`` may be empty or absent, else of that length too (checked, not used).
     """
-    known = _known(msg, JointPositions)
+    known = _known(msg, JointPositions, JOINT_STATE)
     if known is not None:
         return known  # type: ignore[no-any-return]
     reader = _Reader(JOINT_STATE)
@@ -306,7 +307,7 @@ def joint_trajectory(msg: Mapping[str, Any]) -> JointTrajectory:
     times are at least 0 and strictly increase; ``velocities``,
     ``accelerations`` and ``effort`` may be empty, else one per joint.
     """
-    known = _known(msg, JointTrajectory)
+    known = _known(msg, JointTrajectory, JOINT_TRAJECTORY)
     if known is not None:
         return known  # type: ignore[no-any-return]
     reader = _Reader(JOINT_TRAJECTORY)
