@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import queue
+import re
 import threading
 import time
 from typing import Any
@@ -11,7 +12,7 @@ from typing import Any
 import pytest
 import roslibpy
 from rosbridge_support import CounterBridge, ServerThread
-from support import load_robot
+from support import ROOT, load_robot
 from websockets.sync.client import connect
 from world_support import WAIT_S, WorldServer, ask, command_service
 
@@ -282,3 +283,19 @@ def test_a_large_message_is_read_once_off_the_loop(
         assert status["op"] == "status" and status["id"] == "p"
         assert "position[2999] is an integer too large for a float64" in status["msg"]
         assert len(reads) == 2
+
+
+def test_the_docs_way_to_see_errors_works_as_written(ros_world: roslibpy.Ros) -> None:
+    """39.6's docs: the snippet of docs/rosbridge.md that subscribes to the reply topic,
+    run as written, prints the error its comment shows."""
+    page = (ROOT / "docs" / "rosbridge.md").read_text()
+    block = next(b for b in re.findall(r"```python\n(.*?)```", page, re.DOTALL) if "reply" in b)
+    shown = [line.removeprefix("# ") for line in block.splitlines() if line.startswith("# error")]
+    printed: queue.Queue[str] = queue.Queue()
+    exec(block, {"roslibpy": roslibpy, "ros": ros_world, "print": printed.put})  # noqa: S102
+    ask(command_service(ros_world), "help")  # the subscription is in place once this returns
+    joints = roslibpy.Topic(ros_world, "/joint_command", "sensor_msgs/msg/JointState")
+    joints.publish(roslibpy.Message({"name": ["joint_s", "elbow"], "position": [0.5, 0.5]}))
+    line = printed.get(timeout=WAIT_S)
+    pattern = ".*".join(re.escape(part) for part in shown[0].split("..."))
+    assert re.fullmatch(pattern, line), (line, shown)
