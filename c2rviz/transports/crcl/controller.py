@@ -44,7 +44,7 @@ from ...protocol import replies
 from ...protocol.registry import Reply
 from ...session.session import Session
 from .commands import GetStatus, InitCanon
-from .documents import parse_instance
+from .documents import CommandInstance, parse_instance
 from .errors import CrclError
 from .jobs import (
     ARM,
@@ -142,13 +142,17 @@ class Controller:
 
     # documents in
 
-    def receive(self, doc: bytes) -> None:
-        """Run one command document (its motion, if any, goes on in a task)."""
-        try:
-            instance = parse_instance(doc)
-        except CrclError as error:
-            self.refuse_document(error)
-            return
+    def receive(self, doc: bytes | CommandInstance) -> None:
+        """Run one command document (its motion, if any, goes on in a task); a large
+        one comes parsed already (``parse_instance``, off the event loop)."""
+        if isinstance(doc, CommandInstance):
+            instance = doc
+        else:
+            try:
+                instance = parse_instance(doc)
+            except CrclError as error:
+                self.refuse_document(error)
+                return
         command = instance.command
         if isinstance(command, GetStatus):
             self._send_status(self.latest, full=True)

@@ -31,6 +31,8 @@ out, and ``discard_pending`` drops it and skips to the next document.
 
 from __future__ import annotations
 
+import operator
+from itertools import accumulate, islice
 from typing import Final
 
 from .errors import CrclFramingError
@@ -40,6 +42,7 @@ from .markup import (
     CONTROL,
     NAME,
     NOT_SPACE,
+    PLAIN_TAG,
     TAG_STOP,
     TOKEN,
     declaration_at,
@@ -55,6 +58,7 @@ CRCL_ROOTS: Final = ("CRCLCommandInstance", "CRCLProgram", "CRCLStatus")
 _LT, _SLASH, _BANG, _QUESTION = 0x3C, 0x2F, 0x21, 0x3F
 (_BETWEEN, _RESYNC, _CONTENT, _COMMENT, _PI, _CDATA, _START_TAG, _END_TAG) = range(8)
 _ENDS = {_COMMENT: b"-->", _PI: b"?>", _CDATA: b"]]>"}
+_STEP = {(b"/", b""): -1, (b"", b""): 1, (b"", b"/"): 0}  # a PLAIN_TAG's change of depth
 
 
 class DocumentSplitter:
@@ -274,6 +278,8 @@ class DocumentSplitter:
         """Step over whole tags, comments, CDATA and PIs with one regex each (the common
         case); True if that closed the root. Anything else, or a piece not all here
         yet, is left to the state machine."""
+        if self._skim_plain(out):
+            return True
         buf, pos, depth = self._buf, self._pos, self._depth
         while depth > 0:
             i = buf.find(b"<", pos)  # text is skipped by memchr, not by the regex
@@ -290,6 +296,34 @@ class DocumentSplitter:
         if depth:
             return False
         self._close_tag(out, pos)
+        return True
+
+    def _skim_plain(self, out: list[bytes | CrclFramingError]) -> bool:
+        """``_skim`` without a Python step per tag, up to the first quote, comment, CDATA
+        or PI (whose tags need ``TOKEN``): there every tag is ``PLAIN_TAG``, and the
+        depth after each is a running sum, found in C (``accumulate``, ``indexOf``).
+        The same tags, depths and cut as ``_skim``'s; True if the root closed."""
+        buf, pos, depth = self._buf, self._pos, self._depth
+        if depth <= 0:
+            return False
+        stop = len(buf)
+        for special in (b'"', b"'", b"<!", b"<?"):
+            found = buf.find(special, pos, stop)
+            if found >= 0:
+                stop = found
+        end = buf.rfind(b">", pos, stop) + 1
+        if end <= pos:
+            return False
+        kinds = PLAIN_TAG.findall(buf, pos, end)
+        steps = list(map(_STEP.__getitem__, kinds))
+        try:
+            closing = operator.indexOf(accumulate(steps, initial=depth), 0)
+        except ValueError:  # the root is still open at ``end``
+            self._pos, self._depth = end, depth + sum(steps)
+            return False
+        tag = next(islice(PLAIN_TAG.finditer(buf, pos, end), closing - 1, None))
+        self._pos, self._depth = tag.end(), 0
+        self._close_tag(out, tag.end())
         return True
 
     def _markup_inside(self, out: list[bytes | CrclFramingError], i: int) -> bool:

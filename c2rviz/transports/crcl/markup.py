@@ -20,6 +20,7 @@ __all__ = [
     "NOT_SPACE",
     "SPACE",
     "TAG_STOP",
+    "PLAIN_TAG",
     "TOKEN",
     "declaration_at",
     "root_at",
@@ -37,6 +38,10 @@ TOKEN: Final = re.compile(
     re.DOTALL,
 )
 """One whole tag (group ``end`` or ``start``), comment, CDATA section or PI."""
+PLAIN_TAG: Final = re.compile(rb"<(?:(/)[^>]*|[A-Za-z_:\x80-\xff][^>]*?(/?))>")
+"""A tag as ``TOKEN`` reads it where there are no quotes, comments, CDATA or PIs:
+groups (``/``, ``""``) an end tag, (``""``, ``""``) a start tag, (``""``, ``/``) an
+empty-element tag."""
 NAME: Final = re.compile(rb"<([A-Za-z_:\x80-\xff][^ \t\r\n/>!?<\"'=]*)")
 MAX_NAME: Final = 256
 SPACE: Final = b" \t\r\n"

@@ -5,7 +5,9 @@ Lengths and angles stay in the units the connection has set (``SetLengthUnits``,
 (see ``units``).
 
 A ``Pose`` is a point and two directions, the tool frame's x and z axes in the base
-frame. They are checked when a pose is built: every component finite, each axis of
+frame. They are checked when a pose is built: every component finite and within
+``±AXIS_COMPONENT_LIMIT`` (a direction needs no more, and its length is then computed
+without overflow), each axis of
 length at least ``MIN_AXIS_NORM`` (a direction, not necessarily of length 1: users
 write ``0.7071`` for 1/sqrt(2); ``units.pose_rotation`` normalises), and the two
 axes orthogonal: the cosine of the angle between them at most
@@ -35,6 +37,8 @@ from .scalars import (
 )
 
 __all__ = [
+    "AXIS_COMPONENT_LIMIT",
+    "POSITION_LIMIT",
     "MIN_AXIS_NORM",
     "ORTHOGONALITY_TOLERANCE",
     "POSE",
@@ -64,6 +68,12 @@ __all__ = [
 ]
 
 MIN_AXIS_NORM: Final = 1e-6
+AXIS_COMPONENT_LIMIT: Final = 1e6
+"""The largest magnitude of a direction's component (``XAxis``, ``ZAxis``)."""
+POSITION_LIMIT: Final = 1e6
+"""The largest magnitude of a point's coordinate in any length unit: the text port's
+1000 m (``protocol.ranges.POSITION_M``) in millimeters, the finest CRCL length unit.
+``units.pose_to_matrix`` holds a point to 1000 m in the connection's own unit."""
 ORTHOGONALITY_TOLERANCE: Final = 1e-3
 
 
@@ -75,6 +85,14 @@ class Point(Record):
     x: float = one("X", DOUBLE)
     y: float = one("Y", DOUBLE)
     z: float = one("Z", DOUBLE)
+
+    def _check(self) -> None:
+        for label, value in zip("XYZ", (self.x, self.y, self.z)):
+            if not abs(value) <= POSITION_LIMIT:
+                raise CrclValueError(
+                    f"{value!r} is out of range: a position lies within 1000 m of the "
+                    f"origin (-{POSITION_LIMIT:g}..{POSITION_LIMIT:g} in millimeters)"
+                ).within(label)
 
 
 @dataclass(frozen=True)
@@ -180,7 +198,12 @@ ROT_ACCEL = Nested(RotAccelAbsolute, RotAccelRelative, abstract=True)
 
 
 def _unit(axis: Vector, name: str) -> tuple[float, float, float]:
-    norm = math.sqrt(axis.i**2 + axis.j**2 + axis.k**2)
+    for label, value in zip("IJK", (axis.i, axis.j, axis.k)):
+        if not abs(value) <= AXIS_COMPONENT_LIMIT:
+            limit = f"{AXIS_COMPONENT_LIMIT:g}"
+            problem = f"{value!r} is out of range: a direction's components lie within "
+            raise CrclValueError(f"{problem}-{limit}..{limit}").within(label).within(name)
+    norm = math.hypot(axis.i, axis.j, axis.k)
     if not norm >= MIN_AXIS_NORM:
         raise CrclValueError(
             f"{name} ({axis.i!r}, {axis.j!r}, {axis.k!r}) is not a direction: "

@@ -11,7 +11,8 @@ Bad input never costs the server or another client (every case gets a ``CRCL_Err
 status whose ``StateDescription`` says what was wrong):
 
 - a malformed or invalid document, text or markup between documents: that error, and
-  the connection goes on with the next document;
+  the connection goes on with the next document (so does a document a bug in c2rviz
+  fails on: ``INTERNAL_ERROR``, and the traceback in the log);
 - a document that stalls half-sent for ``stall_timeout_s``: its bytes are dropped,
   that error, and the connection goes on;
 - what the stream cannot be re-synchronised after (a document over
@@ -22,7 +23,10 @@ status whose ``StateDescription`` says what was wrong):
 - statuses left unread past ``max_unread``: the connection is reset.
 
 A long run of documents in one read is worked through ``TURN_S`` at a time, so one
-client's flood delays the others by no more than that.
+client's flood delays the others by no more than that; a document too large to parse
+in that time (over ``PARSE_ON_LOOP_BYTES``) is parsed on the door's one parsing
+thread (lxml lets go of the interpreter's lock while it parses), big documents of
+every client in the order they came, while the loop serves the others.
 """
 
 from __future__ import annotations
@@ -30,6 +34,7 @@ from __future__ import annotations
 import asyncio
 import logging
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Final
 
@@ -37,11 +42,22 @@ from ...session.services import Services
 from ...session.session import Session
 from .actions import ACTIONS
 from .controller import Controller
+from .documents import CommandInstance, parse_instance
 from .errors import CrclError, CrclFramingError
 from .framing import DocumentSplitter
 from .hardened import MAX_DOCUMENT_BYTES
 
-__all__ = ["DEFAULT_PORT", "LINGER_S", "READ_BYTES", "TURN_S", "CrclLimits", "CrclServer"]
+__all__ = [
+    "DEFAULT_PORT",
+    "LINGER_S",
+    "PARSE_ON_LOOP_BYTES",
+    "READ_BYTES",
+    "REFUSALS_SUMMED_S",
+    "SPLIT_BYTES",
+    "TURN_S",
+    "CrclLimits",
+    "CrclServer",
+]
 
 log = logging.getLogger("c2rviz.crcl")
 
@@ -53,6 +69,18 @@ TURN_S: Final = 0.002
 """Work per client per event-loop turn [s]: then the other clients go first."""
 LINGER_S: Final = 2.0
 """After the close is decided, how long a client's input is read and dropped [s]."""
+REFUSALS_SUMMED_S: Final = 60.0
+"""Refused connections after the first are logged as one count per this interval [s]."""
+SPLIT_BYTES: Final = 16384
+"""Bytes of a read cut into documents at once [bytes]: the splitter scans every tag
+(about 0.5 ms for this many), so a read of ``READ_BYTES`` goes in slices, the other
+clients served between them."""
+PARSE_ON_LOOP_BYTES: Final = 16384
+"""The largest document parsed on the event loop [bytes]: a larger one (a parse runs at
+about 10 MB/s, so past a turn's ``TURN_S``) is parsed on the door's parsing thread
+while the other clients go on, and this client's next documents wait for it."""
+INTERNAL_ERROR: Final = "internal error reading the document (see the server log)"
+"""The description of a document a bug in c2rviz could not run (the connection goes on)."""
 
 
 @dataclass(frozen=True)
@@ -92,6 +120,8 @@ class CrclServer:
         self._open: set[_Connection] = set()
         self._served: set[_Connection] = set()
         self._door = f"crcl {id(self)}"
+        self._refusals = _RefusalLog()
+        self._parsing: ThreadPoolExecutor | None = None
         self.refused = 0
         """Connections turned away (over ``max_connections``, or while stopping)."""
         self.address: tuple[str, int] | None = None
@@ -108,6 +138,7 @@ class CrclServer:
         Raises:
             OSError: the address cannot be listened on.
         """
+        self._parsing = ThreadPoolExecutor(1, thread_name_prefix="c2rviz-crcl-parse")
         self._server = await asyncio.start_server(self._accept, host, port)
         bound = self._server.sockets[0].getsockname()
         self.address = (str(bound[0]), int(bound[1]))
@@ -135,6 +166,10 @@ class CrclServer:
             await asyncio.wait(list(self._tasks), timeout=5.0)
         await self._server.wait_closed()
         self._server = None
+        self._refusals.flush(final=True)
+        if self._parsing is not None:
+            self._parsing.shutdown(wait=False, cancel_futures=True)
+            self._parsing = None
 
     async def _accept(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         task = asyncio.current_task()
@@ -149,7 +184,7 @@ class CrclServer:
         peer = writer.get_extra_info("peername")
         where = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
         session = Session(self.services, f"crcl {where}", self.robot)
-        connection = _Connection(self, reader, writer, session)
+        connection = _Connection(self, reader, writer, session, self._parsing)
         self._open.add(connection)
         try:
             await self._connection(connection, where)
@@ -159,7 +194,7 @@ class CrclServer:
     async def _connection(self, connection: _Connection, where: str) -> None:
         if self._server is None or len(self._served) >= self.limits.max_connections:
             self.refused += 1
-            log.warning("refused CRCL client %s: %d served already", where, len(self._served))
+            self._refusals.refused(where, len(self._served), self.limits.max_connections)
             limit = self.limits.max_connections
             connection.controller.refuse_document(
                 CrclError(f"too many CRCL connections (limit {limit}); closing")
@@ -177,6 +212,50 @@ class CrclServer:
             log.info("CRCL client %s left", where)
 
 
+def _parse(doc: bytes) -> CommandInstance | CrclError:
+    """``parse_instance`` on the parsing thread: the document, or why it is refused."""
+    try:
+        return parse_instance(doc)
+    except CrclError as error:
+        return error
+
+
+class _RefusalLog:
+    """Logs the first connection refused, then how many more each ``REFUSALS_SUMMED_S``
+    (a storm of clients over the cap costs a line a minute, not a line each)."""
+
+    def __init__(self) -> None:
+        self._more = 0
+        self._timer: asyncio.TimerHandle | None = None
+
+    def refused(self, where: str, served: int, limit: int) -> None:
+        if self._timer is None:
+            log.warning(
+                "refused CRCL client %s: %d served already (limit %d); further refusals "
+                "are counted every %g s",
+                where, served, limit, REFUSALS_SUMMED_S,
+            )  # fmt: skip
+            self._timer = asyncio.get_running_loop().call_later(REFUSALS_SUMMED_S, self.flush)
+        else:
+            self._more += 1
+
+    def flush(self, final: bool = False) -> None:
+        """Log the refusals counted since the last line; go on counting unless there were
+        none or this is the ``final`` line (the server stops)."""
+        if self._timer is not None:
+            self._timer.cancel()
+            self._timer = None
+        if self._more:
+            log.warning(
+                "refused %d more CRCL clients (too many connections) in the last %g s at most",
+                self._more, REFUSALS_SUMMED_S,
+            )  # fmt: skip
+            self._more = 0
+            if not final:
+                loop = asyncio.get_running_loop()
+                self._timer = loop.call_later(REFUSALS_SUMMED_S, self.flush)
+
+
 class _Connection:
     """One client: its bytes, its splitter, its controller."""
 
@@ -186,8 +265,10 @@ class _Connection:
         reader: asyncio.StreamReader,
         writer: asyncio.StreamWriter,
         session: Session,
+        parsing: ThreadPoolExecutor | None = None,
     ) -> None:
         self.limits = server.limits
+        self.parsing = parsing
         self.reader, self.writer = reader, writer
         self.splitter = DocumentSplitter(self.limits.max_document_bytes)
         self.controller = Controller(session, self.send, ACTIONS)
@@ -208,14 +289,19 @@ class _Connection:
     async def run(self) -> None:
         loop = asyncio.get_running_loop()
         splitter, limits = self.splitter, self.limits
-        resumed = loop.time()  # the stall clock runs only while we read
+        # The stall clock runs from a document's first byte, however many reads bring the
+        # rest; the time we spend on our own work meanwhile is added (``owed``), since the
+        # client's bytes may be waiting unread in the socket while we work.
+        pending_since: float | None = None
+        owed = 0.0
         try:
             while not self.closing:
                 timeout = None
-                if splitter.pending_bytes:
-                    started = splitter.started_at
-                    began = resumed if started is None else max(started, resumed)
-                    timeout = max(began + limits.stall_timeout_s - loop.time(), 0.0)
+                started = splitter.started_at
+                if splitter.pending_bytes and started is not None:
+                    if started != pending_since:
+                        pending_since, owed = started, 0.0
+                    timeout = max(started + owed + limits.stall_timeout_s - loop.time(), 0.0)
                 try:
                     data = await asyncio.wait_for(self.reader.read(READ_BYTES), timeout)
                 except asyncio.TimeoutError:
@@ -233,8 +319,17 @@ class _Connection:
                     break
                 if not data:
                     break
-                await self._take(splitter.feed(data, loop.time()))
-                resumed = loop.time()
+                fed = loop.time()
+                for start in range(0, len(data), SPLIT_BYTES):
+                    if start:
+                        await asyncio.sleep(0)  # the other clients' turn between slices
+                    if self.closing or splitter.closed:
+                        break
+                    await self._take(splitter.feed(data[start : start + SPLIT_BYTES], fed))
+                if splitter.started_at is not None:
+                    if splitter.started_at != pending_since:
+                        pending_since, owed = splitter.started_at, 0.0
+                    owed += loop.time() - fed
                 if splitter.closed:
                     await self.close()
         finally:
@@ -244,15 +339,31 @@ class _Connection:
                 self.writer.close()
 
     async def _take(self, items: list[bytes | CrclFramingError]) -> None:
-        """Run the documents (and report the errors) of one read, a turn's work at a time."""
+        """Run the documents (and report the errors) of one read, a turn's work at a time;
+        a document over ``PARSE_ON_LOOP_BYTES`` is parsed off the loop meanwhile."""
         started = time.perf_counter()
         for item in items:
             if self.closing:
                 return
             if isinstance(item, CrclFramingError):
                 self.controller.refuse_document(item)
-            else:
-                self.controller.receive(item)
+                continue
+            try:
+                if len(item) > PARSE_ON_LOOP_BYTES and self.parsing is not None:
+                    loop = asyncio.get_running_loop()
+                    parsed = await loop.run_in_executor(self.parsing, _parse, item)
+                    started = time.perf_counter()  # the others had the loop meanwhile
+                    if self.closing:
+                        return
+                    if isinstance(parsed, CrclError):
+                        self.controller.refuse_document(parsed)
+                    else:
+                        self.controller.receive(parsed)
+                else:
+                    self.controller.receive(item)
+            except Exception:  # a bug costs this document, never the connection
+                log.exception("internal error reading a CRCL document")
+                self.controller.refuse_document(CrclError(INTERNAL_ERROR))
             if time.perf_counter() - started > TURN_S:
                 await asyncio.sleep(0)  # the other clients' turn
                 started = time.perf_counter()

@@ -14,6 +14,7 @@ from typing import Final
 import numpy as np
 from numpy.typing import NDArray
 
+from ...protocol.ranges import POSITION_M
 from .errors import CrclValueError
 from .primitives import Point, Pose, Vector
 
@@ -99,11 +100,26 @@ def pose_to_matrix(pose: Pose, length_unit: str = "meter") -> NDArray[np.float64
     Args:
         pose: A pose in ``length_unit``.
         length_unit: The unit its point is in.
+
+    Raises:
+        CrclValueError: A coordinate farther than ``protocol.ranges.POSITION_M``
+            (1000 m) from the origin, as the text port refuses it.
     """
+    factor = length_factor(length_unit)
+    point = pose.point
+    for label, value in zip("XYZ", (point.x, point.y, point.z)):
+        if abs(value * factor) > POSITION_M:
+            raise (
+                CrclValueError(
+                    f"{value:g} {length_unit} is out of range: a position lies within "
+                    f"-{POSITION_M:g}..{POSITION_M:g} m of the origin"
+                )
+                .within(label)
+                .within("Point")
+            )
     matrix = np.eye(4)
     matrix[:3, :3] = pose_rotation(pose)
-    factor = length_factor(length_unit)
-    matrix[:3, 3] = (pose.point.x * factor, pose.point.y * factor, pose.point.z * factor)
+    matrix[:3, 3] = (point.x * factor, point.y * factor, point.z * factor)
     return matrix
 
 

@@ -3,8 +3,10 @@
 Each frame is read by ``protocol.parse_frame`` and served by one method; a
 request that waits (a publish taken by the session, a service call) holds the
 connection's later requests, never another connection's. Every error becomes a
-``status`` naming it, with the request's ``id`` (and, for ``call_service``, a
-``service_response`` with ``result: false``); the connection goes on.
+``status`` naming it, with the request's ``id``, and also where a roslibpy user
+reads it (roslibpy drops ``status`` frames): for ``call_service`` a
+``service_response`` with ``result: false``, otherwise ``error: ...`` on the
+client's own subscription to ``[NS]/c2rviz/reply``; the connection goes on.
 """
 
 from __future__ import annotations
@@ -13,21 +15,30 @@ import asyncio
 import logging
 from collections import Counter
 from collections.abc import Callable
+from concurrent.futures import Executor
 from typing import Any, Protocol
 
 from websockets.asyncio.server import ServerConnection
 from websockets.exceptions import ConnectionClosed
 
 from ...errors import C2rvizError
-from . import protocol, rosapi
+from . import messages, protocol, rosapi
 from .bridge import Bridge
+from .command_lines import CommandRefused
 from .outbox import Outbox
 from .policy import RosbridgePolicy
 from .protocol import LEVELS, SUPPORTED_OPS, FrameId, RosbridgeError, resolve_name
 
-__all__ = ["Connection", "Host"]
+__all__ = ["DECODE_ON_LOOP_BYTES", "Connection", "Host"]
 
 log = logging.getLogger("c2rviz.rosbridge")
+
+DECODE_ON_LOOP_BYTES = 16384
+"""The largest frame decoded on the event loop [bytes]; a larger one (a trajectory of
+thousands of points) is decoded and its message read on the server's decoding thread,
+the other clients served meanwhile, this client's next frames after it."""
+REPLY_TOPIC = "/c2rviz/reply"
+"""The reply topic's name under each robot's namespace (``[NS]/c2rviz/reply``)."""
 
 
 class Host(Protocol):
@@ -37,10 +48,22 @@ class Host(Protocol):
     policy: RosbridgePolicy
     stats: Counter[str]
     sent_probe: Callable[[float], None] | None
+    decoding: Executor | None
 
     def graph(self) -> rosapi.Graph: ...
 
     def encode(self, spelling: str, msg: dict[str, Any]) -> str | None: ...
+
+
+def _decode(text: str, topics: dict[str, str]) -> tuple[protocol.Op, object]:
+    """Off the loop: the frame's request and, for a publish to a topic whose message
+    c2rviz reads (a trajectory, a joint state), that reading (``messages.read_ahead``)."""
+    op = protocol.parse_frame(text)
+    if isinstance(op, protocol.Publish):
+        kind = topics.get(resolve_name(op.topic))
+        if kind is not None:
+            return op, messages.read_ahead(kind, op.msg)
+    return op, None
 
 
 class Connection:
@@ -114,18 +137,31 @@ class Connection:
 
     async def handle_text(self, text: str) -> None:
         op: protocol.Op | None = None
+        reading: object = None
         try:
-            op = protocol.parse_frame(text)
-            await self.serve(op)
+            decoding = self.server.decoding
+            if len(text) > DECODE_ON_LOOP_BYTES and decoding is not None:
+                topics = dict(self.server.graph().topics)
+                loop = asyncio.get_running_loop()
+                decoded, reading = await loop.run_in_executor(decoding, _decode, text, topics)
+            else:
+                decoded = protocol.parse_frame(text)
+            op = decoded
+            if reading is not None and isinstance(decoded, protocol.Publish):
+                messages.remember(decoded.msg, reading)
+            await self.serve(decoded)
         except (asyncio.CancelledError, ConnectionClosed):
             raise
         except RosbridgeError as error:
-            await self.refuse(error)
+            await self.refuse(error, op)
         except C2rvizError as error:
             await self.refuse(error, op)
         except Exception:
             log.exception("rosbridge: %s failed on %s", self.source, text[:200])
             await self.refuse(C2rvizError("internal error in c2rviz (see its log)"), op)
+        finally:
+            if reading is not None and isinstance(op, protocol.Publish):
+                messages.forget(op.msg)
 
     async def serve(self, op: protocol.Op) -> None:
         if isinstance(op, protocol.Subscribe):
@@ -190,6 +226,7 @@ class Connection:
             server.stats,
             server.sent_probe,
             snapshot=lambda: self.bridge.snapshot(name),
+            unthrottled_length=self.policy.max_queue_length,
         )
         outbox.request(op.id, op.throttle_rate_ms, length)
         outbox.handle = self.bridge.subscribe(name, outbox.deliver)
@@ -248,18 +285,42 @@ class Connection:
         await self.send(protocol.service_response(op.id, op.service, values, True))
 
     async def refuse(self, error: C2rvizError, op: protocol.Op | None = None) -> None:
-        """Answer a refused request: a status error (and a failed service_response)."""
+        """Answer a refused request: a status error, and where a roslibpy user reads it
+        (roslibpy has no handler for ``status``): a failed service_response for a
+        service call, else an ``error: ...`` line on the reply topic this client
+        subscribes to (``[NS]/c2rviz/reply``), as the text port would answer."""
         self.server.stats["errors"] += 1
         if isinstance(error, RosbridgeError):
             id, text = error.id, str(error)
             if error.op == "call_service" and error.service is not None:
                 await self.send(protocol.service_response(id, error.service, text, False))
+            elif error.op != "call_service":
+                self.reply_error(text, getattr(op, "topic", None))
         else:
             id = op.id if op is not None else None
             what = protocol.op_name(op) if op is not None else "request"
             target = getattr(op, "topic", None) or getattr(op, "service", None)
             text = f"{what} {target}: {error}" if target else f"{what}: {error}"
+            if not isinstance(error, CommandRefused):  # its reply is on the topic already
+                self.reply_error(text, getattr(op, "topic", None))
         await self.status("error", text, id)
+
+    def reply_error(self, text: str, topic: str | None) -> None:
+        """Put ``error: text`` on this client's reply subscription for ``topic``'s robot
+        (its namespace; every reply subscription when the frame named no topic)."""
+        replies = {
+            name.removesuffix(REPLY_TOPIC): outbox
+            for name, outbox in ((resolve_name(t), o) for t, o in self.outboxes.items())
+            if name == REPLY_TOPIC or name.endswith(REPLY_TOPIC)
+        }
+        if topic is not None:
+            where = resolve_name(topic)
+            matching = [ns for ns in replies if where.startswith(ns + "/")]
+            chosen = [max(matching, key=len)] if matching else []
+        else:
+            chosen = list(replies)
+        for namespace in chosen:
+            replies[namespace].deliver({"data": f"error: {text}"})
 
     async def status(self, level: str, text: str, id: FrameId) -> None:
         if LEVELS.index(level) <= LEVELS.index(self.level):

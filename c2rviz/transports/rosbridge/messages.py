@@ -6,13 +6,17 @@ either. The readers check one JSON message (as a dict) against its type and
 return a small frozen dataclass in SI units (positions in [rad] or [m], times
 in [s]); an error names the field, e.g. ``points[3].time_from_start is not
 after points[2]``. Fields a type does not have are refused, as rosbridge does.
+
+A large message is read off the event loop (``read_ahead``, by the connection that
+decoded its frame there); ``remember`` keeps that reading so the reader, called
+again on the loop with the very same message, returns it without reading twice.
 """
 
 from __future__ import annotations
 
 import math
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -30,9 +34,12 @@ __all__ = [
     "TypeNameError",
     "command_request",
     "command_response",
+    "forget",
     "joint_positions",
     "joint_trajectory",
     "normalize_type",
+    "read_ahead",
+    "remember",
     "same_type",
     "string_data",
 ]
@@ -136,6 +143,45 @@ class JointTrajectory:
     points: tuple[TrajectoryPoint, ...]
 
 
+_READ_AHEAD: dict[int, tuple[Mapping[str, Any], object]] = {}
+"""Messages read already (off the event loop, ``read_ahead``), by ``id``: the message
+and its reading (or its ``MessageError``), until ``forget``."""
+
+
+def read_ahead(type_name: str, msg: Mapping[str, Any]) -> object:
+    """Read ``msg`` as ``type_name`` (on any thread): the dataclass its reader gives, the
+    ``MessageError`` it raises, or None when c2rviz has no reader for the type."""
+    reader = _READERS.get(type_name)
+    if reader is None:
+        return None
+    try:
+        return reader(msg)
+    except MessageError as error:
+        return error
+
+
+def remember(msg: Mapping[str, Any], reading: object) -> None:
+    """Keep what ``read_ahead`` gave for ``msg``: its reader then returns (or raises) it
+    at once instead of reading ``msg`` again (on the event loop)."""
+    _READ_AHEAD[id(msg)] = (msg, reading)
+
+
+def forget(msg: Mapping[str, Any]) -> None:
+    """Drop what ``remember`` kept for ``msg``."""
+    _READ_AHEAD.pop(id(msg), None)
+
+
+def _known(msg: Mapping[str, Any], kind: type, type_name: str) -> Any:
+    """The reading ``remember`` kept for this very message as ``type_name`` (a ``kind``,
+    or its ``MessageError``, raised); else None."""
+    kept = _READ_AHEAD.get(id(msg))
+    if kept is None or kept[0] is not msg:
+        return None
+    if isinstance(kept[1], MessageError) and kept[1].type_name == type_name:
+        raise kept[1]
+    return kept[1] if isinstance(kept[1], kind) else None
+
+
 class _Reader:
     """Checks fields of one message of ``type_name``; every error names its field."""
 
@@ -189,7 +235,10 @@ class _Reader:
     def number(self, value: object, field: str) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise self.error(field, "must be a number")
-        number = float(value)
+        try:
+            number = float(value)
+        except OverflowError:  # an integer of hundreds of digits: JSON allows it
+            raise self.error(field, "is an integer too large for a float64") from None
         if not math.isfinite(number):
             raise self.error(field, f"is not finite ({number})")
         return number
@@ -238,6 +287,9 @@ def joint_positions(msg: Mapping[str, Any]) -> JointPositions:
     ``name`` and ``position`` are needed and of one length; ``velocity`` and
     ``effort`` may be empty or absent, else of that length too (checked, not used).
     """
+    known = _known(msg, JointPositions, JOINT_STATE)
+    if known is not None:
+        return known  # type: ignore[no-any-return]
     reader = _Reader(JOINT_STATE)
     fields = reader.fields(msg, "", ("header", "name", "position", "velocity", "effort"))
     reader.header(fields.get("header"), "header")
@@ -255,6 +307,9 @@ def joint_trajectory(msg: Mapping[str, Any]) -> JointTrajectory:
     times are at least 0 and strictly increase; ``velocities``,
     ``accelerations`` and ``effort`` may be empty, else one per joint.
     """
+    known = _known(msg, JointTrajectory, JOINT_TRAJECTORY)
+    if known is not None:
+        return known  # type: ignore[no-any-return]
     reader = _Reader(JOINT_TRAJECTORY)
     fields = reader.fields(msg, "", ("header", "joint_names", "points"))
     reader.header(fields.get("header"), "header")
@@ -280,6 +335,12 @@ def joint_trajectory(msg: Mapping[str, Any]) -> JointTrajectory:
         reader.numbers(point.get("effort"), f"{at}.effort", len(names), True)
         points.append(TrajectoryPoint(positions, time_s, velocities or None, accelerations or None))
     return JointTrajectory(names, tuple(points))
+
+
+_READERS: dict[str, Callable[[Mapping[str, Any]], object]] = {
+    JOINT_STATE: joint_positions,
+    JOINT_TRAJECTORY: joint_trajectory,
+}
 
 
 def command_request(args: Mapping[str, Any]) -> str:

@@ -6,11 +6,15 @@ listener of a topic for each ``publish`` frame, so two frames per message
 would reach each listener twice. Of its requests the subscription takes the
 lowest ``throttle_rate`` and the highest ``queue_length``, as rosbridge does.
 
-The outbox holds at most ``queue_length`` messages (at least one); a message
-that arrives when it is full pushes out the oldest (latest wins, counted as
-``thinned``). A subscriber that reads slowly, or a throttle, thus thins the
-stream and never grows memory: the websocket's write buffer (``write_limit``)
-plus this outbox is all a subscriber can hold.
+As in rosbridge_suite, ``queue_length`` buffers what a throttle holds back, and
+only then: a subscription without a throttle (roslibpy's default, with its
+default ``queue_length`` 0) is sent every message, and its outbox holds up to
+``unthrottled_length`` messages (the server's largest ``queue_length``) for a
+subscriber that reads more slowly than they come. The outbox holds at most that
+many messages (at least one); a message that arrives when it is full pushes out
+the oldest (latest wins, counted as ``thinned``). A subscriber that reads slowly,
+or a throttle, thus thins the stream and never grows memory: the websocket's
+write buffer (``write_limit``) plus this outbox is all a subscriber can hold.
 
 Latest wins only where each message is whole (a joint state). A topic whose
 messages are changes (markers added, deleted) gives a ``snapshot``: once a
@@ -52,6 +56,8 @@ class Outbox:
             just after its frame was written; for benchmarks, None otherwise.
         snapshot: Gives the topic's whole state (None: its messages are whole),
             sent instead of what waits after a message was pushed out.
+        unthrottled_length: The messages held for a subscription without a
+            throttle, whatever ``queue_length`` it asked (rosbridge ignores it then).
     """
 
     def __init__(
@@ -62,8 +68,10 @@ class Outbox:
         stats: Counter[str],
         sent_probe: Callable[[float], None] | None = None,
         snapshot: Callable[[], dict[str, Any] | None] | None = None,
+        unthrottled_length: int = 100,
     ) -> None:
         self.spelling = spelling
+        self.unthrottled_length = unthrottled_length
         self._snapshot = snapshot
         self._behind = False  # a message was pushed out: send the snapshot next
         self.handle: object = None
@@ -103,7 +111,10 @@ class Outbox:
 
     def _settle(self) -> None:
         self._throttle_s = min(t for t, _ in self.requests.values()) / 1000.0
-        length = max(1, max(q for _, q in self.requests.values()))
+        if self._throttle_s > 0:
+            length = max(1, max(q for _, q in self.requests.values()))
+        else:  # queue_length buffers what a throttle holds back; without one, send all
+            length = max(1, self.unthrottled_length)
         if length != self._queue.maxlen:
             self._queue = deque(self._queue, maxlen=length)
 

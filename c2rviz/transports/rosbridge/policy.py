@@ -48,9 +48,17 @@ class RosbridgePolicy:
         max_subscriptions: Subscriptions (by id) per connection, and as many
             advertised topics; one more is answered with a status error.
         max_queue_length: Largest ``queue_length`` a subscription gets; a
-            larger request is cut to it (with a status warning).
+            larger request is cut to it (with a status warning). A subscription
+            without a ``throttle_rate`` is sent every message (its
+            ``queue_length`` ignored, as rosbridge does) and holds this many for
+            a slow reader.
         compression: Offer permessage-deflate; off by default (it costs CPU
             per subscriber and frames are small on loopback).
+        max_read_ahead: Frames a connection reads ahead of the one it serves
+            (websockets' ``max_queue``): past it, the server stops reading that
+            connection until it catches up, so a client piling up frames while
+            its service call waits holds about this many frames of memory
+            (``max_frame_bytes`` each), not sixteen.
     """
 
     extra_origins: tuple[str, ...] = ()
@@ -60,6 +68,7 @@ class RosbridgePolicy:
     max_subscriptions: int = 64
     max_queue_length: int = 100
     compression: bool = False
+    max_read_ahead: int = 2
 
     def __post_init__(self) -> None:
         for origin in self.extra_origins:
@@ -69,7 +78,7 @@ class RosbridgePolicy:
             self.token and self.token.isascii() and self.token.isprintable()
         ):
             raise PolicyError("token", self.token, "non-empty printable ASCII")
-        for name in ("max_frame_bytes", "max_connections", "max_subscriptions"):
+        for name in ("max_frame_bytes", "max_connections", "max_subscriptions", "max_read_ahead"):
             if getattr(self, name) < 1:
                 raise PolicyError(name.replace("_", " "), getattr(self, name), "at least 1")
         if self.max_queue_length < 0:

@@ -20,13 +20,19 @@ Every error is answered with a ``status`` naming the problem and the request's
 ``id``; the connection goes on. Frames over ``max_frame_bytes`` close the
 connection with code 1009, one connection over ``max_connections`` is closed
 with 1013. Binary frames are answered with a status: c2rviz speaks JSON text.
+A connection is read at most ``max_read_ahead`` frames ahead of the one served
+(then reading it stops until it catches up: the client's sends wait, as TCP
+makes them). A client that does not let its connection close (it never reads) is dropped
+after ``CLOSE_TIMEOUT_S``.
 """
 
 from __future__ import annotations
 
+import asyncio
 import logging
 from collections import Counter
 from collections.abc import Callable
+from concurrent.futures import Executor, ThreadPoolExecutor
 from http import HTTPStatus
 from typing import Any
 
@@ -40,9 +46,14 @@ from .connection import Connection
 from .messages import normalize_type
 from .policy import RosbridgePolicy
 
-__all__ = ["RosbridgeServer"]
+__all__ = ["CLOSE_TIMEOUT_S", "RosbridgeServer"]
 
 log = logging.getLogger("c2rviz.rosbridge")
+
+CLOSE_TIMEOUT_S = 1.0
+"""Longest wait for a client to answer the closing handshake (at shutdown, or when a
+connection is closed) before its connection is dropped [s]: a client that never
+reads cannot hold the program's stop longer (websockets' default is 10 s)."""
 
 
 class RosbridgeServer:
@@ -77,15 +88,21 @@ class RosbridgeServer:
         self._server: Server | None = None
         self._connections: set[Connection] = set()
         self._encoded: dict[str, tuple[dict[str, Any], str]] = {}
+        self.decoding: Executor | None = None
+        """The thread large frames are decoded on (``connection.DECODE_ON_LOOP_BYTES``),
+        one for every client, in the order they came; while the server runs."""
 
     async def start(self, host: str = "127.0.0.1", port: int = 9090) -> tuple[str, int]:
         """Listen on ``host:port`` (0: any free port); return the address bound."""
+        self.decoding = ThreadPoolExecutor(1, thread_name_prefix="c2rviz-rosbridge-decode")
         self._server = await serve(
             self._handle,
             host,
             port,
             process_request=self._screen,
             max_size=self.policy.max_frame_bytes,
+            max_queue=self.policy.max_read_ahead,
+            close_timeout=CLOSE_TIMEOUT_S,
             compression="deflate" if self.policy.compression else None,
         )
         bound = next(iter(self._server.sockets)).getsockname()
@@ -95,14 +112,24 @@ class RosbridgeServer:
         """Close every connection (code 1001) and the listening socket; idempotent.
 
         A request still being served (a service call that waits on a motion) is
-        given up: its client gets no answer, the connection closes.
+        given up: its client gets no answer, the connection closes. A client that
+        has not let its connection close within ``CLOSE_TIMEOUT_S`` (it never reads,
+        so a send and the closing handshake wait on it) is dropped.
         """
         if self._server is not None:
             for connection in self._connections:
                 connection.stop()
             self._server.close()
-            await self._server.wait_closed()
+            closed = asyncio.ensure_future(self._server.wait_closed())
+            await asyncio.wait((closed,), timeout=CLOSE_TIMEOUT_S)
+            if not closed.done():  # a client that never reads holds a send, and the close
+                for websocket in list(self._server.handlers):
+                    websocket.transport.abort()
+                await closed
             self._server = None
+        if self.decoding is not None:
+            self.decoding.shutdown(wait=False, cancel_futures=True)
+            self.decoding = None
 
     async def __aenter__(self) -> RosbridgeServer:
         return self

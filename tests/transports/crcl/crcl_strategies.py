@@ -20,12 +20,14 @@ from c2rviz.transports.crcl import (
     CrclStatus,
     JointStatuses,
     MoveThroughTo,
+    Point,
     Pose,
     PoseAndSet,
     Vector,
     record_fields,
 )
 from c2rviz.transports.crcl.binding import MANY, OPTIONAL, Nested, Record
+from c2rviz.transports.crcl.primitives import POSITION_LIMIT
 from c2rviz.transports.crcl.scalars import (
     BOOLEAN,
     COMMAND_ID,
@@ -107,6 +109,9 @@ def _fields(cls: type[Record]) -> st.SearchStrategy[dict[str, Any]]:
             parts[f.name] = st.none() | one
         else:
             parts[f.name] = one
+    if cls is Point:  # a position lies within 1000 m in any length unit
+        coordinate = st.floats(-POSITION_LIMIT, POSITION_LIMIT)
+        parts = {"x": coordinate, "y": coordinate, "z": coordinate}
     if issubclass(cls, Pose):
         parts.pop("x_axis")
         parts.pop("z_axis")

@@ -191,7 +191,7 @@ def test_a_latched_topic_comes_at_once(rosbridge: ServerThread, client: ClientCo
 def test_latest_wins_when_messages_come_faster_than_they_go(
     rosbridge: ServerThread, client: ClientConnection
 ) -> None:
-    subscribe(client, rosbridge, "/counter")
+    subscribe(client, rosbridge, "/counter", throttle_rate=1)  # a throttle: latest wins
     rosbridge.call(rosbridge.bridge.tick, 6)  # six messages before the outbox can send one
     assert receive(client)["msg"] == {"data": "6"}
     assert rosbridge.server.stats["thinned"] == 5
@@ -201,7 +201,7 @@ def test_a_topic_of_changes_sends_its_whole_state_after_a_thinning(
     rosbridge: ServerThread, client: ClientConnection
 ) -> None:
     rosbridge.bridge.changes = True  # /counter's messages are changes now (as markers are)
-    subscribe(client, rosbridge, "/counter")
+    subscribe(client, rosbridge, "/counter", throttle_rate=1)
     rosbridge.call(rosbridge.bridge.tick, 6)  # six before the outbox can send one: 5 pushed out
     assert receive(client)["msg"] == {"data": "all 6"}  # the whole state, not the last change
     rosbridge.call(rosbridge.bridge.tick)
@@ -212,7 +212,7 @@ def test_a_topic_of_changes_sends_its_whole_state_after_a_thinning(
 def test_queue_length_keeps_the_newest_few(
     rosbridge: ServerThread, client: ClientConnection
 ) -> None:
-    subscribe(client, rosbridge, "/counter", queue_length=3)
+    subscribe(client, rosbridge, "/counter", throttle_rate=1, queue_length=3)
     rosbridge.call(rosbridge.bridge.tick, 5)
     assert [receive(client)["msg"]["data"] for _ in range(3)] == ["3", "4", "5"]
     assert rosbridge.server.stats["thinned"] == 2
