@@ -87,7 +87,8 @@ class Instruments:
         self.ghosts: dict[str, RobotGhost] = {}
         for name, state in world.robots.items():
             objects = self._objects_now(name)
-            self.histories[name] = RobotHistory(state, world.frame_s, origin, objects)
+            resting = not world.moving(name)
+            self.histories[name] = RobotHistory(state, world.frame_s, origin, objects, resting)
             with panels[name].folder:
                 self.readouts[name] = RobotReadout(server.gui, state.robot, len(world.robots))
                 self.plots[name] = RobotPlots(
@@ -136,7 +137,7 @@ class Instruments:
     def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
         history = self.histories.get(robot)
         if history is not None:
-            history.add(q, t)
+            history.add(q, t, not self.world.moving(robot))
             self._reread.add(robot)
 
     def on_marker(self, robot: str, marker: Marker) -> None:

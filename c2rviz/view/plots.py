@@ -70,12 +70,21 @@ def legend(robot: Robot) -> str:
     return f"{keys} <span style='color:#888'>(dashed: its limits)</span>"
 
 
-def thin(count: int, points: int = PLOT_POINTS) -> np.ndarray:
+def thin(count: int, points: int = PLOT_POINTS, times: np.ndarray | None = None) -> np.ndarray:
     """Indices of at most ``points`` samples of ``count``, evenly spread, first and last
-    kept."""
+    kept. With the samples' ``times`` [s], the corners of each long pause (more than two
+    thinned steps without a sample: the arm at rest) are kept too, at most ``points // 2``
+    of them, so a step after a rest stays a step (``history``) rather than a ramp across
+    the pause."""
     if count <= points:
         return np.arange(count)
-    return np.unique(np.linspace(0, count - 1, points).round().astype(int))
+    corners = np.zeros(0, dtype=int)
+    if times is not None and count > 1:
+        pauses = np.flatnonzero(np.diff(times) > 2.0 * (times[-1] - times[0]) / points)
+        ends = np.concatenate([pauses, pauses + 1, np.minimum(pauses + 2, count - 1)])
+        corners = np.unique(ends)[: points // 2]
+    even = np.linspace(0, count - 1, points - len(corners)).round().astype(int)
+    return np.unique(np.concatenate([even, corners]))
 
 
 class RobotPlots:
@@ -203,7 +212,7 @@ class RobotPlots:
         self.draws += 1
         self.drawn_s = end_s
         window = history.window(end_s - float(self.window.value), end_s)
-        picked = thin(len(window))
+        picked = thin(len(window), PLOT_POINTS, window.times)
         times = window.times[picked]
         x = times - self.origin_s
         chosen = self.chosen()
@@ -215,7 +224,7 @@ class RobotPlots:
         columns = list(chosen)
         previous = np.maximum(picked - 1, 0)
         dt = window.times[picked] - window.times[previous]
-        dt[dt <= 0.0] = np.inf  # the first sample: no velocity known, show 0
+        dt[dt <= 0.0] = np.inf  # the first sample, or a step (two at one time): show 0
         if columns:
             values = window.qs[picked][:, columns] * self._scale[columns]
             limits = self._limit_values(chosen, len(x))
