@@ -91,8 +91,13 @@ class Instruments:
             self.histories[name] = RobotHistory(state, world.frame_s, origin, objects, resting)
             with panels[name].folder:
                 self.readouts[name] = RobotReadout(server.gui, state.robot, len(world.robots))
-                self.plots[name] = RobotPlots(
-                    server.gui, state.robot, origin, velocities, len(world.robots)
+                self.plots[name] = RobotPlots(  # right after the buttons: on a 900 px screen
+                    server.gui,
+                    state.robot,
+                    origin,
+                    velocities,
+                    len(world.robots),
+                    order=panels[name].buttons["stop"].order + 0.5,
                 )
             self.ghosts[name] = RobotGhost(server, views[name])
         self.timeline = timeline

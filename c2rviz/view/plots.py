@@ -112,16 +112,46 @@ class RobotPlots:
         origin_s: float,
         velocities: bool,
         robots: int = 1,
+        order: float | None = None,
     ) -> None:
         """Add the charts to the folder open in ``gui``; times are plotted in seconds from
         ``origin_s`` (the server's start, as ``watch``) [s of the clock]; ``robots`` is how
-        many robots' charts share ``PLOTS_PER_S``."""
+        many robots' charts share ``PLOTS_PER_S``; ``order``: where the ``Plots`` folder
+        stands among the folder's rows (viser's order; None: last)."""
         self.robot = robot
         self.period_s = max(1.0 / PLOT_HZ, robots / PLOTS_PER_S)
         self.origin_s = origin_s
         self._scale = np.array([1.0 if j.prismatic else 180.0 / math.pi for j in robot.joints])
         self._units = ["m" if j.prismatic else "deg" for j in robot.joints]
-        with gui.add_folder("Plots", expand_by_default=True):
+        with gui.add_folder("Plots", expand_by_default=True, order=order):
+            # the charts first, their controls under them: a 900 px screen shows them
+            self.legend: Any = gui.add_markdown(legend(robot))
+            empty = (np.zeros(1), *(np.zeros(1) for _ in robot.joints))
+            self.positions: Any = gui.add_uplot(
+                empty,
+                (_X, *self._joint_series(range(robot.n))),
+                title=f"joints [{self._unit_text()}]",
+                scales=_SCALES,
+                legend=uplot.Legend(show=False),  # the colours are in ``legend``, once
+                aspect=1.6,
+            )
+            self.speeds: Any = gui.add_uplot(
+                empty,
+                (_X, *self._joint_series(range(robot.n))),
+                title=f"velocities [{self._unit_text()}/s]",
+                scales=_SCALES,
+                legend=uplot.Legend(show=False),
+                aspect=1.8,
+                visible=velocities,
+            )
+            self.tool_speed: Any = gui.add_uplot(
+                (np.zeros(1), np.zeros(1)),
+                (_X, uplot.Series(label="tool m/s", stroke="#444444", width=1.5)),
+                title="tool point speed [m/s]",
+                scales=_SCALES,
+                legend=uplot.Legend(show=False),
+                aspect=2.4,
+            )
             self.shown: Any = gui.add_checkbox(
                 "Plots", True, hint="update the charts (off: they cost the server nothing)"
             )
@@ -145,33 +175,6 @@ class RobotPlots:
                     gui.add_checkbox(short_label(j.name), True, hint=f"plot {j.name}")
                     for j in robot.joints
                 ]
-            self.legend: Any = gui.add_markdown(legend(robot))
-            empty = (np.zeros(1), *(np.zeros(1) for _ in robot.joints))
-            self.positions: Any = gui.add_uplot(
-                empty,
-                (_X, *self._joint_series(range(robot.n))),
-                title=f"joints [{self._unit_text()}]",
-                scales=_SCALES,
-                legend=uplot.Legend(show=False),  # the colours are in ``legend``, once
-                aspect=1.4,
-            )
-            self.speeds: Any = gui.add_uplot(
-                empty,
-                (_X, *self._joint_series(range(robot.n))),
-                title=f"velocities [{self._unit_text()}/s]",
-                scales=_SCALES,
-                legend=uplot.Legend(show=False),
-                aspect=1.8,
-                visible=velocities,
-            )
-            self.tool_speed: Any = gui.add_uplot(
-                (np.zeros(1), np.zeros(1)),
-                (_X, uplot.Series(label="tool m/s", stroke="#444444", width=1.5)),
-                title="tool point speed [m/s]",
-                scales=_SCALES,
-                legend=uplot.Legend(show=False),
-                aspect=2.4,
-            )
         self._chosen: tuple[int, ...] | None = None  # the series are set at the first draw
         self._limits: tuple[tuple[tuple[int, ...], int], list[np.ndarray]] | None = None
         self._last_draw = -math.inf
