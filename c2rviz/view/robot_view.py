@@ -26,6 +26,7 @@ import numpy as np
 import pinocchio as pin
 import viser
 
+from ..robot.mesh_files import Mesh
 from ..robot.model import Robot
 from ..robot.visuals import LinkGeometry, Shape
 from . import adapter
@@ -263,9 +264,13 @@ class RobotView:
         }
         if shape.rgba is None:  # a mesh with colours of its own
             assert shape.mesh is not None
-            if not ghost:
+            if ghost:
+                rgb, alpha = GHOST_GREY, 1.0
+            elif isinstance(shape.mesh, Mesh):  # an STL's or OBJ's: one colour of its own
+                assert shape.mesh.rgba is not None
+                rgb, alpha = shape.mesh.rgba[:3], shape.mesh.rgba[3]
+            else:
                 return scene.add_mesh_trimesh(name, shape.mesh, **common)
-            rgb, alpha = GHOST_GREY, 1.0
         else:
             rgb, alpha = shape.rgba[:3], shape.rgba[3]
         if ghost:

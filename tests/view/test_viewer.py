@@ -24,6 +24,7 @@ import yourdfpy
 from support import ROBOTS, ROOT, load_robot
 from viewer_tabs import Harness
 
+from c2rviz.robot.mesh_files import Mesh
 from c2rviz.robot.model import Robot
 from c2rviz.robot.visuals import load_link_geometry
 from c2rviz.session import Services
@@ -466,8 +467,8 @@ def test_a_urdf_material_wins_over_the_mesh_files_own_colour(
     [base], [tip] = links["base"].visual, links["tip"].visual
     assert base.mesh is not None and tip.mesh is not None
     for shape in (base, tip):  # the .mtl was read: the file has a colour of its own
-        assert shape.mesh is not None and shape.mesh.visual.defined
-        assert list(shape.mesh.visual.material.main_color) == [230, 230, 230, 255]
+        assert isinstance(shape.mesh, Mesh) and shape.mesh.rgba is not None
+        assert list(np.round(np.array(shape.mesh.rgba) * 255)) == [230, 230, 230, 255]
     assert base.rgba == pytest.approx((1.0, 0.423529411765, 0.0392156862745, 1.0))
     assert tip.rgba is None  # no URDF material: the file's colour is kept
     nodes = harness(robot).scene.server.scene._handle_from_node_name
