@@ -93,7 +93,8 @@ import sys
 from c2rviz.robot.model import Robot
 from c2rviz.robot.visuals import load_link_geometry
 for urdf in sys.argv[1:]:
-    links = load_link_geometry(Robot.from_urdf(urdf, eelink="tool0" if "tree" in urdf else None).source)
+    robot = Robot.from_urdf(urdf, eelink="tool0" if "tree" in urdf else None)
+    links = load_link_geometry(robot.source)
     meshes = [s.mesh for g in links.values() for s in g.visual if s.mesh is not None]
     print(urdf, len(meshes), sorted({type(m).__name__ for m in meshes}))
 print("trimesh loaded:", "trimesh" in sys.modules)
