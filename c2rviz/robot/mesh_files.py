@@ -1,10 +1,12 @@
-"""STL and OBJ mesh files read with numpy alone (trimesh takes half a second to import).
+"""STL, OBJ and COLLADA mesh files read with numpy (trimesh takes half a second to import).
 
 A robot's page is built at the program's start, so reading its mesh files must not
-pay for a mesh library: ``read_mesh`` reads the two formats robot descriptions use
-most, STL (binary or ASCII) and Wavefront OBJ (its ``.mtl`` diffuse colours, one
-piece per material), into ``Mesh`` pieces; ``visuals`` hands any other format
-(COLLADA ``.dae``, ``.ply``, glTF ...) to trimesh, imported then. As trimesh does,
+pay for a mesh library: ``read_mesh`` reads the formats robot descriptions use most,
+STL (binary or ASCII), Wavefront OBJ (its ``.mtl`` diffuse colours, one piece per
+material) and COLLADA ``.dae`` (``collada``: one piece per primitive and placement, in
+its material's diffuse colour), into ``Mesh`` pieces; ``visuals`` hands any other
+format (``.ply``, glTF ...), and a file these readers refuse (a texture, say), to
+trimesh, imported then. As trimesh does,
 an STL's corners shared by several triangles become one vertex (so the page shades
 it smooth), and an OBJ keeps its own vertices. ``tests/robot/test_mesh_files.py``
 holds both to trimesh's reading of the same files.
@@ -14,39 +16,18 @@ from __future__ import annotations
 
 import os
 import re
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["FORMATS", "Mesh", "MeshFileError", "read_mesh"]
+from .collada import read_collada
+from .mesh import Mesh, MeshFileError
 
-FORMATS = (".stl", ".obj")
+__all__ = ["FORMATS", "Mesh", "MeshFileError", "merged", "read_mesh"]
+
+FORMATS = (".stl", ".obj", ".dae")
 """The suffixes read here (any case); others go to trimesh."""
 _MAX_BYTES = 512 * 1024 * 1024  # a mesh file this big is refused (trimesh is asked)
-
-
-class MeshFileError(ValueError):
-    """A mesh file this reader cannot read (trimesh then tries it)."""
-
-
-@dataclass(frozen=True, eq=False)
-class Mesh:
-    """Triangles: ``vertices`` (k, 3) [m, after scale], ``faces`` (m, 3) indices into them,
-    and the file's own colour ``rgba`` (an OBJ material's; None: the file has none)."""
-
-    vertices: np.ndarray
-    faces: np.ndarray
-    rgba: tuple[float, float, float, float] | None = None
-
-    @property
-    def extents(self) -> np.ndarray:
-        """The size of its bounding box along x, y, z."""
-        return np.ptp(self.vertices, axis=0) if len(self.vertices) else np.zeros(3)
-
-    def scaled(self, factors: np.ndarray) -> Mesh:
-        """The same mesh with each axis scaled by ``factors`` (3,)."""
-        return Mesh(self.vertices * np.asarray(factors, dtype=float), self.faces, self.rgba)
 
 
 def read_mesh(path: Path) -> list[Mesh]:
@@ -62,7 +43,10 @@ def read_mesh(path: Path) -> list[Mesh]:
     if os.path.getsize(path) > _MAX_BYTES:
         raise MeshFileError(f"{path.name}: larger than {_MAX_BYTES} bytes")
     data = path.read_bytes()
-    pieces = _stl(data) if suffix == ".stl" else _obj(data, path.parent)
+    if suffix == ".dae":
+        pieces = read_collada(data)
+    else:
+        pieces = _stl(data) if suffix == ".stl" else _obj(data, path.parent)
     pieces = [p for p in pieces if len(p.faces)]
     if not pieces:
         raise MeshFileError(f"{path.name}: no triangles")
@@ -75,17 +59,17 @@ def _stl(data: bytes) -> list[Mesh]:
         if 84 + 50 * count == len(data):  # binary: 50 bytes a triangle
             record = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
             corners = np.frombuffer(data, record, count, 84)["v"].reshape(-1, 3)
-            return [_merged(corners.astype(float))]
+            return [merged(corners.astype(float))]
     if not data.lstrip()[:5].lower() == b"solid":
         raise MeshFileError("neither a binary STL nor an ASCII one")
     numbers = re.findall(rb"^\s*vertex\s+(\S+)\s+(\S+)\s+(\S+)", data, re.MULTILINE)
     if not numbers or len(numbers) % 3:
         raise MeshFileError("an ASCII STL whose facets are not triangles")
-    return [_merged(np.array(numbers, dtype=float))]
+    return [merged(np.array(numbers, dtype=float))]
 
 
-def _merged(corners: np.ndarray) -> Mesh:
-    """Triangles given corner by corner, each distinct corner one vertex."""
+def merged(corners: np.ndarray) -> Mesh:
+    """Triangles given corner by corner (3k, 3), each distinct corner one vertex."""
     if not np.all(np.isfinite(corners)):
         raise MeshFileError("a corner is not a finite number")
     vertices, index = np.unique(corners, axis=0, return_inverse=True)

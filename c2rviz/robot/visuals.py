@@ -4,8 +4,8 @@
 elements and materials); this module turns every element into a ``Shape`` placed
 at its URDF origin in the link frame. Boxes, cylinders and spheres stay
 primitives (the viewer draws them natively); mesh files, resolved through
-``RobotSource.resolve``, are read by ``mesh_files`` when they are STL or OBJ (numpy
-alone: building the page pays for no mesh library) and by trimesh otherwise
+``RobotSource.resolve``, are read by ``mesh_files`` when they are STL, OBJ or COLLADA
+(numpy and lxml: building the page pays for no mesh library) and by trimesh otherwise
 (imported at the first such file: most robots never load it). Link poses are not
 computed here: the viewer takes them from Pinocchio.
 
