@@ -28,7 +28,7 @@ import viser
 
 from ..robot.mesh_files import Mesh
 from ..robot.model import Robot
-from ..robot.visuals import LinkGeometry, Shape
+from ..robot.visuals import DEFAULT_RGBA, LinkGeometry, Shape
 from . import adapter
 from .link_tree import LinkTree
 
@@ -266,9 +266,9 @@ class RobotView:
             assert shape.mesh is not None
             if ghost:
                 rgb, alpha = GHOST_GREY, 1.0
-            elif isinstance(shape.mesh, Mesh):  # an STL's or OBJ's: one colour of its own
-                assert shape.mesh.rgba is not None
-                rgb, alpha = shape.mesh.rgba[:3], shape.mesh.rgba[3]
+            elif isinstance(shape.mesh, Mesh):  # read by mesh_files: its colour, if it has one
+                rgba = shape.mesh.rgba or DEFAULT_RGBA  # (a collision mesh standing in: none)
+                rgb, alpha = rgba[:3], rgba[3]
             else:
                 return scene.add_mesh_trimesh(name, shape.mesh, **common)
         else:
