@@ -44,7 +44,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--cell",
         metavar="NAME|PATH",
         help="serve the robots of [cell:NAME] in the ini (or of the ini file PATH), each on "
-        "its own port, in one world and one page (README: Several robots)",
+        "its own port, in one world and one page (docs/cells.md)",
     )
     add("--urdf", metavar="PATH", type=Path, help="load this URDF or .xacro instead of the robot's")
     add(

@@ -88,6 +88,9 @@ class Settings:
     hz: float = 100.0
     viewer_host: str = "127.0.0.1"
     viewer_port: int = 8080
+    viewer_port_named: bool = False
+    """The user chose ``viewer_port`` (``--viser-port`` or the ini): taken, it stops the
+    program; the default taken, the page moves to the next free port."""
     viewer: bool = True
     viewer_origins: tuple[str, ...] = ()
     """Origins allowed to open the viewer's websocket besides its own (a reverse proxy)."""
@@ -324,6 +327,7 @@ def load_settings(ini: Path | None, overrides: Mapping[str, Any]) -> Settings:
         parse_clock(values["clock"], "--clock" if "clock" in given else "[options] clock")
     for key in ("package_paths", "xacro_args", "viewer_origins"):
         values[key] = tuple(values.get(key, ()))
+    values["viewer_port_named"] = "viewer_port" in values
     limit_values = {k: values.pop(k) for k in list(values) if k in _LIMIT_FIELDS}
     session_values = {k: values.pop(k) for k in list(values) if k in _SESSION_FIELDS}
     settings = replace(

@@ -79,6 +79,7 @@ def _open_scene(settings: Settings, services: Services, title: str | None) -> Sc
         settings.hz,
         policy=policy,
         title=title,
+        port_named=settings.viewer_port_named,
     )
 
 

@@ -184,6 +184,10 @@ def build_parser() -> argparse.ArgumentParser:
         ".mcap or .db3 file, or a ROS 1 .bag, whose JointState topic is played",
     )
     add_connection_args(parser)
+    parser._option_string_actions["--port"].help = (  # argparse has no public setter
+        "command port (default from cmdinterpreter.ini: 31000); for a CRCL program "
+        "(FILE.xml), the CRCL port (default 64444)"
+    )
     add(
         "--speed",
         "--rate",

@@ -32,6 +32,7 @@ from typing import TextIO
 __all__ = [
     "FINAL_SUFFIXES",
     "RecordFiles",
+    "body_tally",
     "cut_to_line",
     "existing",
     "is_bag_folder",
@@ -201,3 +202,28 @@ def cut_to_line(path: Path) -> None:
             at = start
         if at < end:
             file.truncate(at)
+
+
+def body_tally(path: Path, chunk_bytes: int = 1 << 16) -> tuple[int, int]:
+    """What a recorder's command-file body at ``path`` holds: its frames and its time [us].
+
+    A frame is a ``joints`` line, except the one a ``clear`` writes right after itself
+    (the arm put back where it is) once the first frame is written; the time is the sum
+    of its ``sleep`` lines. Read ``chunk_bytes`` at a time (memory stays flat).
+
+    Raises:
+        OSError: it cannot be read.
+    """
+    frames = us = 0
+    after_clear = False
+    tail = b""
+    with open(os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC), "rb") as source:
+        while chunk := source.read(chunk_bytes):
+            *lines, tail = (tail + chunk).split(b"\n")
+            for line in lines:
+                if line.startswith(b"joints ") and not (after_clear and frames):
+                    frames += 1
+                elif line.startswith(b"sleep "):
+                    us += round(float(line[6:]) * 1e6)
+                after_clear = line == b"clear"
+    return frames, us

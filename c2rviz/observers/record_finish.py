@@ -68,7 +68,13 @@ def finish(
                 html = export(recorded, states[robot])
             except Exception as exc:  # the txt and csv stand; the rest is a bonus
                 files.discard(".html")
-                log.warning("recording %s: no page written: %s", recorded.name, exc)
+                why = exc.strerror or exc if isinstance(exc, OSError) else exc
+                log.warning(
+                    "recording %s: no page written (%s.html): %s; its other files stand",
+                    recorded.name,
+                    recorded.name,
+                    why,
+                )
         try:
             txt = files.publish(recorded.txt) if recorded.txt is not None else None
             csv = files.publish(recorded.csv)

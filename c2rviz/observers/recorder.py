@@ -44,7 +44,7 @@ from ..robot.frames import in_base, se3_pose, wxyz_se3
 from ..world.effects import Marker, Observer
 from ..world.faults import replay_line
 from ..world.world import World
-from .record_files import RecordFiles, cut_to_line, join_body
+from .record_files import RecordFiles, body_tally, cut_to_line, join_body
 from .recorded import FrameSink, Recorded
 
 __all__ = ["BUFFER_BYTES", "FLUSH_S", "FrameSink", "Recorded", "Recorder"]
@@ -290,9 +290,15 @@ class Recorder(Observer):
 
         The header, then the body up to its last whole line. Should that not be
         written (a full disk), the body alone becomes the command file (it plays, with
-        no header). After a write error the CSV is cut after its last whole row too.
+        no header). After a write error the CSV is cut after its last whole row too, and
+        the frames and time the header and ``Recorded`` give are those the body kept (the
+        frames still in a buffer when the disk filled never reached it).
         """
         txt: Path | None = None
+        if self.error is not None:
+            with contextlib.suppress(OSError, ValueError):
+                cut_to_line(self.part)
+                self.frames, self._written_us = body_tally(self.part)
         try:
             self._assemble()
             txt = self.txt

@@ -298,7 +298,9 @@ class Recordings:
         a finish already done when this is awaited counts too."""
         finished: list[Recorded] = []
         awaited: set[asyncio.Future[list[Recorded]]] = set()
-        while waiting := [f for f in (*ending, *self._in_flight) if f not in awaited]:
+        while waiting := [
+            f for f in dict.fromkeys((*ending, *self._in_flight)) if f not in awaited
+        ]:
             awaited.update(waiting)
             for result in await asyncio.gather(*waiting, return_exceptions=True):
                 if isinstance(result, list):

@@ -3,10 +3,11 @@
 ``urdf_elements`` reads the URDF (links, their ``<visual>``/``<collision>``
 elements and materials); this module turns every element into a ``Shape`` placed
 at its URDF origin in the link frame. Boxes, cylinders and spheres stay
-primitives (the viewer draws them natively); mesh files are loaded with trimesh
-(imported at the first mesh: a robot of primitives never loads it), resolved
-through ``RobotSource.resolve``. Link poses are not computed here: the viewer
-takes them from Pinocchio.
+primitives (the viewer draws them natively); mesh files, resolved through
+``RobotSource.resolve``, are read by ``mesh_files`` when they are STL, OBJ or COLLADA
+(numpy and lxml: building the page pays for no mesh library) and by trimesh otherwise
+(imported at the first such file: most robots never load it). Link poses are not
+computed here: the viewer takes them from Pinocchio.
 
 A mesh that cannot be found or read is logged with the places searched, and
 the link falls back to its collision geometry or, failing that, a small grey
@@ -19,10 +20,12 @@ from __future__ import annotations
 import logging
 import warnings
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .mesh_files import FORMATS, Mesh, MeshFileError, read_mesh
 from .sources import RobotSource
 from .urdf_elements import Element, read_links
 
@@ -52,14 +55,15 @@ class Shape:
             else the default grey.
         size: Box edge lengths (x, y, z) [m]; cylinder (radius, length) [m];
             sphere (radius,) [m]; empty for a mesh.
-        mesh: The loaded mesh (kind ``mesh`` only), scale already applied.
+        mesh: The loaded mesh (kind ``mesh`` only), scale already applied: a
+            ``mesh_files.Mesh`` (STL, OBJ) or a trimesh one (any other format).
     """
 
     kind: str
     origin: np.ndarray
     rgba: tuple[float, float, float, float] | None
     size: tuple[float, ...] = ()
-    mesh: trimesh.Trimesh | None = None
+    mesh: Mesh | trimesh.Trimesh | None = None
 
 
 @dataclass
@@ -137,7 +141,10 @@ def _shapes(
         # The URDF's colour is what the robot's author chose for this link, so it
         # wins over the file's (exporters often leave a near-white .mtl behind:
         # pybullet's kuka_iiwa). Without one, a file's own colours are kept.
-        own = mesh.visual is not None and mesh.visual.defined
+        if isinstance(mesh, Mesh):
+            own = mesh.rgba is not None
+        else:
+            own = mesh.visual is not None and mesh.visual.defined
         color = rgba if rgba is not None else None if own else DEFAULT_RGBA
         shapes.append(Shape("mesh", origin, color, (), mesh))
     return shapes
@@ -148,9 +155,11 @@ class _MeshLoader:
 
     def __init__(self, source: RobotSource) -> None:
         self.source = source
-        self.cache: dict[str, list[trimesh.Trimesh] | None] = {}
+        self.cache: dict[str, list[Mesh | trimesh.Trimesh] | None] = {}
 
-    def load(self, uri: str, scale: float | np.ndarray | None) -> list[trimesh.Trimesh] | None:
+    def load(
+        self, uri: str, scale: float | np.ndarray | None
+    ) -> list[Mesh | trimesh.Trimesh] | None:
         """The pieces of the mesh file ``uri``, scaled; None when it cannot be loaded."""
         if uri not in self.cache:
             self.cache[uri] = self._read(uri)
@@ -160,18 +169,33 @@ class _MeshLoader:
         if scale is None:
             return pieces
         factors = np.broadcast_to(np.asarray(scale, dtype=float), (3,))
-        scaled = []
+        scaled: list[Mesh | trimesh.Trimesh] = []
         for piece in pieces:
+            if isinstance(piece, Mesh):
+                scaled.append(piece.scaled(factors))
+                continue
             piece = piece.copy()
             piece.apply_transform(np.diag([*factors, 1.0]))
             scaled.append(piece)
         return scaled
 
-    def _read(self, uri: str) -> list[trimesh.Trimesh] | None:
+    def _read(self, uri: str) -> list[Mesh | trimesh.Trimesh] | None:
         path = self.source.resolve(uri)
         if path is None:  # said already (load_link_geometry)
             return None
-        import trimesh  # the first mesh: robots of primitives never pay for it
+        if path.suffix.lower() in FORMATS:
+            try:
+                return list(read_mesh(path))
+            except OSError as exc:
+                log.warning("mesh %s (%s) cannot be read: %s", uri, path, exc.strerror or exc)
+                return None
+            except (MeshFileError, ValueError, IndexError) as exc:  # trimesh may know better
+                log.debug("mesh %s: %s; trimesh reads it", path, exc)
+        found = self._read_with_trimesh(uri, path)
+        return None if found is None else list(found)
+
+    def _read_with_trimesh(self, uri: str, path: Path) -> list[trimesh.Trimesh] | None:
+        import trimesh  # the first such file: most robots never pay for it
 
         try:
             with warnings.catch_warnings(record=True) as caught:

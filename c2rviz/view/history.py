@@ -15,6 +15,12 @@ that change (``start``): a flood of ``mark`` shortens how far back one can look,
 never the memory. A flood of joint values within a period keeps only the latest
 (taken when the samples are read or the next period is due), as ``TrailKeeper``
 does, so the history always ends where the arm is.
+
+An arm at rest sends nothing, so the history is told when a sample leaves the arm at
+rest (``add(..., resting=True)``): the next change, more than two periods later, is
+kept as a step, the arm held where it rested until that time and then where it went
+(two samples at one time), not as a ramp from the last sample. An instant move after
+a minute at rest plots as a step.
 """
 
 from __future__ import annotations
@@ -75,10 +81,15 @@ class RobotHistory:
     """
 
     def __init__(
-        self, state: RobotState, period_s: float, now: float, objects: Sequence[WorkcellObject]
+        self,
+        state: RobotState,
+        period_s: float,
+        now: float,
+        objects: Sequence[WorkcellObject],
+        resting: bool = False,
     ) -> None:
         """Start remembering ``state``'s robot at clock time ``now`` [s], with the markers it
-        has and ``objects`` (its workcell now)."""
+        has and ``objects`` (its workcell now); ``resting``: the arm is at rest now."""
         self.state = state
         self.period_s = max(period_s, HISTORY_S / MAX_SAMPLES)
         n = state.robot.n
@@ -90,6 +101,7 @@ class RobotHistory:
         self._count = 0
         self._due = -np.inf
         self._pending: tuple[tuple[float, ...], float] | None = None
+        self._resting = False  # the arm stays at the latest state until the next one
         self.folds = 0
         self._start_s = now  # changes before this are folded into the base state
         self._base_markers: deque[Marker] = deque(state.markers, maxlen=MAX_MARKERS)
@@ -99,13 +111,20 @@ class RobotHistory:
         self._objects: list[tuple[float, list[WorkcellObject]]] = []
         self._object_times: list[float] = []
         self._cached: tuple[int, int, deque[Marker]] | None = None  # (folds, index, markers)
-        self.add(state.q, now)
+        self.add(state.q, now, resting)
 
     # what the world tells (the asyncio thread)
 
-    def add(self, q: Sequence[float], t: float) -> None:
-        """The arm is at ``q`` [rad or m] at clock time ``t`` [s]."""
+    def add(self, q: Sequence[float], t: float, resting: bool = False) -> None:
+        """The arm is at ``q`` [rad or m] at clock time ``t`` [s]; ``resting``: it stays
+        there until the next call (it arrived, or it moved at once)."""
+        held, self._resting = self._resting, resting
         if t >= self._due:
+            if held:  # at rest since the latest state: held there until now, then a step
+                self._take_pending()
+                last = self._count - 1
+                if t - self._times[last] > 2.0 * self.period_s:
+                    self._append(tuple(self._qs[last].tolist()), t)
             self._pending = None
             self._append(tuple(q), t)
             self._due = t + self.period_s

@@ -87,11 +87,17 @@ class Instruments:
         self.ghosts: dict[str, RobotGhost] = {}
         for name, state in world.robots.items():
             objects = self._objects_now(name)
-            self.histories[name] = RobotHistory(state, world.frame_s, origin, objects)
+            resting = not world.moving(name)
+            self.histories[name] = RobotHistory(state, world.frame_s, origin, objects, resting)
             with panels[name].folder:
                 self.readouts[name] = RobotReadout(server.gui, state.robot, len(world.robots))
-                self.plots[name] = RobotPlots(
-                    server.gui, state.robot, origin, velocities, len(world.robots)
+                self.plots[name] = RobotPlots(  # right after the buttons: on a 900 px screen
+                    server.gui,
+                    state.robot,
+                    origin,
+                    velocities,
+                    len(world.robots),
+                    order=panels[name].buttons["stop"].order + 0.5,
                 )
             self.ghosts[name] = RobotGhost(server, views[name])
         self.timeline = timeline
@@ -136,7 +142,7 @@ class Instruments:
     def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
         history = self.histories.get(robot)
         if history is not None:
-            history.add(q, t)
+            history.add(q, t, not self.world.moving(robot))
             self._reread.add(robot)
 
     def on_marker(self, robot: str, marker: Marker) -> None:

@@ -70,12 +70,21 @@ def legend(robot: Robot) -> str:
     return f"{keys} <span style='color:#888'>(dashed: its limits)</span>"
 
 
-def thin(count: int, points: int = PLOT_POINTS) -> np.ndarray:
+def thin(count: int, points: int = PLOT_POINTS, times: np.ndarray | None = None) -> np.ndarray:
     """Indices of at most ``points`` samples of ``count``, evenly spread, first and last
-    kept."""
+    kept. With the samples' ``times`` [s], the corners of each long pause (more than two
+    thinned steps without a sample: the arm at rest) are kept too, at most ``points // 2``
+    of them, so a step after a rest stays a step (``history``) rather than a ramp across
+    the pause."""
     if count <= points:
         return np.arange(count)
-    return np.unique(np.linspace(0, count - 1, points).round().astype(int))
+    corners = np.zeros(0, dtype=int)
+    if times is not None and count > 1:
+        pauses = np.flatnonzero(np.diff(times) > 2.0 * (times[-1] - times[0]) / points)
+        ends = np.concatenate([pauses, pauses + 1, np.minimum(pauses + 2, count - 1)])
+        corners = np.unique(ends)[: points // 2]
+    even = np.linspace(0, count - 1, points - len(corners)).round().astype(int)
+    return np.unique(np.concatenate([even, corners]))
 
 
 class RobotPlots:
@@ -103,16 +112,46 @@ class RobotPlots:
         origin_s: float,
         velocities: bool,
         robots: int = 1,
+        order: float | None = None,
     ) -> None:
         """Add the charts to the folder open in ``gui``; times are plotted in seconds from
         ``origin_s`` (the server's start, as ``watch``) [s of the clock]; ``robots`` is how
-        many robots' charts share ``PLOTS_PER_S``."""
+        many robots' charts share ``PLOTS_PER_S``; ``order``: where the ``Plots`` folder
+        stands among the folder's rows (viser's order; None: last)."""
         self.robot = robot
         self.period_s = max(1.0 / PLOT_HZ, robots / PLOTS_PER_S)
         self.origin_s = origin_s
         self._scale = np.array([1.0 if j.prismatic else 180.0 / math.pi for j in robot.joints])
         self._units = ["m" if j.prismatic else "deg" for j in robot.joints]
-        with gui.add_folder("Plots", expand_by_default=True):
+        with gui.add_folder("Plots", expand_by_default=True, order=order):
+            # the charts first, their controls under them: a 900 px screen shows them
+            self.legend: Any = gui.add_markdown(legend(robot))
+            empty = (np.zeros(1), *(np.zeros(1) for _ in robot.joints))
+            self.positions: Any = gui.add_uplot(
+                empty,
+                (_X, *self._joint_series(range(robot.n))),
+                title=f"joints [{self._unit_text()}]",
+                scales=_SCALES,
+                legend=uplot.Legend(show=False),  # the colours are in ``legend``, once
+                aspect=1.6,
+            )
+            self.speeds: Any = gui.add_uplot(
+                empty,
+                (_X, *self._joint_series(range(robot.n))),
+                title=f"velocities [{self._unit_text()}/s]",
+                scales=_SCALES,
+                legend=uplot.Legend(show=False),
+                aspect=1.8,
+                visible=velocities,
+            )
+            self.tool_speed: Any = gui.add_uplot(
+                (np.zeros(1), np.zeros(1)),
+                (_X, uplot.Series(label="tool m/s", stroke="#444444", width=1.5)),
+                title="tool point speed [m/s]",
+                scales=_SCALES,
+                legend=uplot.Legend(show=False),
+                aspect=2.4,
+            )
             self.shown: Any = gui.add_checkbox(
                 "Plots", True, hint="update the charts (off: they cost the server nothing)"
             )
@@ -136,33 +175,6 @@ class RobotPlots:
                     gui.add_checkbox(short_label(j.name), True, hint=f"plot {j.name}")
                     for j in robot.joints
                 ]
-            self.legend: Any = gui.add_markdown(legend(robot))
-            empty = (np.zeros(1), *(np.zeros(1) for _ in robot.joints))
-            self.positions: Any = gui.add_uplot(
-                empty,
-                (_X, *self._joint_series(range(robot.n))),
-                title=f"joints [{self._unit_text()}]",
-                scales=_SCALES,
-                legend=uplot.Legend(show=False),  # the colours are in ``legend``, once
-                aspect=1.4,
-            )
-            self.speeds: Any = gui.add_uplot(
-                empty,
-                (_X, *self._joint_series(range(robot.n))),
-                title=f"velocities [{self._unit_text()}/s]",
-                scales=_SCALES,
-                legend=uplot.Legend(show=False),
-                aspect=1.8,
-                visible=velocities,
-            )
-            self.tool_speed: Any = gui.add_uplot(
-                (np.zeros(1), np.zeros(1)),
-                (_X, uplot.Series(label="tool m/s", stroke="#444444", width=1.5)),
-                title="tool point speed [m/s]",
-                scales=_SCALES,
-                legend=uplot.Legend(show=False),
-                aspect=2.4,
-            )
         self._chosen: tuple[int, ...] | None = None  # the series are set at the first draw
         self._limits: tuple[tuple[tuple[int, ...], int], list[np.ndarray]] | None = None
         self._last_draw = -math.inf
@@ -203,7 +215,7 @@ class RobotPlots:
         self.draws += 1
         self.drawn_s = end_s
         window = history.window(end_s - float(self.window.value), end_s)
-        picked = thin(len(window))
+        picked = thin(len(window), PLOT_POINTS, window.times)
         times = window.times[picked]
         x = times - self.origin_s
         chosen = self.chosen()
@@ -215,7 +227,7 @@ class RobotPlots:
         columns = list(chosen)
         previous = np.maximum(picked - 1, 0)
         dt = window.times[picked] - window.times[previous]
-        dt[dt <= 0.0] = np.inf  # the first sample: no velocity known, show 0
+        dt[dt <= 0.0] = np.inf  # the first sample, or a step (two at one time): show 0
         if columns:
             values = window.qs[picked][:, columns] * self._scale[columns]
             limits = self._limit_values(chosen, len(x))

@@ -20,13 +20,14 @@ was good and a sentence saying what was not, never a blank or frozen page.
 from __future__ import annotations
 
 import base64
+import contextlib
 import importlib.resources
 import json
 import logging
 import os
 import zlib
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 import numpy as np
 import pinocchio as pin
@@ -64,7 +65,7 @@ def write_html(recorded: Recorded, state: RobotState) -> Path:
     else:
         commands = read_commands(recorded.txt, base)
     problems = [*frames.problems, *commands.problems]
-    problems += _disagreements(recorded.name, robot, frames, commands)
+    problems += _disagreements(recorded.name, robot, frames, commands, recorded.error)
     scene, nodes = _scene(recorded.name, state, frames, commands)
     end = max(frames.end_s, commands.end_s if recorded.txt is not None else 0.0)
     meta = {
@@ -97,29 +98,49 @@ def write_html(recorded: Recorded, state: RobotState) -> Path:
     path = recorded.csv.with_suffix(".html")
     part = path.with_name(f".{path.name}.part")  # then renamed: NAME.html whole, or not at all
     flags = os.O_WRONLY | os.O_CREAT | os.O_TRUNC | getattr(os, "O_NOFOLLOW", 0)
-    with open(os.open(part, flags, 0o644), "w", encoding="utf-8") as out:
-        head, tail = scene.rsplit("</body>", 1)
-        out.write(head)
-        out.write(f'<script type="application/json" id="c2rviz-recording">{_json(meta)}</script>\n')
-        for name, array in blobs.items():
-            out.write(f'<script type="application/octet-stream" id="c2rviz-{name}">')
-            out.write(_packed(array))
-            out.write("</script>\n")
-        out.write(f"<style>{_asset('record_player.css')}</style>\n")
-        out.write(f"<script>{_asset('record_player.js')}</script>\n</body>")
-        out.write(tail)
-    os.replace(part, path)  # a link at NAME.html is replaced, never followed
+    try:
+        with _sink(open(os.open(part, flags, 0o644), "w", encoding="utf-8")) as out:
+            head, tail = scene.rsplit("</body>", 1)
+            out.write(head)
+            out.write(
+                f'<script type="application/json" id="c2rviz-recording">{_json(meta)}</script>\n'
+            )
+            for name, array in blobs.items():
+                out.write(f'<script type="application/octet-stream" id="c2rviz-{name}">')
+                out.write(_packed(array))
+                out.write("</script>\n")
+            out.write(f"<style>{_asset('record_player.css')}</style>\n")
+            out.write(f"<script>{_asset('record_player.js')}</script>\n</body>")
+            out.write(tail)
+        os.replace(part, path)  # a link at NAME.html is replaced, never followed
+    except BaseException:  # a full disk: no page, and no part of one left to fill it
+        with contextlib.suppress(OSError):
+            os.unlink(part)
+        raise
     for problem in problems:
         log.warning("recording %s: %s", recorded.name, problem)
     return path
 
 
-def _disagreements(name: str, robot: Robot, frames: Frames, commands: Commands) -> list[str]:
-    """Where NAME.txt and NAME.csv do not tell one recording of this robot."""
+def _sink(file: TextIO) -> TextIO:
+    """Where the page is written: ``file`` (a test puts a disk that fills in between)."""
+    return file
+
+
+def _disagreements(
+    name: str, robot: Robot, frames: Frames, commands: Commands, early: str | None = None
+) -> list[str]:
+    """Where NAME.txt and NAME.csv do not tell one recording of this robot (``early``: why
+    the recording stopped early, if it did: each file then kept what reached the disk)."""
     out = []
     if commands.robot is not None and commands.robot != robot.name:
         out.append(f"{name}.txt is a recording of {commands.robot}, not of {robot.name}")
-    if commands.frames is not None and frames.rows and frames.rows != commands.frames:
+    if commands.frames is not None and frames.rows and frames.rows != commands.frames and early:
+        out.append(
+            f"{name}.csv holds {frames.rows} frames and {name}.txt {commands.frames}: the "
+            f"recording stopped early ({early}), each file with what reached the disk"
+        )
+    elif commands.frames is not None and frames.rows and frames.rows != commands.frames:
         which = "cut short" if frames.rows < commands.frames else "not from this recording"
         out.append(
             f"{name}.csv holds {frames.rows} frames but {name}.txt counts {commands.frames}: "

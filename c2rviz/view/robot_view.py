@@ -26,8 +26,9 @@ import numpy as np
 import pinocchio as pin
 import viser
 
+from ..robot.mesh_files import Mesh
 from ..robot.model import Robot
-from ..robot.visuals import LinkGeometry, Shape
+from ..robot.visuals import DEFAULT_RGBA, LinkGeometry, Shape
 from . import adapter
 from .link_tree import LinkTree
 
@@ -263,9 +264,13 @@ class RobotView:
         }
         if shape.rgba is None:  # a mesh with colours of its own
             assert shape.mesh is not None
-            if not ghost:
+            if ghost:
+                rgb, alpha = GHOST_GREY, 1.0
+            elif isinstance(shape.mesh, Mesh):  # read by mesh_files: its colour, if it has one
+                rgba = shape.mesh.rgba or DEFAULT_RGBA  # (a collision mesh standing in: none)
+                rgb, alpha = rgba[:3], rgba[3]
+            else:
                 return scene.add_mesh_trimesh(name, shape.mesh, **common)
-            rgb, alpha = GHOST_GREY, 1.0
         else:
             rgb, alpha = shape.rgba[:3], shape.rgba[3]
         if ghost:

@@ -22,6 +22,7 @@ them, and the scheduler paces sends by their cost (docs/page.md, "Many robots").
 from __future__ import annotations
 
 import asyncio
+import errno
 import logging
 import socket
 import time
@@ -90,6 +91,7 @@ class ViserScene(Scene):
         *,
         policy: DoorPolicy | None = None,
         title: str | None = None,
+        port_named: bool = False,
     ) -> None:
         """Start the viser server on ``host:port`` (0 picks a free port) and draw the world.
 
@@ -97,13 +99,16 @@ class ViserScene(Scene):
             services: The world to show (all of its robots), and what its page's sessions
                 share with every other source.
             host: Address to serve the page on.
-            port: TCP port; when it is busy viser takes the next free one.
+            port: TCP port; when it is busy viser takes the next free one, unless the
+                user named it.
             hz: Most sends per second [1/s].
             policy: Who may open the page and what it may send.
             title: The cell's or robot's name (default: the robots' names).
+            port_named: The user chose ``port`` (``--viser-port``, the ini): when it is
+                taken the page does not move to another (``doors.open_port``'s rule).
 
         Raises:
-            OSError: ``host`` cannot be listened on.
+            OSError: ``host`` cannot be listened on, or a named ``port`` is taken.
             adapter.ViserInternalsError: the installed viser lacks what the adapter uses.
         """
         _check_host(host)
@@ -114,6 +119,12 @@ class ViserScene(Scene):
         self.server = adapter.start(host, port, label=self.title, policy=self.policy)
         adapter.door(self.server).page_title = self.title
         self.port = self.server.get_port()
+        if port_named and port not in (0, self.port):
+            adapter.stop(self.server, timeout_s=STOP_TIMEOUT_S)
+            raise OSError(
+                errno.EADDRINUSE,
+                "the port is in use; choose another with --viser-port (0 picks a free one)",
+            )
         if port not in (0, self.port):
             log.warning("viewer port %d is busy; serving on %d instead", port, self.port)
         shown_host = "localhost" if host in ("0.0.0.0", "::", "") else host

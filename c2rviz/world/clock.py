@@ -27,9 +27,9 @@ client would then act later, on the clock, than it would in real time. So:
 - The door runs the client's commands inside ``with hold.acting():`` (for the
   coroutine of a reply that waits, create its task inside the block too). A reply
   that waits on the clock (``sleep``'s end, an arrival, rest after ``stop``/``wait``:
-  ``Session.after`` and ``world.moves.Travels`` make these with ``clock.future()``)
-  then releases the hold until it is settled; settling it takes the hold back at
-  once, so the client is busy again before anything else can happen.
+  ``Session.after``, ``world.moves.Travels`` and ``world.grips.Grips`` make these with
+  ``clock.future()``) then releases the hold until it is settled; settling it takes
+  the hold back at once, so the client is busy again before anything else can happen.
 - A door whose client only listens (a ``watch`` stream, a subscription) and sends
   nothing may ``hold.release()`` until it sends again (``hold.take()``).
 - ``with clock.busy():`` holds time for one piece of work that is not a client's.

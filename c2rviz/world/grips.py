@@ -111,8 +111,8 @@ class Grips:
         grip.t0, grip.t1 = t, t + abs(opening - grip.start) * state.robot.gripper.stroke_s
         grip.active = grip.t1 > t
         arrival: asyncio.Future[str] | None = None
-        if wait:
-            arrival = asyncio.get_running_loop().create_future()
+        if wait:  # the clock's future: a virtual clock lets time run while it waits
+            arrival = self.clock.future()
             grip.arrivals.append(arrival)
         if grip.active:
             if self._timer is None:

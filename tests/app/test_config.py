@@ -122,6 +122,30 @@ def test_a_taken_command_port_is_the_one_thing_said(capsys, caplog):
     )
 
 
+@pytest.mark.parametrize("how", ["flag", "ini"])
+def test_a_taken_viewer_port_that_was_named_stops_the_program(how, tmp_path, capsys):
+    """Issue 39, fault 12: a named --viser-port that is taken stops the program with status
+    2 and one sentence, as every other door's named port does; it once moved to the next."""
+    doors = ["--port", "0", "--crcl-port", "0", "--rosbridge-port", "0"]
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        if how == "flag":
+            argv = [*doors, "--viser-port", str(port)]
+        else:
+            ini = tmp_path / "cmdinterpreter.ini"
+            ini.write_text(f"[options]\nviewer_port = {port}\n")
+            argv = [*doors, "--config", str(ini)]
+        assert main(argv) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert err == (
+        f"c2rviz: cannot serve the viewer on 127.0.0.1:{port}: the port is in use; choose "
+        "another with --viser-port (0 picks a free one)\n"
+    )
+
+
 def test_port_zero_prints_the_port_it_picked(c2rviz_process):
     proc = c2rviz_process("--no-viewer")
     assert proc.port > 0

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from support import ServerThread
+from support import Client, ServerThread, load_robot
 
 from c2rviz.protocol import replies
+from c2rviz.session import ServerLimits
+from c2rviz.world.virtual_clock import VirtualClock
 
 
 def test_grip_at_once_and_asked(start_server, connect) -> None:
@@ -59,3 +61,20 @@ def _wait_until(server: ServerThread, condition) -> None:
         if server.call(condition):
             return
     raise AssertionError("never happened")
+
+
+def test_a_grip_that_travels_answers_on_virtual_time(connect) -> None:
+    """Issue 39, fault 13: the reply waited on a future the virtual clock did not know, so
+    the client held the clock while it waited and time never reached the arrival."""
+    server = ServerThread(load_robot("fanuc_lrmate200id"), ServerLimits(), clock=VirtualClock())
+    server.start()
+    try:
+        client = Client(server.host, server.port, timeout=30.0)  # a hang guard, not a timing
+        assert client.ask("motion on") == "ok"
+        assert client.ask("grip 0") == "ok"  # already there: at once
+        assert client.ask("grip 1") == "ok"  # the full stroke, on the clock
+        assert server.call(server.world.clock.now) == pytest.approx(0.3)
+        assert client.ask("grip") == "ok 1"
+        client.close()
+    finally:
+        server.stop()

@@ -84,3 +84,35 @@ def test_thinning_keeps_the_ends() -> None:
     assert list(thin(5, 10)) == [0, 1, 2, 3, 4]
     picked = thin(10_000, 200)
     assert len(picked) <= 200 and picked[0] == 0 and picked[-1] == 9_999
+
+
+def test_a_move_after_a_rest_is_a_step_not_a_ramp() -> None:
+    """Issue 39, rough edge 8: an arm at rest sends nothing, so an instant move 35 s later
+    was kept as a sample at 0 s and one at 35 s: a 35-second ramp on the plot."""
+    h = RobotHistory(RobotState("arm", load_robot()), 0.01, 0.0, [], resting=True)
+    h.add((0.3,) * 7, 35.0, resting=True)  # motion off: there at once, and resting
+    window = h.window(-1.0, 40.0)
+    assert list(window.times) == [0.0, 35.0, 35.0]  # held where it rested until the step
+    assert window.qs[:, 0] == pytest.approx([0.0, 0.0, 0.3])
+    assert h.at(34.9) == pytest.approx((0.0,) * 7) and h.at(35.0) == pytest.approx((0.3,) * 7)
+    h.add((0.31,) * 7, 35.5)  # a move leaving after half a second at rest: a flat line first
+    h.add((0.32,) * 7, 35.51)  # on its way: no step between frames
+    assert list(h.window(-1.0, 40.0).times) == [0.0, 35.0, 35.0, 35.5, 35.5, 35.51]
+
+
+def test_steps_keep_the_history_within_a_sample_a_period() -> None:
+    h = history()
+    for k in range(1, MAX_SAMPLES):  # a flood of instant moves, each at rest: no steps
+        h.add((k * 1e-6,) * 7, k * 0.01, resting=True)
+    assert len(h.window(-np.inf, np.inf)) == MAX_SAMPLES
+    g = history()
+    for k in range(1, MAX_SAMPLES):  # one every three periods: a step each, two samples
+        g.add((k * 1e-6,) * 7, k * 0.03, resting=True)
+    assert g.start <= g.end - HISTORY_S  # the whole window still kept
+
+
+def test_thinning_keeps_the_corners_of_a_rest() -> None:
+    times = np.concatenate([np.arange(1000) * 0.01, [35.0, 35.0], 35.0 + np.arange(1, 1000) * 0.01])
+    picked = thin(len(times), 200, times)
+    assert len(picked) <= 200 and picked[0] == 0 and picked[-1] == len(times) - 1
+    assert {999, 1000, 1001} <= set(picked.tolist())  # the rest's end, the hold, the step

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import asyncio
 import math
+import time
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -24,6 +25,7 @@ from c2rviz.view import adapter
 from c2rviz.view.ghost import REFUSED_S
 from c2rviz.view.history import HISTORY_S
 from c2rviz.view.plots import PLOT_POINTS
+from c2rviz.world.clock import Clock
 from c2rviz.world.world import World
 
 BOX = "object table box 0.2,0.2,0.2 0,0.8,0.85,0,0,0"  # beside the motoman, at +y
@@ -106,6 +108,35 @@ def test_the_plots_end_at_the_arm_in_degrees_with_the_limits(harness) -> None:
     history = h.scene.instruments.histories[name]
     assert data[0][-1] == pytest.approx(history.end - h.scene.instruments.origin_s)
     assert len(data[0]) <= PLOT_POINTS
+
+
+class Leaping(Clock):
+    """Real time that can leap ahead at once (``offset`` [s]): an arm idle for a while."""
+
+    def __init__(self) -> None:
+        self.offset = 0.0
+
+    def now(self) -> float:
+        return time.monotonic() + self.offset
+
+    def call_at(self, when: float, fn: Callable[..., Any], *args: Any) -> Any:
+        return asyncio.get_running_loop().call_at(when - self.offset, fn, *args)
+
+
+def test_an_instant_move_after_a_rest_plots_as_a_step(harness) -> None:
+    """Issue 39, rough edge 8: motion off, 35 s at rest, then a move: a step on the chart
+    (two points at the move's time), not a 35-second ramp from the last sample."""
+    clock = Leaping()
+    h = harness(World(load_robot(), clock=clock))
+    h.tab()
+    plots = h.scene.instruments.plots[h.world.default]
+    clock.offset = 35.0
+    h.call(lambda: h.world.set_q((0.3, 0, 0, 0, 0, 0, 0)))
+    h.until(lambda: plots.draws and plots.positions.data[1][-1] != 0.0, "the chart to follow")
+    x, joint_s = plots.positions.data[0], plots.positions.data[1]
+    assert x[-1] == x[-2] and x[-1] - x[0] > 30.0  # the step, after the rest
+    assert list(joint_s[:-1]) == [0.0] * (len(x) - 1)  # flat until the step
+    assert joint_s[-1] == pytest.approx(math.degrees(0.3))
 
 
 def test_a_long_window_is_thinned_and_the_tool_speed_is_plotted(harness) -> None:

@@ -24,6 +24,7 @@ import yourdfpy
 from support import ROBOTS, ROOT, load_robot
 from viewer_tabs import Harness
 
+from c2rviz.robot.mesh_files import Mesh
 from c2rviz.robot.model import Robot
 from c2rviz.robot.visuals import load_link_geometry
 from c2rviz.session import Services
@@ -454,6 +455,26 @@ def test_missing_meshes_warn_and_fall_back(
     assert_frames_match(h, [0.5, -0.5])
 
 
+def test_a_collision_mesh_stands_in_for_a_missing_visual_one(
+    tmp_path: Path, harness: Callable[..., Harness]
+) -> None:
+    """An STL read without trimesh, standing in with no colour of its own: drawn grey."""
+    trimesh.creation.box(extents=(0.05, 0.05, 0.15)).export(tmp_path / "arm.stl")
+    urdf = tmp_path / "stand_in.urdf"
+    urdf.write_text(
+        '<robot name="stand_in"><link name="base">'
+        '<visual><geometry><mesh filename="missing.stl"/></geometry></visual>'
+        '<collision><geometry><mesh filename="arm.stl"/></geometry></collision></link>'
+        '<joint name="j" type="revolute"><parent link="base"/><child link="tip"/>'
+        '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+        '<link name="tip"/></robot>'
+    )
+    robot = Robot.from_urdf(urdf)
+    h = harness(robot)
+    node = h.scene.server.scene._handle_from_node_name["/robots/stand_in/links/base/visual_0"]
+    assert tuple(node.color) == pytest.approx((178, 178, 184), abs=1)  # the default grey
+
+
 MTL_ROBOT = ROOT / "tests" / "data" / "mtl_robot" / "robot.urdf"
 
 
@@ -466,8 +487,8 @@ def test_a_urdf_material_wins_over_the_mesh_files_own_colour(
     [base], [tip] = links["base"].visual, links["tip"].visual
     assert base.mesh is not None and tip.mesh is not None
     for shape in (base, tip):  # the .mtl was read: the file has a colour of its own
-        assert shape.mesh is not None and shape.mesh.visual.defined
-        assert list(shape.mesh.visual.material.main_color) == [230, 230, 230, 255]
+        assert isinstance(shape.mesh, Mesh) and shape.mesh.rgba is not None
+        assert list(np.round(np.array(shape.mesh.rgba) * 255)) == [230, 230, 230, 255]
     assert base.rgba == pytest.approx((1.0, 0.423529411765, 0.0392156862745, 1.0))
     assert tip.rgba is None  # no URDF material: the file's colour is kept
     nodes = harness(robot).scene.server.scene._handle_from_node_name

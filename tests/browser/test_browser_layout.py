@@ -1,0 +1,54 @@
+"""The page's layout on a common laptop screen, in a real headless Chromium (issue 39, rough
+edge 11): at 1400x900 a robot's joint chart is in view as the page opens, without
+scrolling the panel or folding anything (it once stood 400 px below the fold, under the
+status rows and the readout)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import pytest
+from browser_support import ARTIFACTS, DEADLINE_S, wait_until
+
+pytestmark = pytest.mark.browser
+
+# The joint chart's box and the panel's scrolling viewport around it, in window pixels.
+CHART_IN_PANEL = """() => {
+  const title = [...document.querySelectorAll('.u-title')]
+    .find((t) => t.textContent.startsWith('joints'));
+  if (!title) return null;
+  const chart = title.closest('.uplot').getBoundingClientRect();
+  const view = title.closest('.mantine-ScrollArea-viewport');
+  const panel = view.getBoundingClientRect();
+  return {top: chart.top, bottom: chart.bottom, height: chart.height,
+          viewTop: panel.top, viewBottom: panel.bottom, scrollTop: view.scrollTop,
+          windowHeight: innerHeight};
+}"""
+
+
+@pytest.mark.parametrize("robot", ["motoman_sia20d", "fanuc_lrmate200id"])
+def test_the_joint_chart_is_in_view_at_1400_by_900(
+    robot: str, browser: Any, c2rviz_process: Callable[..., Any]
+) -> None:
+    proc = c2rviz_process("--viser-port", "0", "--robot", robot)
+    page = browser.new_page(viewport={"width": 1400, "height": 900})
+    try:
+        page.goto(proc.viewer_url + "/?fixedDpr=1")
+        page.get_by_text("Stop").first.wait_for(timeout=DEADLINE_S * 1000)
+
+        before: list[Any] = [None]
+
+        def laid_out() -> tuple[bool, Any]:  # the same box twice running: the page is still
+            box = page.evaluate(CHART_IN_PANEL)
+            settled = box is not None and box["height"] > 100 and box == before[0]
+            before[0] = box
+            return settled, box
+
+        box = wait_until(laid_out, "the joint chart to be laid out")
+        ARTIFACTS.mkdir(exist_ok=True)
+        page.screenshot(path=str(ARTIFACTS / f"layout-1400x900-{robot}.png"))
+        assert box["scrollTop"] == 0 and box["windowHeight"] == 900, box
+        assert box["viewTop"] <= box["top"] and box["bottom"] <= box["viewBottom"], box
+    finally:
+        page.close()
