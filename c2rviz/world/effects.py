@@ -23,6 +23,8 @@ if TYPE_CHECKING:
 
     from ..collision.workcell import WorkcellObject
     from ..errors import C2rvizError
+    from .goals import Goal
+    from .parts import Part
 
 __all__ = ["MAX_MARKERS", "Marker", "NullScene", "Observer", "RecordingScene", "Scene"]
 
@@ -77,6 +79,16 @@ class Observer:
 
     def on_ghost(self, robot: str, shown: bool) -> None:
         """``robot``'s ghost (its target while it travels, its path) is now ``shown`` or not."""
+
+    def on_parts(self, parts: Sequence[Part], t: float) -> None:
+        """The parts are now ``parts`` (poses in the world frame), at time ``t`` [s]."""
+
+    def on_part_event(self, robot: str | None, text: str) -> None:
+        """A part was ``grasped NAME``, ``released NAME`` (by ``robot``) or is ``resting
+        NAME on WHAT`` (robot None)."""
+
+    def on_goals(self, goals: Sequence[Goal]) -> None:
+        """The goals are now ``goals`` (poses in the world frame)."""
 
 
 class Scene(Observer):

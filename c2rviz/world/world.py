@@ -27,6 +27,7 @@ from .effects import Observer
 from .grips import Grips
 from .live_collisions import Contacts
 from .moves import Travel, Travels
+from .part_world import WorldParts
 from .state import Marker, RobotState
 
 __all__ = ["RobotState", "World"]
@@ -86,6 +87,9 @@ class World:
             self.travels.add(state, (limits or {}).get(name) or motion_limits(state.robot))
         self.grips = Grips(self._show_opening, self.clock, self.frame_s)
         """The grippers' moves (a robot's ``robot.gripper``; checked by the session)."""
+        self.parts = WorldParts(self.robots, self.contacts, self.clock, self.frame_s, self._tell)
+        """The parts: grasped, carried, released (``part_world.py``)."""
+        self.contacts.furnish = self.parts.furnish
 
     def state(self, name: str | None = None) -> RobotState:
         """The robot called ``name`` (the default robot for None)."""
@@ -144,6 +148,7 @@ class World:
     def _show(self, state: RobotState, q: tuple[float, ...], t: float) -> None:
         """The robot is seen at ``q`` at time ``t``: tell every observer."""
         state.q = q
+        self.parts.moved(state.name, q)
         for observer in self.observers:
             observer.on_joints(state.name, q, t)
 
@@ -230,6 +235,7 @@ class World:
         """The program stops: no more frames, checks or solves."""
         self.travels.stop_all()
         self.grips.stop_all()
+        self.parts.stop()
         self.contacts.stop()
 
     # The workcell and collisions.
@@ -256,6 +262,11 @@ class World:
             for name, state in self.robots.items()
             if name != robot
         ]
+
+    def _tell(self, method: str, *args: object) -> None:
+        """Call the observers' ``method`` with ``args`` (the parts' effects)."""
+        for observer in self.observers:
+            getattr(observer, method)(*args)
 
     def _tell_collisions(self, robot: str, pairs: list[Pair]) -> None:
         for observer in self.observers:

@@ -1,4 +1,9 @@
-"""What the gripper verb does: the fingers to an opening, travelling as ``motion`` says."""
+"""What the gripper verb does: the fingers to an opening, travelling as ``motion`` says.
+
+Closing on a part takes it by the grasp rule (``world/grasp.py``, docs/parts.md): the
+fingers stop where they touch it and the reply says that opening (``ok 0.433``); opening
+them lets go of what they hold.
+"""
 
 from __future__ import annotations
 
@@ -22,8 +27,20 @@ def grip(session: Session, command: Grip) -> Reply:
         raise NoGripper(state.name)
     if command.opening is None:
         return replies.ok(replies.numbers([grips.now(state)]))
+    opening, reply = command.opening, replies.OK
+    parts = session.world.parts
+    now = grips.now(state)
+    if parts.parts.held_by(state.name):
+        if opening > state.opening_target:
+            parts.release(state.name)
+        else:  # the fingers stay on the part they hold
+            opening = max(opening, state.opening_target)
+    elif opening < now:
+        opening, taken = parts.close(state.name, now, opening)
+        if taken is not None:
+            reply = replies.ok(replies.numbers([opening]))
     if session.motion == "off":
-        grips.set(state, command.opening, session.source)
-        return replies.OK
-    arrival = grips.go(state, command.opening, session.source, wait=session.motion == "on")
-    return replies.OK if arrival is None else arrival
+        grips.set(state, opening, session.source)
+        return reply
+    arrival = grips.go(state, opening, session.source, session.motion == "on", reply)
+    return reply if arrival is None else arrival
