@@ -128,6 +128,9 @@ class RecordingScene(Scene):
     errors: list[tuple[str, str, str]] = field(default_factory=list)
     """(robot, line, message) of each refusal."""
     ghosts: list[tuple[str, bool]] = field(default_factory=list)
+    part_times: list[float] = field(default_factory=list)
+    """The clock time [s] of each change of the parts."""
+    part_events: list[str] = field(default_factory=list)
 
     def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
         self.joints.append(tuple(q))
@@ -161,3 +164,9 @@ class RecordingScene(Scene):
 
     def on_ghost(self, robot: str, shown: bool) -> None:
         self.ghosts.append((robot, shown))
+
+    def on_parts(self, parts: Sequence[Part], t: float) -> None:
+        self.part_times.append(t)
+
+    def on_part_event(self, robot: str | None, text: str) -> None:
+        self.part_events.append(text)

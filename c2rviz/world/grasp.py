@@ -4,10 +4,11 @@ Parallel gripper. The *jaws* are the finger links' collision shapes: their centr
 the midpoint of the first two fingers' shapes (the middle of each shape's bounding box)
 at the opening shown now, and the *closing axis* runs from one to the other (at the
 gripper's full opening). The *gap* is the gripper's separation now (the one CRCL reports).
-Closing to opening S takes a part when all of these hold:
+Closing to opening S takes a part when all of these hold (of several, the one whose
+centre is nearest the closing line):
 
-- the closing line (the axis through the jaws' centre) passes through the part, within
-  ``BETWEEN_M`` of the part's centre;
+- the closing line (the axis through the jaws' centre) passes through the part, at the
+  point of it nearest the part's centre (a long part may be held by one end);
 - the part fits between the fingers as they are now: its width across the axis is at most
   the gap plus ``GRIP_TOL_M``, and it lies within the gap (± ``GRIP_TOL_M``);
 - the fingers would pass its width: the separation at S is below it.
@@ -34,7 +35,6 @@ from ..robot.model import Robot
 from .parts import Part
 
 __all__ = [
-    "BETWEEN_M",
     "CUP_M",
     "GRIP_TOL_M",
     "Jaws",
@@ -46,8 +46,6 @@ __all__ = [
     "take",
 ]
 
-BETWEEN_M = 0.02
-"""The closing line passes at most this far from the part's centre [m]."""
 GRIP_TOL_M = 0.002
 """How far a part may stand out of the gap between the fingers and still be taken [m]."""
 CUP_M = 0.003
@@ -166,8 +164,6 @@ def take(jaws: Jaws, gripper: Gripper, target: float, parts: Sequence[Part]) -> 
         offset = part.pose.translation - jaws.centre
         along = float(offset @ jaws.axis)
         across = float(np.linalg.norm(offset - along * jaws.axis))
-        if across > BETWEEN_M:
-            continue
         if not contains(part.obj.shape, part.obj.size, part.pose, jaws.centre + along * jaws.axis):
             continue
         half = extent(part.obj.shape, part.obj.size, part.pose.rotation, jaws.axis)

@@ -314,9 +314,9 @@ class WorldParts:
         shapes: list[PartShape] = []
         for part in self.parts.all():
             if part.holder is None:
-                shapes.append((part.name, part.geometry, to_root * part.pose, None, touch))
+                shapes.append((part.name, part.checked, to_root * part.pose, None, touch))
             elif part.holder == robot:
-                shapes.append((part.name, part.geometry, part.offset, part.link, touch))
+                shapes.append((part.name, part.checked, part.offset, part.link, touch))
         model.set_parts(shapes)
 
     def _fingers(self, robot: str) -> pin.GeometryModel:

@@ -30,6 +30,7 @@ __all__ = [
     "MAX_PARTS",
     "PART_SHAPES",
     "PART_SIZE_M",
+    "CHECK_MARGIN_M",
     "FLOOR",
     "Part",
     "PartError",
@@ -44,6 +45,8 @@ MAX_PARTS = 100
 PART_SIZE_M = (0.001, 2.0)
 """A part's size (edge, radius, length) [m]: a part is something a gripper lifts."""
 PART_SHAPES = ("box", "cylinder", "sphere")
+CHECK_MARGIN_M = 0.0005
+"""Collision checks see a part this much smaller all round [m] (touching is not hitting)."""
 FLOOR = "floor"
 """What a part lying on the world's floor (z = 0) rests on."""
 _DEFAULT_RGBA = (0.85, 0.55, 0.2, 1.0)  # orange: apart from the grey-blue objects
@@ -85,6 +88,8 @@ class Part:
     Attributes:
         obj: Its name, shape, size and colour (``obj.placement`` is where it was added).
         geometry: Its coal shape (centred on its pose).
+        checked: The shape collision checks use: ``CHECK_MARGIN_M`` smaller all round, so
+            a part resting on a table, or held against it, does not count as hitting it.
         pose: Its pose in the world frame now.
         kind: Its type (``type=``), or None.
         holder: The robot holding it, or None.
@@ -96,6 +101,7 @@ class Part:
 
     obj: WorkcellObject
     geometry: coal.CollisionGeometry
+    checked: coal.CollisionGeometry
     pose: pin.SE3
     kind: str | None = None
     holder: str | None = None
@@ -116,6 +122,18 @@ class Part:
         if self.on is not None and not self.falling:
             return f"resting on {self.on}"
         return "free"
+
+
+def _shrunk(obj: WorkcellObject) -> coal.CollisionGeometry:
+    """``obj``'s shape ``CHECK_MARGIN_M`` smaller all round (at most half its size)."""
+    if obj.shape == "box":
+        return coal.Box(*(max(v - 2 * CHECK_MARGIN_M, v / 2) for v in obj.size))
+    if obj.shape == "cylinder":
+        radius, length = obj.size
+        return coal.Cylinder(
+            max(radius - CHECK_MARGIN_M, radius / 2), max(length - 2 * CHECK_MARGIN_M, length / 2)
+        )
+    return coal.Sphere(max(obj.size[0] - CHECK_MARGIN_M, obj.size[0] / 2))
 
 
 def check_part_size(size: Sequence[float]) -> None:
@@ -166,7 +184,7 @@ class Parts:
             raise BadObjectName(kind, "is too long for a type (64 characters)")
         if len(self._parts) >= self.max_parts:
             raise TooManyParts(self.max_parts)
-        return Part(obj, collision_geometry(obj), pin.SE3(pose), kind)
+        return Part(obj, collision_geometry(obj), _shrunk(obj), pin.SE3(pose), kind)
 
     def add(self, part: Part) -> None:
         self._parts[part.name] = part
