@@ -223,7 +223,9 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
         for name in parser.get(section, "robots", fallback="").split()
     }
     for section in parser.sections():
-        if section in ("options", "objects") or section.startswith(("cell:", "objects:")):
+        if section in ("options", "objects", "parts") or section.startswith(
+            ("cell:", "objects:", "parts:")
+        ):
             continue
         items = dict(parser.items(section))
         if "robot" in items:  # a member of a cell (see cell.py), not a robot of its own

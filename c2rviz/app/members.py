@@ -13,12 +13,14 @@ from pathlib import Path
 import pinocchio as pin
 
 from ..collision.model import CollisionModel
+from ..errors import C2rvizError, ConfigError
 from ..motion.planner import MotionLimits
 from ..robot.frames import pose_se3
 from ..robot.model import Robot
 from ..world.world import World
 from .cell import load_cell
 from .config import Settings
+from .ini_parts import IniPart, ini_parts
 from .robot_options import IniObject, gripper_from, ini_objects, limits_from, tool_from
 
 __all__ = ["Member", "furnish", "members"]
@@ -36,6 +38,7 @@ class Member:
     limits: MotionLimits
     tool: pin.SE3 | None = None
     objects: tuple[IniObject, ...] = ()
+    parts: tuple[IniPart, ...] = ()
 
 
 def members(settings: Settings) -> tuple[list[Member], str | None]:
@@ -110,6 +113,12 @@ def furnish(world: World, member: Member) -> None:
             model.set_object(name, shape, size, placement, rgba, mesh)  # noqa: B023 (run now)
 
         world.edit_objects(member.name, add)
+    base = world.state(member.name).base
+    for name, shape, size, placement, kind, rgba in member.parts:
+        try:
+            world.parts.add(name, shape, size, base * placement, kind, rgba)
+        except C2rvizError as exc:
+            raise ConfigError(f"[parts] {name}: {exc}") from None
 
 
 def _member(
@@ -123,6 +132,7 @@ def _member(
     first: bool,
 ) -> Member:
     objects = tuple(ini_objects(ini, name, first)) if ini is not None else ()
+    parts = tuple(ini_parts(ini, name, first)) if ini is not None else ()
     robot.gripper = gripper_from(section, given, robot)
     return Member(
         name,
@@ -132,4 +142,5 @@ def _member(
         limits_from(section, given, robot),
         tool_from(section, given),
         objects,
+        parts,
     )
