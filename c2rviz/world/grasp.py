@@ -35,6 +35,10 @@ from ..robot.model import Robot
 from .parts import Part
 
 __all__ = [
+    "SUCTION_BELOW",
+    "VACUUM_STROKE_S",
+    "is_vacuum",
+    "make_vacuum",
     "CUP_M",
     "GRIP_TOL_M",
     "Jaws",
@@ -50,6 +54,22 @@ GRIP_TOL_M = 0.002
 """How far a part may stand out of the gap between the fingers and still be taken [m]."""
 CUP_M = 0.003
 """A vacuum cup takes a part whose surface is at most this far from it [m]."""
+
+
+SUCTION_BELOW = 0.5
+"""A vacuum gripper's suction is on below this opening (``grip 0``), off from it (``grip 1``)."""
+VACUUM_STROKE_S = 0.05
+"""Suction on to off, or back [s]."""
+
+
+def make_vacuum(link: str) -> Gripper:
+    """A vacuum gripper: no finger joints, its cup the robot's tool point on ``link``."""
+    return Gripper(link, (), (), (), (), VACUUM_STROKE_S)
+
+
+def is_vacuum(gripper: Gripper | None) -> bool:
+    """True for a vacuum gripper (one with no finger joints)."""
+    return gripper is not None and not gripper.joints
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,7 @@ from ..collision.geometry import robot_geometry
 from ..collision.part_geometry import Obstacle, drop, signed_distance
 from .clock import Timer
 from .goals import MAX_GOALS, Goal, GoalResult, TooManyGoals, score
-from .grasp import extent, finger_links, jaws, opening_for, take
+from .grasp import at_cup, extent, finger_links, jaws, opening_for, take
 from .parts import FLOOR, Part, PartError, Parts
 
 if TYPE_CHECKING:
@@ -187,6 +187,18 @@ class WorldParts:
         part.pose = pin.SE3(part.pose.rotation, part.pose.translation - along * found.axis)
         self.hold(robot, part, gripper.name)
         return max(opening_for(gripper, 2.0 * half), target), part
+
+    def suck(self, robot: str) -> Part | None:
+        """Robot ``robot``'s vacuum cup (its tool point) turns suction on: it takes the part
+        whose surface is within ``CUP_M`` of it, if any."""
+        state = self.robots[robot]
+        if self.parts.held_by(robot):
+            return None
+        cup = state.base * state.robot.ee_pose(state.q) * state.tool
+        part = at_cup(cup, [p for p in self.parts.all() if p.holder != robot])
+        if part is not None:
+            self.hold(robot, part, state.robot.eelink)
+        return part
 
     def hold(self, robot: str, part: Part, link: str) -> None:
         """Fix ``part`` to ``robot``'s ``link`` where it is (taking it from whoever had it)."""

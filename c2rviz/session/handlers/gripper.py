@@ -2,7 +2,9 @@
 
 Closing on a part takes it by the grasp rule (``world/grasp.py``, docs/parts.md): the
 fingers stop where they touch it and the reply says that opening (``ok 0.433``); opening
-them lets go of what they hold.
+them lets go of what they hold. A vacuum gripper's suction turns on below
+``SUCTION_BELOW`` (``grip 0``; taking a part at the cup replies ``ok held``) and off
+from it (``grip 1``), letting go.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from ...errors import NoGripper
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
 from ...protocol.verbs.gripper import Grip
+from ...world.grasp import SUCTION_BELOW, is_vacuum
 
 if TYPE_CHECKING:
     from ..session import Session
@@ -30,7 +33,12 @@ def grip(session: Session, command: Grip) -> Reply:
     opening, reply = command.opening, replies.OK
     parts = session.world.parts
     now = grips.now(state)
-    if parts.parts.held_by(state.name):
+    if is_vacuum(state.robot.gripper):
+        if opening >= SUCTION_BELOW:
+            parts.release(state.name)
+        elif parts.suck(state.name) is not None:
+            reply = replies.ok("held")
+    elif parts.parts.held_by(state.name):
         if opening > state.opening_target:
             parts.release(state.name)
         else:  # the fingers stay on the part they hold
