@@ -18,7 +18,7 @@ from support import ROOT
 NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
 WORDS_ONLY = re.compile(r"^(rand|status)\b")
 """Commands whose numbers vary from run to run."""
-OWN_TEST = {"planning.md"}
+OWN_TEST = {"planning.md", "parts.md"}
 """Pages whose sessions a test of their own replays reply for reply (planning's, with
 ``--seed 1``: tests/planning/test_planning_docs.py)."""
 
