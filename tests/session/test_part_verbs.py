@@ -234,3 +234,21 @@ def test_watch_tells_grasped_released_and_resting(fanuc):
         assert events == ["event grasped p1", "event released p1", "event resting p1 on table"]
     finally:
         watcher.close()
+
+
+def test_a_plan_goes_around_a_post_the_carried_part_would_hit(fanuc):
+    _, client = fanuc
+    _at_pick(client)
+    assert client.ask(_part()) == "ok"
+    assert client.ask("grip 0").startswith("ok 0.")
+    assert client.ask(f"joints {LIFT}") == "ok"
+    # lower than the fingertips, higher than the bottom of the part they hold
+    assert client.ask("object post box 0.05,0.05,0.45 0.272,0.272,0.225,0,0,0") == "ok"
+    for line in ("collisions", "guard on", "motion on"):
+        assert client.ask(line) == ("ok none" if line == "collisions" else "ok")
+    reply = client.ask(f"joints {OFF_TABLE}")
+    assert reply.startswith("error: p1 would hit post at "), reply
+    reply = client.ask(f"plan joints {OFF_TABLE}")
+    assert reply.startswith("ok ") and "waypoints" in reply, reply
+    assert client.ask("part p1").endswith(" held")
+    assert _pose(client.ask("part p1"))[1] > 0.3  # carried round the post
