@@ -37,12 +37,15 @@ from ..robot.visuals import LinkGeometry, load_link_geometry
 from ..session.services import Services
 from ..session.session import Session
 from ..world.effects import Marker, Scene
+from ..world.goals import Goal
+from ..world.parts import Part
 from . import adapter
 from .handle import ToolHandles
 from .instruments import Instruments
 from .markers import MarkerLayer
 from .page_input import PageInput
 from .panel import RECENT_COMMANDS, RobotPanel, StatePanel
+from .parts_layer import PartsLayer
 from .policy import DoorPolicy
 from .robot_view import RobotView, node_name
 from .scheduler import SendScheduler
@@ -153,6 +156,9 @@ class ViserScene(Scene):
         self.markers = MarkerLayer(server, segments, self._pick)
         self.workcells = {name: WorkcellLayer(server, view) for name, view in self.views.items()}
         self.trails = TrailLayer(server, segments)
+        self.parts = PartsLayer(server)
+        self._parts: list[Part] | None = world.parts.parts.all()  # to draw at the next send
+        self._goals: list[Goal] | None = list(world.parts.goals.values())
         self.handles = ToolHandles(server, segments, self.scheduler.request)
         self._frame_camera()
         self.page_input = PageInput(server, self.markers)
@@ -258,6 +264,14 @@ class ViserScene(Scene):
 
     def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
         self._collisions[robot] = list(pairs)
+        self.scheduler.request()
+
+    def on_parts(self, parts: Sequence[Part], t: float) -> None:
+        self._parts = list(parts)
+        self.scheduler.request()
+
+    def on_goals(self, goals: Sequence[Goal]) -> None:
+        self._goals = list(goals)
         self.scheduler.request()
 
     def _pick(self, robot: str, shape: str, instance: int) -> None:
@@ -388,6 +402,12 @@ class ViserScene(Scene):
                 if name in self.workcells:
                     self.workcells[name].show_objects(objects)
             self._objects.clear()
+            if self._parts is not None:
+                self.parts.show_parts(self._parts)
+                self._parts = None
+            if self._goals is not None:
+                self.parts.show_goals(self._goals, self.world.parts.parts.all())
+                self._goals = None
         for name, pairs in self._collisions.items():
             if name in self.workcells:
                 self.workcells[name].show_collisions(pairs)
