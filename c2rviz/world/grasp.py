@@ -164,7 +164,9 @@ def jaws(
 
 
 def opening_for(gripper: Gripper, separation: float) -> float:
-    """The opening (0..1) at which the jaws' separation is ``separation`` [m]."""
+    """The opening (0..1) at which the jaws' separation is ``separation`` [m]: the largest
+    found whose separation is still below it (so closing to it again touches the part:
+    a replay of a recorded ``grip`` grasps as the run did)."""
     low, high = 0.0, 1.0
     if gripper.separation(high) <= separation:
         return high
@@ -174,7 +176,7 @@ def opening_for(gripper: Gripper, separation: float) -> float:
             low = middle
         else:
             high = middle
-    return (low + high) / 2.0
+    return low
 
 
 def take(jaws: Jaws, gripper: Gripper, target: float, parts: Sequence[Part]) -> Part | None:
