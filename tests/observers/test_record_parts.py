@@ -77,3 +77,39 @@ def test_a_recorded_pick_and_place_replays_to_the_same_part_poses(tmp_path: Path
             replayed.close()
     finally:
         second.stop()
+
+
+def test_the_bag_has_each_part_as_a_tf_frame_and_a_marker(tmp_path: Path) -> None:
+    from rosbags.highlevel import AnyReader
+
+    server = _server(tmp_path)
+    client = Client(server.host, server.port)
+    try:
+        for line in SETUP:
+            assert client.ask(line).startswith("ok"), line
+        assert client.ask("record take").startswith("ok recording take")
+        for line in RUN:
+            assert client.ask(line).startswith("ok"), line
+        assert client.ask("record stop").startswith("ok")
+    finally:
+        client.close()
+        server.stop()
+    frames: dict[str, list[tuple[str, tuple[float, float, float]]]] = {}
+    marked: list[tuple[str, int]] = []
+    with AnyReader([tmp_path / "take"]) as reader:
+        for conn, _, raw in reader.messages():
+            message = reader.deserialize(raw, conn.msgtype)
+            if conn.topic == "/tf":
+                for x in message.transforms:
+                    t = x.transform.translation
+                    frames.setdefault(x.child_frame_id, []).append(
+                        (x.header.frame_id, (t.x, t.y, t.z))
+                    )
+            elif conn.topic.endswith("visualization_marker_array"):
+                marked += [(m.ns, m.action) for m in message.markers if m.ns == "parts"]
+    assert {"parts/p1", "parts/p2", "parts/p3"} <= set(frames)
+    parent, (x, y, z) = frames["parts/p1"][-1]
+    assert parent == "base_link" and z == pytest.approx(0.085, abs=1e-6)  # on the floor
+    heights = [where[2] for _, where in frames["parts/p1"]]
+    assert max(heights) > 0.4 and len(heights) > 20  # carried up, falling: frame by frame
+    assert marked.count(("parts", 0)) == 3 and marked.count(("parts", 2)) == 1  # p2 deleted
