@@ -18,20 +18,26 @@ from ..ros.messages import INT32, Msg, tf_message, transforms
 from ..world.parts import Part
 from .bag_topics import xyz_xyzw
 
-__all__ = ["PART_FRAME", "PartFrames", "part_transforms"]
+__all__ = ["PART_FRAME", "PartFrames", "part_items", "part_transforms"]
 
 PART_FRAME = "parts/{name}"
 """A part's TF frame."""
 
 
-def part_transforms(t_s: float, parent: str, to_parent: pin.SE3, parts: Sequence[Part]) -> Msg:
-    """A ``TFMessage`` placing each part's frame in ``parent`` (``to_parent``: the world
-    frame's pose in ``parent``... its inverse places world poses there)."""
-    items = [
+def part_items(
+    parent: str, to_parent: pin.SE3, parts: Sequence[Part]
+) -> list[tuple[str, str, Sequence[float], Sequence[float]]]:
+    """Each part's frame in ``parent`` (``to_parent`` takes a world pose into ``parent``),
+    as ``messages.transforms`` takes them."""
+    return [
         (parent, PART_FRAME.format(name=part.name), *xyz_xyzw(to_parent * part.pose))
         for part in parts
     ]
-    return tf_message(transforms(t_s, items))
+
+
+def part_transforms(t_s: float, parent: str, to_parent: pin.SE3, parts: Sequence[Part]) -> Msg:
+    """A ``TFMessage`` placing each part's frame in ``parent`` (see ``part_items``)."""
+    return tf_message(transforms(t_s, part_items(parent, to_parent, parts)))
 
 
 class PartFrames:
