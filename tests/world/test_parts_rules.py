@@ -138,3 +138,20 @@ async def _hand_over() -> None:
     assert [p.name for p in parts.release("b")] == ["p"]
     assert parts.parts.get("p").holder is None
     world.close()
+
+
+def test_a_held_part_collides_with_another_robot_of_the_cell() -> None:
+    asyncio.run(_held_against_the_other())
+
+
+async def _held_against_the_other() -> None:
+    world = _cell()
+    world.parts.add("p", "box", (0.03, 0.03, 0.03), _at(*JAWS))
+    _, taken = world.parts.close("a", 1.0, 0.0)
+    assert taken is not None
+    # (the two hands overlap: a rule test, not a cell one could build)
+    assert ("p", "b/gripper_hand") not in world.contacts.now("a")
+    world.set_q((0, 0.32, -0.33, 0, -0.9207963, 0), "b")  # b's hand 17 mm lower: onto p
+    assert ("p", "b/gripper_hand") in world.contacts.now("a")
+    assert ("gripper_hand", "a/p") in world.contacts.now("b")
+    world.close()
