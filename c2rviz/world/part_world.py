@@ -79,6 +79,7 @@ class WorldParts:
         self.tell = tell
         self.parts = Parts()
         self._geometry: dict[str, pin.GeometryModel] = {}
+        self._data: dict[str, pin.Data] = {}  # each robot's, for the parts it carries
         self._falls: dict[str, tuple[float, float, float, str]] = {}  # t0, z0, drop, onto
         self._timer: Timer | None = None
         self.goals: dict[str, Goal] = {}
@@ -296,11 +297,15 @@ class WorldParts:
             return
         state = self.robots[robot]
         model = state.robot.model
-        data = model.createData()
-        pin.framesForwardKinematics(model, data, state.robot.configuration(q))
+        data = self._data.get(robot)
+        if data is None:
+            data = self._data[robot] = model.createData()
+        pin.forwardKinematics(model, data, state.robot.configuration(q))
         for part in held:
             assert part.link is not None
-            part.pose = state.origin * data.oMf[model.getFrameId(part.link)] * part.offset
+            frame = model.getFrameId(part.link)
+            link = pin.updateFramePlacement(model, data, frame)
+            part.pose = state.origin * link * part.offset
         self.changed(models=False)
 
     def stop(self) -> None:
