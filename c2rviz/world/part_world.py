@@ -247,6 +247,18 @@ class WorldParts:
         part.falling, part.on = False, onto
         self.tell("on_part_event", None, f"resting {part.name} on {onto}")
 
+    def objects_changed(self) -> None:
+        """The workcell changed: a part resting on an object that is gone settles again."""
+        there = {name for name, _, _ in self.obstacles()} | {FLOOR}
+        for part in self.parts.all():
+            if part.on is not None and part.on not in there and not part.falling:
+                self._unsupport_part(part)
+        self.changed()
+
+    def _unsupport_part(self, part: Part) -> None:
+        part.on = None
+        self._settle(part)
+
     def _unsupport(self, name: str) -> None:
         """Parts resting on ``name`` (taken or removed) settle again."""
         for part in self.parts.all():

@@ -253,6 +253,8 @@ class World:
         for observer in self.observers:
             observer.on_objects(robot, objects)
         self.contacts.changed(robot)
+        if self.parts.parts:
+            self.parts.objects_changed()
 
     def others(self, robot: str) -> list[tuple[str, CollisionModel, tuple[float, ...], pin.SE3]]:
         """Every other robot of the world as it stands: its name, collision model, joints

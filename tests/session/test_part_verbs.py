@@ -252,3 +252,14 @@ def test_a_plan_goes_around_a_post_the_carried_part_would_hit(fanuc):
     assert reply.startswith("ok ") and "waypoints" in reply, reply
     assert client.ask("part p1").endswith(" held")
     assert _pose(client.ask("part p1"))[1] > 0.3  # carried round the post
+
+
+def test_a_part_on_an_object_that_is_removed_falls(fanuc):
+    _, client = fanuc
+    assert client.ask(TABLE) == "ok"
+    assert client.ask(_part()) == "ok"
+    assert client.ask("part p1").endswith(" resting on table")
+    assert client.ask("object table remove") == "ok"
+    assert client.ask("sleep 1") == "ok"
+    reply = client.ask("part p1")
+    assert reply.endswith(" resting on floor") and _pose(reply)[2] == pytest.approx(TALL / 2)
