@@ -349,6 +349,8 @@ class CollisionModel:
 
     def set_parts(self, parts: Sequence[PartShape]) -> None:
         """The parts now (``part_checks.add_parts`` says how each is checked)."""
+        if not parts and not self._parts:
+            return  # nothing to check before or after: the checks (and revision) stay
         self._parts = tuple(parts)
         self._rebuild()
 

@@ -16,12 +16,18 @@ import pinocchio as pin
 from ..ros import markers as mk
 from ..ros.messages import INT32, Msg, tf_message, transforms
 from ..world.parts import Part
-from .bag_topics import xyz_xyzw
 
 __all__ = ["PART_FRAME", "PartFrames", "part_items", "part_transforms"]
 
 PART_FRAME = "parts/{name}"
 """A part's TF frame."""
+
+
+def xyz_xyzw(placement: pin.SE3) -> tuple[Sequence[float], Sequence[float]]:
+    """Translation and quaternion (x, y, z, w) of ``placement`` (as ``bag_topics``'s, which
+    this module does not import: rosbridge uses it, and the start loads no rosbags)."""
+    x, y, z, qx, qy, qz, qw = pin.SE3ToXYZQUAT(placement).tolist()
+    return (x, y, z), (qx, qy, qz, qw)
 
 
 def part_items(
