@@ -158,7 +158,7 @@ class ViserScene(Scene):
         self.trails = TrailLayer(server, segments)
         self.parts = PartsLayer(server)
         self._parts: list[Part] | None = world.parts.parts.all()  # to draw at the next send
-        self._goals: list[Goal] | None = list(world.parts.goals.values())
+        self._goals: list[Goal] | None = world.parts.goals.all()
         self.handles = ToolHandles(server, segments, self.scheduler.request)
         self._frame_camera()
         self.page_input = PageInput(server, self.markers)

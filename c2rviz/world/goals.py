@@ -18,13 +18,14 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import C2rvizError
-from .parts import Part
+from .parts import Part, PartError, Parts
 
 __all__ = [
     "DEFAULT_TOL_M",
     "DEFAULT_TOL_RAD",
     "MAX_GOALS",
     "Goal",
+    "GoalBook",
     "GoalResult",
     "TooManyGoals",
     "score",
@@ -112,3 +113,31 @@ def score(goals: Sequence[Goal], parts: Sequence[Part]) -> list[GoalResult]:
         )
         results.append(GoalResult(goal, part.name, distance, angle, met))
     return results
+
+
+class GoalBook:
+    """The goals of a world, by key, in the order they were first set."""
+
+    def __init__(self, max_goals: int = MAX_GOALS) -> None:
+        self.max_goals = max_goals
+        self._goals: dict[str, Goal] = {}
+
+    def set(self, goal: Goal, parts: Parts) -> None:
+        """Add or replace ``goal``; one for a named part that is not in ``parts`` is refused
+        (``UnknownPart``; a type goal with no part of its type counts as missing)."""
+        if goal.kind is None:
+            parts.get(goal.key)
+        if goal.key not in self._goals and len(self._goals) >= self.max_goals:
+            raise TooManyGoals(self.max_goals)
+        self._goals[goal.key] = goal
+
+    def remove(self, key: str) -> None:
+        """Remove one goal (``all``: every one)."""
+        if key == "all":
+            self._goals.clear()
+        elif self._goals.pop(key, None) is None:
+            have = ", ".join(self._goals) or "none"
+            raise PartError(f"no goal for {key!r} (goals: {have})")
+
+    def all(self) -> list[Goal]:
+        return list(self._goals.values())

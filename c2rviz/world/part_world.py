@@ -14,7 +14,6 @@ and never passes through an object. A part resting on a part that is taken away 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
@@ -23,8 +22,8 @@ import pinocchio as pin
 
 from ..collision.geometry import robot_geometry
 from ..collision.part_geometry import Obstacle, drop, signed_distance
-from .clock import Timer
-from .goals import MAX_GOALS, Goal, GoalResult, TooManyGoals, score
+from .falls import G_M_S2, Falls
+from .goals import Goal, GoalBook, GoalResult, score
 from .grasp import at_cup, extent, finger_links, jaws, opening_for, take
 from .parts import FLOOR, Part, PartError, Parts
 
@@ -40,8 +39,6 @@ REST_TOL_M = 0.002
 """A part put down this close above something rests on it [m]."""
 OVERLAP_TOL_M = 0.001
 """A new part may sink this deep into an object or part (resting on it) [m]."""
-G_M_S2 = 9.81
-"""A falling part's acceleration [m/s²]."""
 
 
 class PartInsideObject(PartError):
@@ -80,33 +77,23 @@ class WorldParts:
         self.parts = Parts()
         self._geometry: dict[str, pin.GeometryModel] = {}
         self._data: dict[str, pin.Data] = {}  # each robot's, for the parts it carries
-        self._falls: dict[str, tuple[float, float, float, str]] = {}  # t0, z0, drop, onto
-        self._timer: Timer | None = None
-        self.goals: dict[str, Goal] = {}
+        self.falls = Falls(clock, frame_s, self._rest, lambda done: self.changed(models=done))
+        self.goals = GoalBook()
 
     # --- goals ------------------------------------------------------------------------
 
     def set_goal(self, goal: Goal) -> None:
-        """Add or replace a goal; one for a named part that does not exist is refused
-        (a type goal with no part of its type counts as missing)."""
-        if goal.kind is None:
-            self.parts.get(goal.key)
-        if goal.key not in self.goals and len(self.goals) >= MAX_GOALS:
-            raise TooManyGoals(MAX_GOALS)
-        self.goals[goal.key] = goal
-        self.tell("on_goals", list(self.goals.values()))
+        """Add or replace a goal (``GoalBook.set``: a named part must exist)."""
+        self.goals.set(goal, self.parts)
+        self.tell("on_goals", self.goals.all())
 
     def remove_goal(self, key: str) -> None:
         """Remove one goal (``all``: every one)."""
-        if key == "all":
-            self.goals.clear()
-        elif self.goals.pop(key, None) is None:
-            have = ", ".join(self.goals) or "none"
-            raise PartError(f"no goal for {key!r} (goals: {have})")
-        self.tell("on_goals", list(self.goals.values()))
+        self.goals.remove(key)
+        self.tell("on_goals", self.goals.all())
 
     def score(self) -> list[GoalResult]:
-        return score(list(self.goals.values()), self.parts.all())
+        return score(self.goals.all(), self.parts.all())
 
     # --- what is around --------------------------------------------------------------
 
@@ -162,7 +149,7 @@ class WorldParts:
         """Remove one part (``all``: every one)."""
         gone = self.parts.clear() if name == "all" else [self.parts.remove(name)]
         for part in gone:
-            self._falls.pop(part.name, None)
+            self.falls.cancel(part.name)
         for part in gone:
             self._unsupport(part.name)
         self.changed()
@@ -210,8 +197,7 @@ class WorldParts:
         link_pose = state.origin * data.oMf[model.getFrameId(link)]
         part.holder, part.link, part.on = robot, link, None
         part.offset = link_pose.inverse() * part.pose
-        self._falls.pop(part.name, None)
-        part.falling = False
+        self.falls.cancel(part.name)
         self.tell("on_part_event", robot, f"grasped {part.name}")
         self._unsupport(part.name)
         self.changed()
@@ -233,15 +219,7 @@ class WorldParts:
             self._lower(part, down)
             self._rest(part, onto)
         else:
-            part.falling, part.on = True, None
-            self._falls[part.name] = (
-                self.clock.now(),
-                float(part.pose.translation[2]),
-                down,
-                onto,
-            )
-            if self._timer is None:
-                self._timer = self.clock.call_later(self.frame_s, self._tick)
+            self.falls.start(part, down, onto)
 
     def _rest(self, part: Part, onto: str) -> None:
         part.falling, part.on = False, onto
@@ -280,26 +258,6 @@ class WorldParts:
     def _lower(part: Part, down: float) -> None:
         part.pose = pin.SE3(part.pose.rotation, part.pose.translation - np.array([0, 0, down]))
 
-    def _tick(self) -> None:
-        self._timer = None
-        t = self.clock.now()
-        for name, (t0, z0, down, onto) in list(self._falls.items()):
-            part = self.parts.get(name)
-            fallen = min(down, 0.5 * G_M_S2 * (t - t0) ** 2)
-            part.pose = pin.SE3(
-                part.pose.rotation, np.array([*part.pose.translation[:2], z0 - fallen])
-            )
-            if fallen >= down:
-                del self._falls[name]
-                self._rest(part, onto)
-        self.changed(models=not self._falls)
-        if self._falls:
-            self._timer = self.clock.call_later(self.frame_s, self._tick)
-
-    def fall_time(self, down_m: float) -> float:
-        """How long a fall of ``down_m`` takes [s]."""
-        return math.sqrt(2.0 * down_m / G_M_S2)
-
     # --- following the arms ----------------------------------------------------------
 
     def moved(self, robot: str, q: Sequence[float]) -> None:
@@ -321,9 +279,7 @@ class WorldParts:
         self.changed(models=False)
 
     def stop(self) -> None:
-        if self._timer is not None:
-            self._timer.cancel()
-            self._timer = None
+        self.falls.stop()
 
     # --- telling ----------------------------------------------------------------------
 
