@@ -117,7 +117,7 @@ class Grips:
         grip.active = grip.t1 > t
         arrival: asyncio.Future[str] | None = None
         if wait:
-            arrival = asyncio.get_running_loop().create_future()
+            arrival = self.clock.future()  # a virtual clock goes on while it waits
             grip.arrivals.append(arrival)
         if grip.active:
             if self._timer is None:

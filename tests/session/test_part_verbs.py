@@ -263,3 +263,14 @@ def test_a_part_on_an_object_that_is_removed_falls(fanuc):
     assert client.ask("sleep 1") == "ok"
     reply = client.ask("part p1")
     assert reply.endswith(" resting on floor") and _pose(reply)[2] == pytest.approx(TALL / 2)
+
+
+def test_with_motion_on_the_fingers_travel_onto_the_part_and_reply_where_they_stop(fanuc):
+    server, client = fanuc
+    _at_pick(client)
+    assert client.ask(_part()) == "ok"
+    assert client.ask("motion on") == "ok"
+    t0 = server.call(server.world.clock.now)
+    assert client.ask("grip 0") == "ok 0.5"  # on arrival, half a stroke later
+    assert server.call(server.world.clock.now) - t0 == pytest.approx(0.15, abs=0.02)
+    assert client.ask("part p1").endswith(" held")
