@@ -166,6 +166,11 @@ class CollisionModel:
         self.self_pairs = self._choose_pairs(skip, moving, samples, seed)
         self.workcell = Workcell(known, max_objects)
         self._parts: tuple[PartShape, ...] = ()
+        self._touching: tuple[frozenset[str], frozenset[str], frozenset[str]] = (
+            frozenset(),
+            frozenset(),
+            frozenset(),
+        )  # its fingers, every part's name, the other robots' fingers (``set_parts``)
         self._revision = 0
         self._rebuild()
 
@@ -274,7 +279,13 @@ class CollisionModel:
         self._revision += 1
         moving, link_of = held_as_links(geometry, self._moving_geoms, self._link_of)
         self._snapshot = CheckGeometry(  # one assignment: another thread reads it whole
-            geometry, data, tuple(names), moving, link_of, self._revision
+            geometry,
+            data,
+            tuple(names),
+            moving,
+            link_of,
+            self._revision,
+            *self._touching,
         )
 
     # --- for checkers of one's own -----------------------------------------------
@@ -347,12 +358,27 @@ class CollisionModel:
         self.workcell.clear()
         self._rebuild()
 
-    def set_parts(self, parts: Sequence[PartShape]) -> None:
-        """The parts now (``part_checks.add_parts`` says how each is checked)."""
-        if not parts and not self._parts:
-            return  # nothing to check before or after: the checks (and revision) stay
+    def set_parts(
+        self,
+        parts: Sequence[PartShape],
+        touch: frozenset[str] = frozenset(),
+        names: frozenset[str] = frozenset(),
+        other_touch: frozenset[str] = frozenset(),
+    ) -> None:
+        """The parts now (``part_checks.add_parts`` says how each is checked); ``touch``:
+        this robot's links that may touch parts, ``names``: every part's (those other
+        robots hold too), ``other_touch``: the other robots' links that may touch a part
+        (as ``robot/link``)."""
+        if not parts and not self._parts and not names and not self._touching[1]:
+            return  # no parts before or after: the checks (and revision) stay
         self._parts = tuple(parts)
+        self._touching = (touch, names, other_touch)
         self._rebuild()
+
+    @property
+    def touching(self) -> tuple[frozenset[str], frozenset[str], frozenset[str]]:
+        """Its fingers, the parts' names, the other robots' fingers (``set_parts``)."""
+        return self._touching
 
     def objects(self) -> list[str]:
         """The objects' names, in the order they were first set."""

@@ -6,8 +6,9 @@ where the URDF's neutral pose puts them, not at their opening). A part this robo
 is fixed to its gripper's link and checked against every link of the robot except those
 fixed to that link and the ones it may touch, against the workcell's objects and against
 the free parts; ``held_as_links`` makes a ``BatchCheck`` check it against the other
-robots of a cell too, and ``held_shapes`` shows it to them. A pair with a part is
-``(link, part)``, ``(part, object)`` or ``(part, other_part)``.
+robots of a cell too, and ``held_shapes`` shows it to them. Between robots, a robot's
+fingers and a part another one holds may touch (``batch.may_touch``: a hand-over). A
+pair with a part is ``(link, part)``, ``(part, object)`` or ``(part, other_part)``.
 """
 
 from __future__ import annotations

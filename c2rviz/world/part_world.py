@@ -302,7 +302,14 @@ class WorldParts:
                 shapes.append((part.name, part.checked, to_root * part.pose, None, touch))
             elif part.holder == robot:
                 shapes.append((part.name, part.checked, part.offset, part.link, touch))
-        model.set_parts(shapes)
+        other_touch = frozenset(
+            f"{name}/{link}"
+            for name, other in self.robots.items()
+            if name != robot
+            for link in finger_links(other.robot)
+        )
+        names = frozenset(self.parts.names())
+        model.set_parts(shapes, touch, names, other_touch)
 
     def _fingers(self, robot: str) -> pin.GeometryModel:
         geometry = self._geometry.get(robot)

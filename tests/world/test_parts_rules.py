@@ -11,6 +11,7 @@ import pinocchio as pin
 import pytest
 from support import load_robot
 
+from c2rviz.collision.other_robots import placed_shapes
 from c2rviz.collision.part_geometry import drop, extent
 from c2rviz.collision.workcell import collision_geometry, make_object
 from c2rviz.robot.gripper import Gripper
@@ -151,6 +152,16 @@ async def _held_against_the_other() -> None:
     assert taken is not None
     # (the two hands overlap: a rule test, not a cell one could build)
     assert ("p", "b/gripper_hand") not in world.contacts.now("a")
+    # b's fingers (checked closed, through p) may touch the part a holds, as a's may
+    fingers = {"gripper_finger_left", "gripper_finger_right"}
+    assert not [(x, y) for x, y in world.contacts.now("a") if x == "p" and y[2:] in fingers]
+    assert not [(x, y) for x, y in world.contacts.now("b") if x in fingers and y == "a/p"]
+    source = world.collision_model("b").check_geometry()
+    others = placed_shapes("a", world.collision_model("a"), world.state("a").q, pin.SE3.Identity())
+    check = world.collision_model("b").batch_check(others, origin=world.state("b").origin)
+    assert not [n for n in check.names if n[0] in fingers and n[1] == "a/p"]
+    assert [n for n in check.names if n == ("gripper_hand", "a/p")]
+    assert source.touch == fingers and "p" in source.parts
     world.set_q((0, 0.32, -0.33, 0, -0.9207963, 0), "b")  # b's hand 17 mm lower: onto p
     assert ("p", "b/gripper_hand") in world.contacts.now("a")
     assert ("gripper_hand", "a/p") in world.contacts.now("b")
