@@ -9,6 +9,7 @@ import re
 import pytest
 from support import ROOT, Client, ServerLimits, ServerThread, load_robot
 
+from c2rviz.protocol.verbs import parts as verbs_parts
 from c2rviz.world import goals, grasp, part_world, parts
 from c2rviz.world.virtual_clock import VirtualClock
 
@@ -70,4 +71,5 @@ def test_the_limits_table_is_the_code() -> None:
     for name, cell in values.items():
         row = next(line for line in table.splitlines() if f".{name}`" in line)
         assert cell in row, (name, row)
+    assert verbs_parts.PART_SIZE_M == parts.PART_SIZE_M  # the parser's copy
     assert goals.DEFAULT_TOL_M == 0.005 and math.degrees(goals.DEFAULT_TOL_RAD) == 5.0
