@@ -14,7 +14,7 @@ NUMBER = r"-?\d+(?:\.\d+)?(?:e[+-]?\d+)?"
 
 EVENT = re.compile(
     r"event (arrived|stopped|clear|dropped \d+|marker \S+ \w+ \S+|record-stopped .+"
-    r"|collision \S+)"
+    r"|collision \S+|grasped \S+|released \S+|resting \S+ on \S+)"
 )
 
 

@@ -13,6 +13,7 @@ from pathlib import Path
 import pinocchio as pin
 
 from ..collision.model import CollisionModel
+from ..errors import C2rvizError, ConfigError
 from ..motion.planner import MotionLimits
 from ..robot.frames import pose_se3
 from ..robot.model import Robot
@@ -20,6 +21,7 @@ from ..world.world import World
 from .cell import load_cell
 from .config import Settings
 from .ini_faults import IniFault, ini_faults, start_faults
+from .ini_parts import IniPart, ini_parts
 from .robot_options import IniObject, gripper_from, ini_objects, limits_from, tool_from
 
 __all__ = ["Member", "furnish", "members"]
@@ -38,6 +40,7 @@ class Member:
     tool: pin.SE3 | None = None
     objects: tuple[IniObject, ...] = ()
     faults: tuple[IniFault, ...] = ()
+    parts: tuple[IniPart, ...] = ()
 
 
 def members(settings: Settings) -> tuple[list[Member], str | None]:
@@ -113,6 +116,12 @@ def furnish(world: World, member: Member) -> None:
 
         world.edit_objects(member.name, add)
     start_faults(world, member.name, member.faults)
+    base = world.state(member.name).base
+    for name, shape, size, placement, kind, rgba in member.parts:
+        try:
+            world.parts.add(name, shape, size, base * placement, kind, rgba)
+        except C2rvizError as exc:
+            raise ConfigError(f"[parts] {name}: {exc}") from None
 
 
 def _member(
@@ -126,6 +135,7 @@ def _member(
     first: bool,
 ) -> Member:
     objects = tuple(ini_objects(ini, name, first)) if ini is not None else ()
+    parts = tuple(ini_parts(ini, name, first)) if ini is not None else ()
     robot.gripper = gripper_from(section, given, robot)
     return Member(
         name,
@@ -136,4 +146,5 @@ def _member(
         tool_from(section, given),
         objects,
         tuple(ini_faults(ini, name, robot, first)) if ini is not None else (),
+        parts,
     )

@@ -32,6 +32,7 @@ from ..errors import C2rvizError, ConfigError
 from ..motion.planner import MotionLimits, motion_limits
 from ..robot.gripper import Gripper, make_gripper
 from ..robot.model import Robot
+from ..world.grasp import make_vacuum
 
 __all__ = ["IniObject", "gripper_from", "ini_objects", "limits_from", "pose_from", "tool_from"]
 
@@ -66,6 +67,8 @@ def gripper_from(section: str, extras: Mapping[str, str], robot: Robot) -> Gripp
         return robot.gripper
     if text.strip().lower() == "none":
         return None
+    if text.strip().lower() == "vacuum":
+        return make_vacuum(robot.eelink)
     where = f"[{section}] gripper"
     joints: list[tuple[str, float, float]] = []
     for entry in text.split():

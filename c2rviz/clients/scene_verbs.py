@@ -9,7 +9,9 @@ from pathlib import Path
 from typing import TypeVar
 
 from . import calls
+from . import part_verbs as part_calls
 from .calls import Call, speaks
+from .part_verbs import PartState, Score
 from .records import RecordingResult, RecordingStatus, TrailStatus
 
 __all__ = ["SceneVerbs"]
@@ -116,3 +118,66 @@ class SceneVerbs:
         """Refuse this connection's commands whose target or path collides (``True``);
         return whether the guard is on."""
         return self.call(calls.guard(on))
+
+    # Parts, goals and the score (docs/parts.md).
+
+    @speaks("part")
+    def add_part(
+        self,
+        name: str,
+        shape: str,
+        size: float | Sequence[float],
+        pose: Sequence[float],
+        kind: str | None = None,
+        color: Sequence[float] | None = None,
+    ) -> None:
+        """Add part ``name`` a gripper can pick: a ``box`` (size sx, sy, sz [m]), a
+        ``cylinder`` (r, length [m]) or a ``sphere`` (r [m]) at ``pose`` (x, y, z [m], roll,
+        pitch, yaw [rad, or deg]; a sphere's x, y, z alone) in the base frame; ``kind`` is
+        its ``type=``, ``color`` its r, g, b (0..1)."""
+        return self.call(part_calls.add_part(name, shape, size, pose, kind, color))
+
+    @speaks("part")
+    def part(self, name: str) -> PartState:
+        """Where part ``name`` is (x, y, z [m], roll, pitch, yaw [rad, or deg], base frame)
+        and what holds it (``free``, ``held``, ``resting on WHAT``)."""
+        return self.call(part_calls.part(name))
+
+    @speaks("part")
+    def remove_part(self, name: str) -> None:
+        """Remove part ``name``."""
+        return self.call(part_calls.remove_part(name))
+
+    @speaks("part")
+    def remove_parts(self) -> None:
+        """Remove every part."""
+        return self.call(part_calls.REMOVE_PARTS)
+
+    @speaks("parts")
+    def parts(self) -> dict[str, PartState]:
+        """Every part by name: its pose (x, y, z [m], roll, pitch, yaw [rad, or deg], base
+        frame) and state."""
+        return self.call(part_calls.PARTS)
+
+    @speaks("goal")
+    def goal(self, target: str, pose: Sequence[float], tol: Sequence[float] | None = None) -> None:
+        """Say where part ``target`` (or any part of a type: ``type=T``) should end: ``pose``
+        (x, y, z [m], roll, pitch, yaw [rad, or deg], base frame) within ``tol`` (metres,
+        angle [rad, or deg]; default 5 mm and 5 degrees)."""
+        return self.call(part_calls.goal(target, pose, tol))
+
+    @speaks("goal")
+    def remove_goal(self, target: str) -> None:
+        """Remove the goal of ``target`` (a part's name or ``type=T``)."""
+        return self.call(part_calls.remove_goal(target))
+
+    @speaks("goal")
+    def remove_goals(self) -> None:
+        """Remove every goal."""
+        return self.call(part_calls.REMOVE_GOALS)
+
+    @speaks("score")
+    def score(self) -> Score:
+        """How many goals are met, and how far off the others are (mm, and degrees or
+        radians as the server words it)."""
+        return self.call(part_calls.SCORE)

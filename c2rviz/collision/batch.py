@@ -30,7 +30,7 @@ import pinocchio as pin
 from ..robot.model import Robot
 from .geometry import Pair
 
-__all__ = ["CHUNK", "BatchCheck", "CheckGeometry", "PlacedShape"]
+__all__ = ["CHUNK", "BatchCheck", "CheckGeometry", "PlacedShape", "may_touch"]
 
 CHUNK = 8  # configurations per Pinocchio call (the event loop's longest wait, see the module)
 
@@ -61,6 +61,21 @@ class CheckGeometry:
     moving: tuple[int, ...]
     link_of: tuple[str, ...]
     revision: int
+    touch: frozenset[str] = frozenset()
+    """Links that may touch parts (the fingers): never checked against another robot's
+    held part (``part_checks``)."""
+    parts: frozenset[str] = frozenset()
+    """Every part's name."""
+    other_touch: frozenset[str] = frozenset()
+    """The other robots' links that may touch parts (``robot/link``)."""
+
+
+def may_touch(source: CheckGeometry, mine: str, other: str) -> bool:
+    """Whether this robot's shape ``mine`` and another robot's ``other`` (``robot/link``)
+    are a finger and a held part, which may touch."""
+    return (mine in source.touch and other.rsplit("/", 1)[-1] in source.parts) or (
+        mine in source.parts and other in source.other_touch
+    )
 
 
 class BatchCheck:
@@ -105,7 +120,11 @@ class BatchCheck:
             k = geometry.addGeometryObject(
                 pin.GeometryObject(f"cell/{name}", 0, 0, to_root * placement, shape)
             )
-            pairs += [(pin.CollisionPair(i, k), (source.link_of[i], name)) for i in source.moving]
+            pairs += [
+                (pin.CollisionPair(i, k), (source.link_of[i], name))
+                for i in source.moving
+                if not may_touch(source, source.link_of[i], name)
+            ]
         excluded = set(without)
         kept = [(p, n) for p, n in pairs if n not in excluded and (only is None or n in only)]
         if len(kept) != len(geometry.collisionPairs):

@@ -44,6 +44,7 @@ from .geometry import (
     read_srdf,
     robot_geometry,
 )
+from .part_checks import PartShape, add_parts, held_as_links, held_shapes
 from .workcell import MAX_OBJECTS, Workcell, WorkcellObject
 
 __all__ = [
@@ -164,6 +165,12 @@ class CollisionModel:
         self.warnings = tuple(notes)
         self.self_pairs = self._choose_pairs(skip, moving, samples, seed)
         self.workcell = Workcell(known, max_objects)
+        self._parts: tuple[PartShape, ...] = ()
+        self._touching: tuple[frozenset[str], frozenset[str], frozenset[str]] = (
+            frozenset(),
+            frozenset(),
+            frozenset(),
+        )  # its fingers, every part's name, the other robots' fingers (``set_parts``)
         self._revision = 0
         self._rebuild()
 
@@ -232,8 +239,10 @@ class CollisionModel:
         link_pairs: set[Pair],
         objects: list[tuple[WorkcellObject, coal.CollisionGeometry]],
         exact: bool = True,
+        parts: Sequence[PartShape] = (),
     ) -> _Checks:
-        """A geometry model checking ``link_pairs`` and the objects against moving links."""
+        """A geometry model checking ``link_pairs`` and the objects against moving links
+        (and ``parts``: see ``part_checks.add_parts``)."""
         geometry = pin.GeometryModel()
         names = []
         for obj in self._geometry.geometryObjects:
@@ -257,22 +266,26 @@ class CollisionModel:
             for i in self._moving_geoms:
                 geometry.addCollisionPair(pin.CollisionPair(i, k))
                 names.append((self._link_of[i], obj.name))
+        if parts:
+            add_parts(self.model, geometry, names, self._link_of, self._moving_geoms, parts)
         data = geometry.createData()
         configure_requests(data, exact)
         return geometry, data, names
 
     def _rebuild(self) -> None:
         self._checks = geometry, data, names = self._build(
-            set(self.self_pairs.checked), self.workcell.items()
+            set(self.self_pairs.checked), self.workcell.items(), parts=self._parts
         )
         self._revision += 1
+        moving, link_of = held_as_links(geometry, self._moving_geoms, self._link_of)
         self._snapshot = CheckGeometry(  # one assignment: another thread reads it whole
             geometry,
             data,
             tuple(names),
-            tuple(self._moving_geoms),
-            tuple(self._link_of),
+            moving,
+            link_of,
             self._revision,
+            *self._touching,
         )
 
     # --- for checkers of one's own -----------------------------------------------
@@ -345,6 +358,28 @@ class CollisionModel:
         self.workcell.clear()
         self._rebuild()
 
+    def set_parts(
+        self,
+        parts: Sequence[PartShape],
+        touch: frozenset[str] = frozenset(),
+        names: frozenset[str] = frozenset(),
+        other_touch: frozenset[str] = frozenset(),
+    ) -> None:
+        """The parts now (``part_checks.add_parts`` says how each is checked); ``touch``:
+        this robot's links that may touch parts, ``names``: every part's (those other
+        robots hold too), ``other_touch``: the other robots' links that may touch a part
+        (as ``robot/link``)."""
+        if not parts and not self._parts and not names and not self._touching[1]:
+            return  # no parts before or after: the checks (and revision) stay
+        self._parts = tuple(parts)
+        self._touching = (touch, names, other_touch)
+        self._rebuild()
+
+    @property
+    def touching(self) -> tuple[frozenset[str], frozenset[str], frozenset[str]]:
+        """Its fingers, the parts' names, the other robots' fingers (``set_parts``)."""
+        return self._touching
+
     def objects(self) -> list[str]:
         """The objects' names, in the order they were first set."""
         return self.workcell.names()
@@ -402,13 +437,15 @@ class CollisionModel:
         another robot, ``other_robots.py``)."""
         geometry = self._geometry
         data = geometry.createData()  # its own data: safe beside checks on another thread
+        model_data = self.model.createData()
         pin.updateGeometryPlacements(
-            self.model, self.model.createData(), geometry, data, self.robot.configuration(q)
+            self.model, model_data, geometry, data, self.robot.configuration(q)
         )
-        return [
+        shapes = [
             (link, obj.geometry, data.oMg[k].copy())
             for k, (link, obj) in enumerate(zip(self._link_of, geometry.geometryObjects))
         ]
+        return shapes + held_shapes(self.model, model_data, self._parts)
 
     def links_in(self, pairs: Iterable[Pair]) -> list[str]:
         """The robot links among ``pairs`` (to highlight), sorted."""

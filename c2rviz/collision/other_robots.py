@@ -21,7 +21,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from .batch import PlacedShape
+from .batch import PlacedShape, may_touch
 from .geometry import Pair
 from .model import CollisionModel
 
@@ -57,7 +57,7 @@ def pairs_between(
     if not placed:
         return []
     mine = [(link, shape, origin * placement) for link, shape, placement in model.link_shapes(q)]
-    near = _near(mine, placed)
+    near = _apart(model, mine, placed, _near(mine, placed))
     return sorted({(mine[i][0], placed[j][0]) for i, j in near if _collide(mine[i], placed[j])})
 
 
@@ -84,10 +84,23 @@ def first_hit_between(
         mine = [
             (link, shape, origin * placement) for link, shape, placement in model.link_shapes(q)
         ]
-        for i, j in _near(mine, placed):
+        for i, j in _apart(model, mine, placed, _near(mine, placed)):
             if _collide(mine[i], placed[j]):
                 return index, (mine[i][0], placed[j][0])
     return None
+
+
+def _apart(
+    model: CollisionModel,
+    mine: list[tuple[str, Any, pin.SE3]],
+    theirs: list[tuple[str, Any, pin.SE3]],
+    pairs: list[tuple[int, int]],
+) -> list[tuple[int, int]]:
+    """``pairs`` less a finger and a held part, which may touch (``batch.may_touch``)."""
+    source = model.check_geometry()
+    if not source.parts:
+        return pairs
+    return [(i, j) for i, j in pairs if not may_touch(source, mine[i][0], theirs[j][0])]
 
 
 def _near(

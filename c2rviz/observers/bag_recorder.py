@@ -17,6 +17,8 @@ or for several robots of a cell at once:
   ``MAX_MARKERS`` deletes the oldest, ``clear`` deletes each one) and the
   workcell objects (namespace ``workcell``, one id per object name: ADD when set
   or changed, DELETE when removed), in the frames the page shows them in;
+- the parts (``bag_parts``): each one's frame ``parts/NAME`` on ``/tf`` as they move,
+  and a marker of it (namespace ``parts``) on the first robot's marker topic;
 - ``/c2rviz/commands``: each accepted command as ``SOURCE: LINE``, and
   ``/c2rviz/replies``: each reply as ``SOURCE: LINE -> REPLY``, from every source
   (as NAME.txt's ``# sources``); the lines of one frame (``1/hz``) are one message,
@@ -38,13 +40,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import pinocchio as pin
+
 from ..ros import markers as mk
 from ..ros.bag_writer import BagWriter
 from ..ros.messages import INT32, Msg
 from ..ros.robot_bag import BagRobot
 from ..world.effects import Observer
+from ..world.parts import Part
 from ..world.state import MAX_MARKERS, Marker, RobotState
 from ..world.world import World
+from .bag_parts import PartFrames, part_transforms
 from .bag_topics import TextLines, marker_message, namespaces, object_message, xyz_xyzw
 
 if TYPE_CHECKING:
@@ -133,6 +139,9 @@ class BagRecorder(Observer):
             model = world.contacts.models.get(name)
             if model is not None:
                 self.on_objects(name, model.object_list())
+        self.part_frames = PartFrames(world.frame_s)
+        if world.parts.parts.all():
+            self.on_parts(world.parts.parts.all(), t0)
 
     def _t(self) -> float:
         return max(0.0, self.world.clock.now() - self.t0)
@@ -209,6 +218,26 @@ class BagRecorder(Observer):
         if out:
             self._markers(t_s, out, arm)
 
+    def on_parts(self, parts: Sequence[Part], t: float) -> None:
+        if self.closed or not self.arms:
+            return
+        frames, t_s = self.part_frames, max(0.0, t - self.t0)
+        arm = next(iter(self.arms.values()))
+        changes = frames.markers(t_s, parts)
+        if not changes and not frames.due(t):
+            frames.pending = list(parts)
+            return
+        frames.last_t, frames.pending = t, None
+        to_parent = (
+            pin.SE3.Identity() if arm.marker_frame == WORLD_FRAME else arm.state.origin.inverse()
+        )
+        try:
+            self.writer.tf(t_s, part_transforms(t_s, arm.marker_frame, to_parent, parts))
+        except Exception as exc:
+            self._broken(exc)
+        if changes:
+            self._markers(t_s, changes, arm)
+
     def _markers(self, t_s: float, markers: list[Msg], arm: _Arm) -> None:
         try:
             self.writer.markers(t_s, mk.marker_array(markers), arm.bag.namespace)
@@ -241,6 +270,10 @@ class BagRecorder(Observer):
 
     def stop(self) -> None:
         """Write what waits and take no more (on the asyncio thread); ``close`` ends the bag."""
+        pending = self.part_frames.pending
+        if pending is not None and not self.closed:
+            self.part_frames.last_t = None
+            self.on_parts(pending, self.world.clock.now())
         if not self.closed:
             self.commands.flush()
             self.replies.flush()

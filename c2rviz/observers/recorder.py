@@ -39,12 +39,23 @@ from typing import TextIO
 
 import numpy as np
 
+from ..collision.workcell import WorkcellObject
 from ..protocol import replies
 from ..robot.frames import in_base, se3_pose, wxyz_se3
 from ..world.effects import Marker, Observer
 from ..world.faults import replay_line
+from ..world.parts import Part
 from ..world.world import World
 from .record_files import RecordFiles, body_tally, cut_to_line, join_body
+from .record_parts import (
+    PartSignature,
+    csv_columns,
+    csv_poses,
+    object_lines,
+    part_changes,
+    part_line,
+    signature,
+)
 from .recorded import FrameSink, Recorded
 
 __all__ = ["BUFFER_BYTES", "FLUSH_S", "FrameSink", "Recorded", "Recorder"]
@@ -127,10 +138,14 @@ class Recorder(Observer):
             self.files.discard(".txt.part")
             raise
         joints = ",".join(self.state.robot.joint_names)
-        self._write(self._rows, f"time,{joints},x,y,z,roll,pitch,yaw\n")
+        self._csv_parts = world.parts.parts.names()  # each one's pose in every row
+        columns = "".join(csv_columns(name) for name in self._csv_parts)
+        self._write(self._rows, f"time,{joints},x,y,z,roll,pitch,yaw{columns}\n")
         self._write(self._body, "radians\nmotion off\nclear\n")
         for marker in self.state.markers:
             self._mark(marker)
+        self._parts: PartSignature = {}
+        self._workcell(world)
         self._frame(self.state.q, self.t0)
 
     @property
@@ -185,6 +200,44 @@ class Recorder(Observer):
         lines, self._faults = self._faults, []
         self._write(self._body, "".join(f"{line}\n" for line in lines))
 
+    def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
+        if robot == self.robot and not self.closed:
+            self._catch_up(self.world.clock.now())
+            self._write(self._body, object_lines(objects))
+
+    def on_parts(self, parts: Sequence[Part], t: float) -> None:
+        if self.closed:
+            return
+        if signature(parts) != self._parts:
+            self._catch_up(t)
+            self._write(self._body, part_changes(self._parts, parts, self.state.base))
+            self._parts = signature(parts)
+        if self._csv_parts:  # a part moved (falling, carried): a frame, as if the arm did
+            self.on_joints(self.robot, self.state.q, t)
+
+    def on_gripper(self, robot: str, opening: float, t: float) -> None:
+        if robot == self.robot and not self.closed:
+            self._catch_up(t)
+            if self._pending is not None:  # the grasp rule needs the joints of now
+                pending, self._pending = self._pending, None
+                self._frame(pending, t)
+            self._write(self._body, f"grip {opening!r}\n")
+
+    def _workcell(self, world: World) -> None:
+        """The objects, the parts and the gripper at the start, when there are parts or
+        objects (a recording of neither is as it was before parts)."""
+        model = world.contacts.models.get(self.robot)
+        objects = model.object_list() if model is not None else []
+        parts = world.parts.parts.all()
+        if not objects and not parts:
+            return
+        lines = object_lines(objects) + "part all remove\n"
+        lines += "".join(part_line(part, self.state.base) for part in parts)
+        if self.state.robot.gripper is not None:
+            lines += f"grip {self.state.opening!r}\n"
+        self._write(self._body, lines)
+        self._parts = signature(parts)
+
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         if accepted and source not in self.sources:
             if len(self.sources) < _MAX_SOURCES:
@@ -218,7 +271,8 @@ class Recorder(Observer):
         self._due = t + self.period_s
         pose = replies.numbers(se3_pose(self.state.robot.ee_pose(q) * self.state.tool))
         self._write(self._body, f"joints {_numbers(q)}\n")  # exact: a replay is the same
-        self._write(self._rows, f"{us / 1e6:.6f},{replies.numbers(q)},{pose}\n")
+        poses = csv_poses(self.world.parts.parts, self._csv_parts, self.state.base)
+        self._write(self._rows, f"{us / 1e6:.6f},{replies.numbers(q)},{pose}{poses}\n")
         self.frames += 1
         if self.bag is not None:
             self.bag.frame(self.robot, us / 1e6, t, q)

@@ -9,6 +9,9 @@ A connection that sent ``watch [HZ]`` also receives, between its replies::
     event stopped            a move came to rest after ``stop``
     event collision a~b,...  the colliding pairs changed (``none``: clear again), once
                              collisions are checked (an object, ``collisions``, ``guard on``)
+    event grasped NAME       a gripper took part NAME (docs/parts.md)
+    event released NAME      a gripper let go of part NAME
+    event resting NAME on X  part NAME came to rest on X (an object, a part, floor)
     event record-stopped NAME: WHY
     event fault KIND [ARGS]  a fault began (docs/faults.md; ARGS in SI, latency in ms)
     event cleared KIND [ARGS]   it ended (``fault clear``)
@@ -362,3 +365,6 @@ class WatchHub(Observer):
 
     def on_fault(self, robot: str, text: str) -> None:
         self.event(text, robot)
+
+    def on_part_event(self, robot: str | None, text: str) -> None:
+        self.event(text)  # parts are the world's: every watcher hears of them

@@ -71,7 +71,10 @@ class Gripper:
         return table[k] + (x - k) * (table[k + 1] - table[k])
 
     def opening_of(self, values: Sequence[float]) -> float:
-        """The opening (clamped to 0..1) that the first leader's ``values[0]`` means."""
+        """The opening (clamped to 0..1) that the first leader's ``values[0]`` means (a
+        vacuum gripper, with no joints: 1, suction off)."""
+        if not self.closed:
+            return 1.0
         span = self.opened[0] - self.closed[0]
         return min(max((values[0] - self.closed[0]) / span, 0.0), 1.0) if span else 0.0
 

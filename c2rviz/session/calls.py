@@ -25,6 +25,7 @@ from ..planning import MoveChecker, MoveRequest, first_blocked, path_points
 from ..planning.cancel import STOPPED
 from ..protocol import replies
 from ..protocol.registry import Reply
+from ..world.grasp import SUCTION_BELOW, is_vacuum
 from .guarded import checker_of, request
 from .handlers.cartesian import StraightPlan, plan_straight, play_straight, solve
 
@@ -172,15 +173,37 @@ def _check(
 
 
 def grip(session: Session, opening: float) -> Reply:
-    """``Session.grip``: see there."""
+    """``Session.grip``: see there. Closing on a part takes it by the grasp rule
+    (``world/grasp.py``, docs/parts.md): the fingers stop where they touch it and the reply
+    says that opening (``ok 0.433``); opening them lets go of what they hold. A vacuum
+    gripper's suction turns on below ``SUCTION_BELOW`` (taking a part at the cup replies
+    ``ok held``) and off from it, letting go."""
     state, grips = session.state, session.world.grips
     if state.robot.gripper is None:
         raise NoGripper(state.name)
+    grips.rules.refuse(state)  # a stop refuses the fingers too, before a part is touched
+    reply = replies.OK
+    parts = session.world.parts
+    now = grips.now(state)
+    if is_vacuum(state.robot.gripper):
+        if opening >= SUCTION_BELOW:
+            parts.release(state.name)
+        elif parts.suck(state.name) is not None:
+            reply = replies.ok("held")
+    elif parts.parts.held_by(state.name):
+        if opening > state.opening_target:
+            parts.release(state.name)
+        else:  # the fingers stay on the part they hold
+            opening = max(opening, state.opening_target)
+    elif opening < now:
+        opening, taken = parts.close(state.name, now, opening)
+        if taken is not None:
+            reply = replies.ok(replies.numbers([opening]))
     if session.motion == "off":
         grips.set(state, opening, session.source)
-        return replies.OK
-    arrival = grips.go(state, opening, session.source, wait=session.motion == "on")
-    return replies.OK if arrival is None else arrival
+        return reply
+    arrival = grips.go(state, opening, session.source, session.motion == "on", reply)
+    return reply if arrival is None else arrival
 
 
 def brake(session: Session, fingers: bool) -> Reply:

@@ -10,12 +10,23 @@ in every run): the server side loads when a test first asks for a server.
 from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
-from .assertions import assert_arrives, assert_no_collision_during
+from .assertions import (
+    assert_arrives,
+    assert_goals_met,
+    assert_no_collision_during,
+    assert_part_at,
+)
 
 if TYPE_CHECKING:
     from .server import TestServer
 
-__all__ = ["TestServer", "assert_arrives", "assert_no_collision_during"]
+__all__ = [
+    "TestServer",
+    "assert_arrives",
+    "assert_goals_met",
+    "assert_no_collision_during",
+    "assert_part_at",
+]
 
 
 def __getattr__(name: str) -> Any:

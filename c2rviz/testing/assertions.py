@@ -6,6 +6,8 @@
 - ``with assert_no_collision_during(robot): ...``: nothing collides while the block runs
   and the moves it started come to rest (every frame is checked: the server's live
   collision check, read from a ``watch`` stream).
+- ``assert_part_at(robot, name, pose, tol)``: part ``name`` is at ``pose`` (docs/parts.md).
+- ``assert_goals_met(robot)``: every goal is met (``score``).
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ from ..clients.client import Client
 from ..clients.records import State, read_pairs, read_stream_line
 from ..clients.stream import WatchStream
 
-__all__ = ["assert_arrives", "assert_no_collision_during"]
+__all__ = ["assert_arrives", "assert_goals_met", "assert_no_collision_during", "assert_part_at"]
 
 
 def _values(values: Sequence[float]) -> str:
@@ -67,6 +69,70 @@ def assert_arrives(
         len(at) != len(where) or any(abs(w - a) > tol for w, a in zip(where, at))
     ):
         raise AssertionError(f"the arm arrived at {_values(where)}, not at {_values(at)}")
+
+
+def _rotation(roll: float, pitch: float, yaw: float) -> list[list[float]]:
+    """R = Rz(yaw) Ry(pitch) Rx(roll), as the server's poses mean it [rad]."""
+    cr, sr, cp, sp, cy, sy = (f(a) for a in (roll, pitch, yaw) for f in (math.cos, math.sin))
+    return [
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ]
+
+
+def _angle_between(a: Sequence[float], b: Sequence[float]) -> float:
+    """The angle of the rotation from rpy ``a`` to rpy ``b`` [rad]."""
+    ra, rb = _rotation(*a), _rotation(*b)
+    trace = sum(ra[k][i] * rb[k][i] for i in range(3) for k in range(3))
+    return math.acos(max(-1.0, min(1.0, (trace - 1.0) / 2.0)))
+
+
+def assert_part_at(
+    robot: Client,
+    name: str,
+    pose: Sequence[float],
+    tol: float = 0.001,
+    tol_angle: float | None = None,
+) -> None:
+    """Part ``name`` is at ``pose`` (x, y, z [m], roll, pitch, yaw [the connection's angle
+    unit], in its robot's base frame), within ``tol`` [m] and ``tol_angle`` (None: any
+    orientation; the connection's unit).
+
+    Raises:
+        AssertionError: naming where the part is, and its state (``held``, ``resting on
+            table``), or that there is no such part.
+    """
+    reply = robot.ask(f"part {name}")
+    if not reply.startswith("ok "):
+        raise AssertionError(f"part {name}: {reply} ({robot.ask('parts')})")
+    words = reply.split(" ", 2)
+    where, state = [float(v) for v in words[1].split(",")], words[2]
+    distance = math.dist(where[:3], pose[:3])
+    scale = math.pi / 180.0 if robot.in_degrees else 1.0
+    message = f"part {name} is at {_values(where)} ({state}), not at {_values(pose)}"
+    if distance > tol:
+        raise AssertionError(f"{message}: {distance * 1000:.1f} mm off")
+    if tol_angle is not None and len(pose) == 6:
+        angle = _angle_between([v * scale for v in where[3:]], [v * scale for v in pose[3:]])
+        if angle > tol_angle * scale:
+            raise AssertionError(f"{message}: turned {angle / scale:.3g} off")
+
+
+def assert_goals_met(robot: Client) -> None:
+    """Every goal set with ``goal`` is met.
+
+    Raises:
+        AssertionError: the ``score`` (which goals are how far off, which parts missing)
+            and where every part is.
+    """
+    reply = robot.ask("score")
+    if reply == "ok no goals":
+        raise AssertionError("no goals are set (goal NAME POSE)")
+    met = reply.split()[1] if reply.startswith("ok ") else ""
+    count, _, total = met.partition("/")
+    if not count or count != total:
+        raise AssertionError(f"not every goal is met: {reply[3:]}; parts: {robot.ask('parts')}")
 
 
 class _Collisions:

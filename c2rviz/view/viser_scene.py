@@ -38,6 +38,8 @@ from ..robot.visuals import LinkGeometry, load_link_geometry
 from ..session.services import Services
 from ..session.session import Session
 from ..world.effects import Marker, Scene
+from ..world.goals import Goal
+from ..world.parts import Part
 from ..world.world import World
 from . import adapter
 from .handle import ToolHandles
@@ -45,6 +47,7 @@ from .instruments import Instruments
 from .markers import MarkerLayer
 from .page_input import PageInput
 from .panel import RECENT_COMMANDS, RobotPanel, StatePanel
+from .parts_layer import PartsLayer
 from .policy import DoorPolicy
 from .robot_view import RobotView, node_name
 from .scheduler import SendScheduler
@@ -165,6 +168,9 @@ class ViserScene(Scene):
         self.markers = MarkerLayer(server, segments, self._pick)
         self.workcells = {name: WorkcellLayer(server, view) for name, view in self.views.items()}
         self.trails = TrailLayer(server, segments)
+        self.parts = PartsLayer(server)
+        self._parts: list[Part] | None = world.parts.parts.all()  # to draw at the next send
+        self._goals: list[Goal] | None = world.parts.goals.all()
         self.handles = ToolHandles(server, segments, self.scheduler.request)
         self._frame_camera()
         self.page_input = PageInput(server, self.markers)
@@ -277,6 +283,14 @@ class ViserScene(Scene):
         if panel is not None:
             panel.show_faults(fault_banner(self.world, robot))
             self.scheduler.request()
+
+    def on_parts(self, parts: Sequence[Part], t: float) -> None:
+        self._parts = list(parts)
+        self.scheduler.request()
+
+    def on_goals(self, goals: Sequence[Goal]) -> None:
+        self._goals = list(goals)
+        self.scheduler.request()
 
     def _pick(self, robot: str, shape: str, instance: int) -> None:
         """A marker clicked in a page (viser's thread): chosen in its robot's folder."""
@@ -406,6 +420,12 @@ class ViserScene(Scene):
                 if name in self.workcells:
                     self.workcells[name].show_objects(objects)
             self._objects.clear()
+            if self._parts is not None:
+                self.parts.show_parts(self._parts)
+                self._parts = None
+            if self._goals is not None:
+                self.parts.show_goals(self._goals, self.world.parts.parts.all())
+                self._goals = None
         for name, pairs in self._collisions.items():
             if name in self.workcells:
                 self.workcells[name].show_collisions(pairs)

@@ -23,6 +23,8 @@ if TYPE_CHECKING:
 
     from ..collision.workcell import WorkcellObject
     from ..errors import C2rvizError
+    from .goals import Goal
+    from .parts import Part
 
 __all__ = ["MAX_MARKERS", "Marker", "NullScene", "Observer", "RecordingScene", "Scene"]
 
@@ -83,6 +85,16 @@ class Observer:
         (``fault estop``, ``fault stall joint_l``, ``cleared estop``, ``reset``, ``fault
         disconnect``; values in SI, latency in ms)."""
 
+    def on_parts(self, parts: Sequence[Part], t: float) -> None:
+        """The parts are now ``parts`` (poses in the world frame), at time ``t`` [s]."""
+
+    def on_part_event(self, robot: str | None, text: str) -> None:
+        """A part was ``grasped NAME``, ``released NAME`` (by ``robot``) or is ``resting
+        NAME on WHAT`` (robot None)."""
+
+    def on_goals(self, goals: Sequence[Goal]) -> None:
+        """The goals are now ``goals`` (poses in the world frame)."""
+
 
 class Scene(Observer):
     """An observer that is a view: it starts with the world and stops with the program."""
@@ -121,6 +133,9 @@ class RecordingScene(Scene):
     errors: list[tuple[str, str, str]] = field(default_factory=list)
     """(robot, line, message) of each refusal."""
     ghosts: list[tuple[str, bool]] = field(default_factory=list)
+    part_times: list[float] = field(default_factory=list)
+    """The clock time [s] of each change of the parts."""
+    part_events: list[str] = field(default_factory=list)
 
     def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
         self.joints.append(tuple(q))
@@ -154,3 +169,9 @@ class RecordingScene(Scene):
 
     def on_ghost(self, robot: str, shown: bool) -> None:
         self.ghosts.append((robot, shown))
+
+    def on_parts(self, parts: Sequence[Part], t: float) -> None:
+        self.part_times.append(t)
+
+    def on_part_event(self, robot: str | None, text: str) -> None:
+        self.part_events.append(text)

@@ -34,6 +34,7 @@ class Grip:
     t0: float = 0.0
     t1: float = 0.0
     active: bool = False
+    reply: str = replies.OK
     arrivals: list[asyncio.Future[str]] = field(default_factory=list)
 
     def at(self, t: float) -> float:
@@ -93,9 +94,17 @@ class Grips:
         self.publish(state, opening, self.clock.now())
 
     def go(
-        self, state: RobotState, opening: float, source: str, wait: bool
+        self,
+        state: RobotState,
+        opening: float,
+        source: str,
+        wait: bool,
+        reply: str = replies.OK,
     ) -> asyncio.Future[str] | None:
         """Move the fingers to ``opening`` (0..1, checked) at the gripper's speed.
+
+        Args:
+            reply: What the wait ends with on arrival (closing on a part: its opening).
 
         Returns:
             With ``wait``, the reply that comes on arrival (``ok``) or an error when
@@ -108,6 +117,7 @@ class Grips:
         t = self.clock.now()
         grip.start = self.now(state)
         grip.goal = state.opening_target = opening
+        grip.reply = reply
         grip.t0, grip.t1 = t, t + abs(opening - grip.start) * state.robot.gripper.stroke_s
         grip.active = grip.t1 > t
         arrival: asyncio.Future[str] | None = None
@@ -167,4 +177,4 @@ def _settle(grip: Grip) -> None:
     waiting, grip.arrivals = grip.arrivals, []
     for future in waiting:
         if not future.done():
-            future.set_result(replies.OK)
+            future.set_result(grip.reply)

@@ -58,6 +58,8 @@ class Contacts(Observer):
         self.pairs: dict[str, list[Pair]] = {}
         self._dirty: set[str] = set()
         self._timer: Timer | None = None
+        self.furnish: Callable[[str, CollisionModel], None] | None = None
+        """Gives a model built here the world's parts (the world's ``WorldParts``)."""
 
     def model(self, robot: str) -> CollisionModel:
         """The robot's collision model, built on first use (~10 ms for a bundled arm)."""
@@ -68,6 +70,8 @@ class Contacts(Observer):
                 state.robot, disabled=self.disabled.get(robot, ()), max_objects=self.max_objects
             )
             self.models[robot] = model
+            if self.furnish is not None:
+                self.furnish(robot, model)
             self.pairs[robot] = []
             self.changed(robot)
         return model

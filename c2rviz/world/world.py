@@ -28,6 +28,7 @@ from .fault_rules import FaultRules
 from .grips import Grips
 from .live_collisions import Contacts
 from .moves import Travel, Travels
+from .part_world import WorldParts
 from .state import Marker, RobotState
 
 __all__ = ["RobotState", "World"]
@@ -90,6 +91,9 @@ class World:
         self.faults = FaultRules(self.robots, self.clock, self.travels, self._tell_fault)
         """Every robot's faults (``fault``), which every move from every door meets."""
         self.travels.rules = self.grips.rules = self.faults
+        self.parts = WorldParts(self.robots, self.contacts, self.clock, self.frame_s, self._tell)
+        """The parts: grasped, carried, released (``part_world.py``)."""
+        self.contacts.furnish = self.parts.furnish
 
     def state(self, name: str | None = None) -> RobotState:
         """The robot called ``name`` (the default robot for None)."""
@@ -161,6 +165,7 @@ class World:
     def _show(self, state: RobotState, q: tuple[float, ...], t: float) -> None:
         """The robot is seen at ``q`` at time ``t``: tell every observer."""
         state.q = q
+        self.parts.moved(state.name, q)
         for observer in self.observers:
             observer.on_joints(state.name, q, t)
 
@@ -249,6 +254,7 @@ class World:
         self.travels.stop_all()
         self.grips.stop_all()
         self.faults.close()
+        self.parts.stop()
         self.contacts.stop()
 
     # The workcell and collisions.
@@ -266,6 +272,8 @@ class World:
         for observer in self.observers:
             observer.on_objects(robot, objects)
         self.contacts.changed(robot)
+        if self.parts.parts:
+            self.parts.objects_changed()
 
     def others(self, robot: str) -> list[tuple[str, CollisionModel, tuple[float, ...], pin.SE3]]:
         """Every other robot of the world as it stands: its name, collision model, joints
@@ -279,6 +287,11 @@ class World:
     def _tell_fault(self, robot: str, text: str) -> None:
         for observer in list(self.observers):  # (the TCP door may close clients)
             observer.on_fault(robot, text)
+
+    def _tell(self, method: str, *args: object) -> None:
+        """Call the observers' ``method`` with ``args`` (the parts' effects)."""
+        for observer in self.observers:
+            getattr(observer, method)(*args)
 
     def _tell_collisions(self, robot: str, pairs: list[Pair]) -> None:
         for observer in self.observers:

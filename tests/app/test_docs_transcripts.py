@@ -18,10 +18,11 @@ from support import ROOT
 NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
 WORDS_ONLY = re.compile(r"^(rand|status)\b")
 """Commands whose numbers vary from run to run."""
-OWN_TEST = {"planning.md", "faults.md", "cells.md"}
+OWN_TEST = {"planning.md", "faults.md", "cells.md", "parts.md"}
 """Pages whose sessions a test of their own replays reply for reply (planning's, with
 ``--seed 1``: tests/planning/test_planning_docs.py; the cell's, on ``--cell twoarms``:
-tests/app/test_doc_pointers.py; faults.md's: tests/app/test_faults_docs.py)."""
+tests/app/test_doc_pointers.py; faults.md's: tests/app/test_faults_docs.py; parts.md's:
+tests/session/test_parts_docs.py)."""
 
 
 @dataclass(frozen=True)

@@ -22,6 +22,7 @@ from c2rviz.protocol.verbs.joints import Home, Joints, Move, Rand, Units
 from c2rviz.protocol.verbs.markers import Clear, Color, Mark, MarkerShape
 from c2rviz.protocol.verbs.motion import MotionMode, Speed, Status, Stop, Target, Wait
 from c2rviz.protocol.verbs.observe import Ghost, Trail, Unwatch, Watch
+from c2rviz.protocol.verbs.parts import GoalEdit, PartEdit, PartsQuery, Score
 from c2rviz.protocol.verbs.planning import Plan
 from c2rviz.protocol.verbs.queries import Help, Limits, Names, Pose, Version, Where
 from c2rviz.protocol.verbs.record import Record
@@ -157,6 +158,33 @@ GOOD = [
     ("fault clear ALL", FaultVerb(clear="all"), "fault-clear-all"),
     ("faults", Faults(), "faults"),
     ("reset", Reset(), "reset"),
+    (
+        "part p1 box 0.03,0.03,0.03 0.5,0,0.015,0,0,0 type=cube color=1,0,0",
+        PartEdit("p1", "box", (0.03,) * 3, (0.5, 0, 0.015, 0, 0, 0), "cube", (1.0, 0.0, 0.0)),
+        "part-box",
+    ),
+    (
+        "part c cylinder 0.01,0.05 0.5,0.1,0.025,0,0,90",
+        PartEdit("c", "cylinder", (0.01, 0.05), (0.5, 0.1, 0.025, 0, 0, 90)),
+        "part-cylinder",
+    ),
+    (
+        "part s sphere 0.02 0.4,0,0.02",
+        PartEdit("s", "sphere", (0.02,), (0.4, 0, 0.02, 0, 0, 0)),
+        "part-sphere",
+    ),
+    ("part p1", PartEdit("p1", ""), "part-ask"),
+    ("part p1 remove", PartEdit("p1", "remove"), "part-remove"),
+    ("part all remove", PartEdit("all", "remove"), "part-all-remove"),
+    ("parts", PartsQuery(), "parts"),
+    ("goal p1 0.5,0,0.015,0,0,0", GoalEdit("p1", False, (0.5, 0, 0.015, 0, 0, 0)), "goal"),
+    (
+        "goal type=cube 0.5,0,0.015,0,0,0 0.01,2",
+        GoalEdit("type=cube", False, (0.5, 0, 0.015, 0, 0, 0), 0.01, 2.0),
+        "goal-type-tol",
+    ),
+    ("goal all remove", GoalEdit("all", True), "goal-all-remove"),
+    ("score", Score(), "score"),
 ]
 
 
@@ -232,6 +260,26 @@ BAD = [
     ("grip -0.1", BadArguments, "grip: -0.1 is outside 0..1", "grip-negative"),
     ("grip nan", BadArguments, "bad number 'nan'", "grip-nan"),
     ("grip 0.5 1", BadArguments, "grip: takes 1 argument, got 2", "grip-two"),
+    ("part", BadArguments, "part: needs a name", "part-none"),
+    ("part p1 cone 1 0,0,0", BadArguments, "unknown shape 'cone'", "part-cone"),
+    (
+        "part p1 box 1e308,1,1 0,0,0,0,0,0",
+        BadArguments,
+        "part size 1e+308 m is outside",
+        "part-huge",
+    ),
+    ("part p1 box 0.1,0.1 0,0,0,0,0,0", BadArguments, "needs 3 values, got 2", "part-two-sizes"),
+    ("part p1 box 0.1,0.1,0.1 0,0,0", BadArguments, "needs 6 values, got 3", "part-no-angles"),
+    ("part p/1 box 0.1,0.1,0.1 0,0,0,0,0,0", BadArguments, "bad part name", "part-slash"),
+    ("part all box 0.1,0.1,0.1 0,0,0,0,0,0", BadArguments, "'all' is not a part", "part-all"),
+    ("part p1 sphere 0.1 0,0,0 hue=3", BadArguments, "not type=TYPE or color", "part-option"),
+    ("part p1 sphere 0.1 0,0,0 color=2,0,0", BadArguments, "each in 0..1", "part-colour"),
+    ("part p1 box 0.1,0.1,0.1 1e9,0,0,0,0,0", BadArguments, "outside -1000..1000", "part-far"),
+    ("parts x", BadArguments, "parts: takes no arguments", "parts-arg"),
+    ("goal", BadArguments, "needs a part name", "goal-none"),
+    ("goal p1 0,0,0", BadArguments, "needs 6 values, got 3", "goal-short"),
+    ("goal p1 0,0,0,0,0,0 0,1", BadArguments, "tolerances must be > 0", "goal-zero-tol"),
+    ("score now", BadArguments, "score: takes no arguments", "score-arg"),
     ("home 1", BadArguments, "home: takes no arguments", "home-arg"),
     ("limits some", BadArguments, "limits: unknown argument 'some'", "limits-other"),
     ("motion fast", BadArguments, "unknown mode 'fast'; choose off, on or follow", "motion-fast"),

@@ -9,6 +9,7 @@ from . import joints, markers, queries, connection  # the seed's verbs
 from . import cartesian, cell, motion, observe, record, workcell
 from . import planning
 from . import gripper
+from . import parts
 from . import faults
 # isort: on
 
@@ -22,6 +23,7 @@ __all__ = [
     "markers",
     "motion",
     "observe",
+    "parts",
     "planning",
     "queries",
     "record",

@@ -15,7 +15,8 @@ __all__ = ["Grip"]
     "grip",
     "[S]",
     "the gripper to S, 0 closed .. 1 open, travelling as `motion` says (a robot with no "
-    "gripper gets an error); alone, reply its opening",
+    "gripper gets an error); closing on a part grasps it and replies the opening where the "
+    "fingers stop, opening releases it (docs/parts.md); alone, reply its opening",
 )
 @dataclass(frozen=True, slots=True)
 class Grip:

@@ -1,4 +1,5 @@
-"""What the gripper verb does: the fingers to an opening, travelling as ``motion`` says."""
+"""What the gripper verb does: the fingers to an opening, travelling as ``motion`` says,
+by the grasp rule for parts (``Session.grip``, ``calls.grip``: every door's grip)."""
 
 from __future__ import annotations
 

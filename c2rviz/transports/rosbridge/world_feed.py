@@ -10,8 +10,9 @@ as it moves, without waiting another frame. Each flush sends, for the robots
 that changed and only for topics someone reads:
 
 * ``[NS]/joint_states``: stamped with the world's clock time of the change;
-* ``/tf``: every robot's moving joints (one message holds them all, so a slow
-  subscriber that keeps only the latest loses no robot), stamped likewise;
+* ``/tf``: every robot's moving joints and every part's frame ``parts/NAME``
+  (``observers.bag_parts``; one message holds them all, so a slow subscriber that
+  keeps only the latest loses no robot), stamped likewise;
 * ``[NS]/visualization_marker_array``: markers added (and those pushed out past
   ``MAX_MARKERS`` deleted; all deleted after a ``clear``, or when more went than
   half of those left, then all sent again), and the workcell objects as a whole
@@ -32,15 +33,19 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import partial
 
+import pinocchio as pin
+
 from ...collision.workcell import WorkcellObject
+from ...observers.bag_parts import part_items
 from ...observers.watch import WatchHub
 from ...ros.markers import marker_array
 from ...ros.messages import Msg, string, tf_message, transforms
 from ...world.clock import Timer
 from ...world.effects import MAX_MARKERS, Marker, Observer
+from ...world.parts import Part
 from ...world.world import World
 from .diagnostics import DIAGNOSTICS_TOPIC, diagnostics
-from .robot_topics import RobotTopics
+from .robot_topics import WORLD_FRAME, RobotTopics
 from .topic_hub import TopicHub
 
 __all__ = ["FLUSH_SLACK", "WorldFeed"]
@@ -88,6 +93,7 @@ class WorldFeed(Observer):
         self._timer: Timer | None = None
         self._last_flush = -float("inf")
         self._readers = 0  # events topics read now
+        self._parts_at: float | None = None  # when parts last moved, not yet published
         now = world.clock.now()
         statics: list[Msg] = []
         for name, feed in self.robots.items():
@@ -138,11 +144,21 @@ class WorldFeed(Observer):
         return marker_array(msgs)
 
     def _tf(self, t: float) -> Msg:
-        """Every robot's moving joints as shown now, stamped ``t`` [s]."""
-        items = []
+        """Every robot's moving joints and every part as shown now, stamped ``t`` [s]."""
+        items: list[tuple[str, str, Sequence[float], Sequence[float]]] = []
         for name, feed in self.robots.items():
             items.extend(feed.topics.moving(self.world.state(name).q))
+        first = next(iter(self.robots), None)
+        if first is not None and self.world.parts.parts:
+            frame = self.robots[first].topics.marker_frame
+            to_parent = self.world.state(first).origin.inverse()
+            to_parent = pin.SE3.Identity() if frame == WORLD_FRAME else to_parent
+            items.extend(part_items(frame, to_parent, self.world.parts.parts.all()))
         return tf_message(transforms(t, items))
+
+    def on_parts(self, parts: Sequence[Part], t: float) -> None:
+        self._parts_at = t
+        self._schedule()
 
     # The world's effects.
 
@@ -219,6 +235,9 @@ class WorldFeed(Observer):
                     hub.publish(topics.joint_states, topics.joint_state(q, t))
             if feed.markers_changed or feed.objects_changed:
                 self._flush_markers(feed)
+        if self._parts_at is not None:
+            moved_at = self._parts_at if moved_at is None else max(moved_at, self._parts_at)
+            self._parts_at = None
         if moved_at is not None and hub.wanted(TF_TOPIC):
             hub.publish(TF_TOPIC, self._tf(moved_at))
 

@@ -1,0 +1,187 @@
+"""Part verbs: parts a gripper picks and places, goals for them, and a score."""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ...errors import BadArguments, shown
+from ..grammar import count, numbers
+from ..ranges import ANGLE_LIMIT, check_pose
+from ..registry import usage, verb
+
+__all__ = ["GoalEdit", "PartEdit", "PartsQuery", "Score"]
+
+_NAME = re.compile(r"[A-Za-z0-9_.-]{1,64}")
+# shape -> (how many size values, whether the pose has an orientation)
+_SHAPES = {"box": (3, True), "sphere": (1, False), "cylinder": (2, True)}
+PART_SIZE_M = (0.001, 2.0)  # world.parts.PART_SIZE_M (the protocol may not import world)
+
+Pose = tuple[float, float, float, float, float, float]
+
+
+@dataclass(frozen=True, slots=True)
+class PartEdit:
+    """Add part ``name`` (size [m]; pose x, y, z [m], roll, pitch, yaw [client's angle
+    unit], in the robot's base frame), ``remove`` it (``all``: every one), or with
+    shape ``""`` ask where it is."""
+
+    name: str
+    shape: str
+    size: tuple[float, ...] = ()
+    pose: Pose = (0.0,) * 6
+    kind: str | None = None
+    rgb: tuple[float, float, float] | None = None
+
+
+def _name(verb_name: str, name: str, what: str = "part") -> str:
+    if _NAME.fullmatch(name) is None:
+        raise BadArguments(
+            verb_name,
+            f"bad {what} name {shown(name)}: use letters, digits, _ . - (at most 64)",
+            usage(verb_name),
+        )
+    return name
+
+
+def _options(verb_name: str, words: list[str]) -> tuple[str | None, tuple[float, ...] | None]:
+    kind: str | None = None
+    rgb: tuple[float, ...] | None = None
+    for word in words:
+        key, _, value = word.partition("=")
+        if key.lower() == "type" and value:
+            kind = _name(verb_name, value, "type")
+        elif key.lower() in ("color", "colour") and value:
+            rgb = count(verb_name, numbers(verb_name, value), 3)
+            if not all(0.0 <= c <= 1.0 for c in rgb):
+                raise BadArguments(verb_name, "color takes r,g,b each in 0..1", usage(verb_name))
+        else:
+            raise BadArguments(
+                verb_name,
+                f"{shown(word)} is not type=TYPE or color=r,g,b",
+                usage(verb_name),
+            )
+    return kind, rgb
+
+
+def _parse_part(verb_name: str, words: list[str]) -> PartEdit:
+    if not words:
+        raise BadArguments(verb_name, "needs a name", usage(verb_name))
+    name = words[0]
+    if name == "all" and words[1:] == ["remove"]:
+        return PartEdit("all", "remove")
+    _name(verb_name, name)
+    if name == "all":
+        raise BadArguments(
+            verb_name, "'all' is not a part name (all remove clears)", usage(verb_name)
+        )
+    if len(words) == 1:
+        return PartEdit(name, "")
+    kind = words[1].lower()
+    if kind == "remove":
+        if len(words) != 2:
+            raise BadArguments(verb_name, "remove takes nothing more", usage(verb_name))
+        return PartEdit(name, "remove")
+    if kind not in _SHAPES:
+        raise BadArguments(
+            verb_name,
+            f"unknown shape {shown(kind)}; choose box, cylinder or sphere",
+            usage(verb_name),
+        )
+    sizes, oriented = _SHAPES[kind]
+    if len(words) < 4:
+        raise BadArguments(verb_name, f"{kind} takes a size and a pose", usage(verb_name))
+    size = count(verb_name, numbers(verb_name, words[2]), sizes)
+    low, high = PART_SIZE_M
+    for value in size:
+        if not low <= value <= high:
+            raise BadArguments(
+                verb_name, f"part size {value:g} m is outside {low:g}..{high:g} m", usage(verb_name)
+            )
+    pose = numbers(verb_name, words[3])
+    if not oriented and len(pose) == 3:
+        pose = (*pose, 0.0, 0.0, 0.0)
+    x, y, z, roll, pitch, yaw = count(verb_name, pose, 6)
+    check_pose(verb_name, (x, y, z, roll, pitch, yaw))
+    part_kind, rgb = _options(verb_name, words[4:])
+    colour = None if rgb is None else (rgb[0], rgb[1], rgb[2])
+    return PartEdit(name, kind, size, (x, y, z, roll, pitch, yaw), part_kind, colour)
+
+
+verb(
+    "part",
+    "NAME box sx,sy,sz x,y,z,roll,pitch,yaw [type=T] [color=r,g,b] | "
+    "NAME cylinder r,length x,y,z,roll,pitch,yaw [...] | NAME sphere r x,y,z [...] | "
+    "NAME remove | NAME",
+    "add a part a gripper can pick (base frame, metres, angles in the connection's unit; "
+    "docs/parts.md), remove it (`part all remove`: every one), or alone reply its pose and "
+    "state: `ok x,y,z,roll,pitch,yaw free|held|resting on OBJECT`",
+    parse=_parse_part,
+)(PartEdit)
+
+
+@verb(
+    "parts",
+    "",
+    "reply every part: `ok NAME:x,y,z,roll,pitch,yaw:STATE;...` (base frame; `ok none`)",
+)
+@dataclass(frozen=True, slots=True)
+class PartsQuery:
+    """Ask for every part's pose and state."""
+
+
+@dataclass(frozen=True, slots=True)
+class GoalEdit:
+    """Set where part ``key`` (or any part of type ``type=T``) should end, with its
+    tolerances (None: the defaults), or ``remove`` it (``all``: every goal)."""
+
+    key: str
+    remove: bool = False
+    pose: Pose = (0.0,) * 6
+    tol_m: float | None = None
+    tol_angle: float | None = None
+
+
+def _parse_goal(verb_name: str, words: list[str]) -> GoalEdit:
+    if not words:
+        raise BadArguments(verb_name, "needs a part name (or type=T) and a pose", usage(verb_name))
+    key = words[0]
+    if key.lower().startswith("type="):
+        key = "type=" + _name(verb_name, key[5:], "type")
+    elif not (key == "all" and words[1:] == ["remove"]):
+        _name(verb_name, key)
+    if words[1:] == ["remove"]:
+        return GoalEdit(key, remove=True)
+    if len(words) not in (2, 3):
+        raise BadArguments(verb_name, "takes a pose and maybe TOL_M,TOL_ANGLE", usage(verb_name))
+    pose = count(verb_name, numbers(verb_name, words[1]), 6)
+    check_pose(verb_name, pose)
+    x, y, z, roll, pitch, yaw = pose
+    if len(words) == 2:
+        return GoalEdit(key, False, (x, y, z, roll, pitch, yaw))
+    tol_m, tol_angle = count(verb_name, numbers(verb_name, words[2]), 2)
+    if not (0.0 < tol_m <= 1.0 and 0.0 < tol_angle <= ANGLE_LIMIT):
+        raise BadArguments(
+            verb_name, "tolerances must be > 0: TOL_M at most 1 m, then TOL_ANGLE", usage(verb_name)
+        )
+    return GoalEdit(key, False, (x, y, z, roll, pitch, yaw), tol_m, tol_angle)
+
+
+verb(
+    "goal",
+    "NAME|type=T x,y,z,roll,pitch,yaw [TOL_M,TOL_ANGLE] | NAME remove | all remove",
+    "say where a part (or any part of a type) should end (base frame; tolerances default "
+    "to 5 mm and 5 degrees); `score` tells how far each is",
+    parse=_parse_goal,
+)(GoalEdit)
+
+
+@verb(
+    "score",
+    "",
+    "reply how many goals are met and how far off the others are: "
+    "`ok 3/4 met; p2 12.1 mm 3.0 deg off; p4 missing` (`ok no goals`)",
+)
+@dataclass(frozen=True, slots=True)
+class Score:
+    """Ask for the goals' score."""
