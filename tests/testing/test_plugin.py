@@ -264,3 +264,20 @@ def test_a_recording_name_is_short_and_names_the_worker():
     assert len(named) == 100 and named.endswith("-gw12")
     assert named == recording_name(long, "gw12")  # the same in every process (no hash seed)
     assert named != recording_name(long + "y", "gw12")
+
+
+def test_the_pytest_extra_brings_what_the_docs_say():
+    """Issue 39, rough edge 5: docs/testing.md says `pip install -e '.[pytest]'` brings pytest
+    and pytest-xdist; pyproject's extra does."""
+    import tomllib
+
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"][
+        "optional-dependencies"
+    ]
+    names = {re.split(r"[<>=\[ ]", spec)[0] for spec in extras["pytest"]}
+    assert {"pytest", "pytest-xdist"} <= names
+    page = (ROOT / "docs" / "testing.md").read_text()
+    assert (
+        "pip install -e '.[pytest]'" in page
+        and "installs c2rviz with pytest and pytest-xdist" in page
+    )
