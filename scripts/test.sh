@@ -27,8 +27,25 @@ python3 -m venv .venv
 .venv/bin/lint-imports --no-cache
 workers=(-n "${C2RVIZ_TEST_WORKERS:-auto}" --dist loadgroup)
 if [ "${C2RVIZ_TEST_WORKERS:-auto}" = "1" ]; then workers=(-p no:xdist); fi
+
+# `--cov` (or C2RVIZ_COVERAGE=1): branch coverage of c2rviz/ ([tool.coverage.*] in
+# pyproject.toml), the programs the tests start included, printed at the end. A whole
+# run (no other arguments) also fails below the floor the docs give (docs/testing.md).
+COVERAGE_FLOOR=85
+cov=()
+args=()
+for arg in "$@"; do
+    if [ "$arg" = "--cov" ]; then C2RVIZ_COVERAGE=1; else args+=("$arg"); fi
+done
+if [ "${C2RVIZ_COVERAGE:-0}" = "1" ]; then
+    export COVERAGE_FILE="$PWD/.coverage"  # the children's data too, whatever their cwd
+    rm -f .coverage .coverage.*
+    cov=(--cov --cov-report=term:skip-covered --cov-report=xml)
+    if [ "${#args[@]}" -eq 0 ]; then cov+=(--cov-fail-under="$COVERAGE_FLOOR"); fi
+fi
+
 status=0
-.venv/bin/python -m pytest "${workers[@]}" "$@" || status=$?
+.venv/bin/python -m pytest "${workers[@]}" "${cov[@]}" "${args[@]}" || status=$?
 if [ "$status" -eq 5 ]; then
     echo "scripts/test.sh: pytest collected no test: that is a failure, not a pass" >&2
 fi
