@@ -70,13 +70,16 @@ class FreshContexts:
     browser context (cookies, storage and viewport of its own, as a fresh browser has),
     ``new_context`` a context; ``close_contexts`` closes what a test opened.
 
+    A Chromium that died is launched again before the next test.
+
     Playwright's sync API marks its event loop as this thread's running loop between its
     calls; a session-long Playwright would then refuse every later test's ``asyncio.run``.
     ``close_contexts`` (after each browser test) unmarks it, ``resume`` (before) marks it again.
     """
 
-    def __init__(self, browser: Any) -> None:
-        self._browser = browser
+    def __init__(self, launch: Callable[[], Any]) -> None:
+        self._launch = launch
+        self._browser = launch()
         self._contexts: list[Any] = []
         self._loop: asyncio.AbstractEventLoop | None = asyncio._get_running_loop()
 
@@ -89,8 +92,12 @@ class FreshContexts:
         return self.new_context(**options).new_page()
 
     def resume(self) -> None:
+        """Before a test: the loop marked again, and a new Chromium if the last one died
+        (one test's crash must not fail every later browser test)."""
         if self._loop is not None:
             asyncio._set_running_loop(self._loop)
+        if not self._browser.is_connected():
+            self._browser = self._launch()
 
     def close_contexts(self) -> None:
         try:

@@ -125,13 +125,14 @@ def chromium() -> Iterator[Any]:
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as pw:
-        launched = pw.chromium.launch(executable_path=str(CHROMIUM), args=ARGS)
-        browser = FreshContexts(launched)
+        browser = FreshContexts(
+            lambda: pw.chromium.launch(executable_path=str(CHROMIUM), args=ARGS)
+        )
         try:
             yield browser
         finally:
             browser.resume()
-            launched.close()
+            browser.close()
 
 
 @pytest.fixture
