@@ -31,7 +31,7 @@ if [ "${C2RVIZ_TEST_WORKERS:-auto}" = "1" ]; then workers=(-p no:xdist); fi
 # `--cov` (or C2RVIZ_COVERAGE=1): branch coverage of c2rviz/ ([tool.coverage.*] in
 # pyproject.toml), the programs the tests start included, printed at the end. A whole
 # run (no other arguments) also fails below the floor the docs give (docs/testing.md).
-COVERAGE_FLOOR=85
+COVERAGE_FLOOR=92  # a little below the 93.5 % measured (docs/testing.md)
 cov=()
 args=()
 for arg in "$@"; do
