@@ -1,6 +1,7 @@
 """The abilities of the real program, measured: motion, Cartesian, collisions, the cell.
 
-Usage: ``python benchmarks/abilities.py [--quick] [--reps N] [--no-pin] [--no-cell]``.
+Usage: ``python benchmarks/abilities.py [--quick|--smoke] [--reps N] [--no-pin] [--no-cell]``
+(``--smoke``: the test suite's run, every row on the least work).
 
 Each repetition launches ``python -m c2rviz --port 0 --viser-port P`` (with
 ``--robot`` for each bundled robot, ``--guard on`` once, ``--cell`` once) as
@@ -45,6 +46,12 @@ QUICK = Plan(
     motion=MotionPlan(moves=2, far=0.6, speed=100, bystander_s=1.0, idle_s=0.5),
     arm=ArmPlan(ik_targets=5, lines=2, bystander_s=1.0, guard_round_trips=100),
     cell_pipelined=3_000,
+)
+SMOKE = Plan(
+    reps=1,
+    motion=MotionPlan(moves=2, far=0.3, speed=100, bystander_s=0.3, idle_s=0.2),
+    arm=ArmPlan(ik_targets=2, lines=1, line_m=0.2, bystander_s=0.3, guard_round_trips=20),
+    cell_pipelined=300,
 )
 
 # (key, label, unit, format, note)
@@ -174,11 +181,12 @@ def table(reps: list[dict[str, Figure]]) -> str:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="one short repetition (for CI)")
+    parser.add_argument("--smoke", action="store_true", help="every row, the least work")
     parser.add_argument("--reps", type=int, help="repetitions (default 3; 1 with --quick)")
     parser.add_argument("--no-pin", action="store_true", help="let the OS place the processes")
     parser.add_argument("--no-cell", action="store_true", help="leave out row 4 (the cell)")
     args = parser.parse_args(argv)
-    plan = QUICK if args.quick else Plan()
+    plan = SMOKE if args.smoke else QUICK if args.quick else Plan()
     reps = max(1, args.reps) if args.reps is not None else plan.reps
 
     def log(text: str) -> None:

@@ -17,7 +17,9 @@ Prints one table (``machine: ...`` first), each row with its goal:
   put together and NAME.html written, viser already loaded) and the peak memory it
   adds (the process's peak RSS, reset just before).
 
-``--quick`` measures 2 s windows and a 1-minute "hour" (the rows say so). Figures
+``--quick`` measures 2 s windows and a 1-minute "hour" (the rows say so); ``--smoke``
+(the test suite's: every row, the least work) half-second windows and a 10-second
+"hour". Figures
 only: nothing here passes or fails; the "met" column reads the goals.
 """
 
@@ -145,8 +147,9 @@ class Mover:
         self.stopped.set()
 
 
-def live(robots: int, window_s: float) -> dict[str, tuple[float, float]]:
-    """(frames a second to the tab, server CPU %) with the plots on, then off."""
+def live(robots: int, window_s: float, settle_s: float = 1.0) -> dict[str, tuple[float, float]]:
+    """(frames a second to the tab, server CPU %) with the plots on, then off; each
+    measured ``window_s`` after ``settle_s`` (twice that at first: charts drawn once)."""
     with tempfile.TemporaryDirectory() as folder:
         names = [f"arm{k}" for k in range(robots)]
         ini = Path(folder) / "cell.ini"
@@ -165,11 +168,11 @@ def live(robots: int, window_s: float) -> dict[str, tuple[float, float]]:
         tab = Tab(proc.url or "", f"/robots/{names[0]}/links/base_link/link_s")
         mover = Mover(proc.address, names)
         try:
-            time.sleep(2.0)  # every robot under way, every chart drawn once
+            time.sleep(2 * settle_s)  # every robot under way, every chart drawn once
             out = {}
             for mode in ("on", "off"):
                 tab.set_plots(mode == "on")
-                time.sleep(1.0)
+                time.sleep(settle_s)
                 out[mode] = measure(proc, tab, window_s)
             return out
         finally:
@@ -314,16 +317,19 @@ def row(label: str, unit: str, value: float, goal: str = "", met: bool | None = 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="short windows, a 1-minute hour")
+    parser.add_argument("--smoke", action="store_true", help="every row, the least work")
     parser.add_argument("--no-browser", action="store_true", help="skip the load-time rows")
     args = parser.parse_args(argv)
-    window = 2.0 if args.quick else 10.0
-    hour = 60.0 if args.quick else 3600.0
-    ten = 60.0 if args.quick else 600.0
+    args.quick = args.quick or args.smoke
+    window = 0.5 if args.smoke else 2.0 if args.quick else 10.0
+    settle = 0.3 if args.smoke else 1.0
+    hour = 10.0 if args.smoke else 60.0 if args.quick else 3600.0
+    ten = 10.0 if args.smoke else 60.0 if args.quick else 600.0
     print(f"{machine()}; viser {viser.__version__}")
     rows = ["| row | unit | figure | goal | met |", "|---|---|---|---|---|"]
     add = rows.append
     for robots in (1, 8):
-        figures = live(robots, window)
+        figures = live(robots, window, settle)
         (fps_on, cpu_on), (fps_off, cpu_off) = figures["on"], figures["off"]
         name = f"{robots} robot{'s' if robots > 1 else ''}"
         add(row(f"{name}: frames/s to a tab, plots on", "1/s", fps_on, ">= 50", fps_on >= 50))
@@ -333,7 +339,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         extra = cpu_on - cpu_off
         add(row(f"{name}: CPU the plots add", "% core", extra, "<= 20", extra <= 20))
     with tempfile.TemporaryDirectory() as folder:
-        tag = "1 min (quick)" if args.quick else "10 min"
+        tag = "10 s (smoke)" if args.smoke else "1 min (quick)" if args.quick else "10 min"
         made = recording(ten, Path(folder), "ten")
         floor = viser_page(Path(folder))
         size = float(made["html_bytes"])  # type: ignore[arg-type]
@@ -346,7 +352,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             add(row(f"recorded page, {tag}: open to first frame", "s", load, "<= 2", load <= 2))
             load = open_s(floor, SCENE_SHOWN, reps)
             add(row("viser's own page of the robot: open to scene", "s", load))
-        tag = "1 min (quick)" if args.quick else "1 h"
+        tag = "10 s (smoke)" if args.smoke else "1 min (quick)" if args.quick else "1 h"
         made = recording(hour, Path(folder), "hour")
         took, extra = float(made["seconds"]), float(made["extra_mb"])  # type: ignore[arg-type]
         note = "" if made["reset"] else " (peak not reset)"

@@ -51,6 +51,14 @@ QUICK = Plan(
     frame_samples=15,
     flood_s=0.5,
 )
+SMOKE = Plan(  # the test suite's run: every row, the least work
+    reps=1,
+    pipelined=2_000,
+    round_trips=200,
+    per_client=10,
+    frame_samples=10,
+    flood_s=0.3,
+)
 
 
 # Measurements.
@@ -215,11 +223,12 @@ def run_ours(plan: Plan, viewer: bool) -> Figures:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="one short repetition (for CI)")
+    parser.add_argument("--smoke", action="store_true", help="every row, the least work")
     parser.add_argument("--reps", type=int, help="repetitions (default 5; 1 with --quick)")
     parser.add_argument("--no-viewer", action="store_true", help="TCP rows only")
     parser.add_argument("--no-pin", action="store_true", help="let the OS place the processes")
     args = parser.parse_args(argv)
-    plan = QUICK if args.quick else FULL
+    plan = SMOKE if args.smoke else QUICK if args.quick else FULL
     if args.reps is not None:
         plan = Plan(**{**plan.__dict__, "reps": max(1, args.reps)})
     viewer = not args.no_viewer and (ROOT / "c2rviz" / "view" / "viser_scene.py").is_file()

@@ -14,6 +14,7 @@ CI machine is slow, not wrong; a timeout says what it last saw.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import io
 import socket
@@ -62,6 +63,51 @@ PAGE_STATE = """() => {
     poses,
   };
 }""".replace("LINK_NODE", f"({LINK_NODE_JS})")
+
+
+class FreshContexts:
+    """The session's one Chromium as each test sees it: ``new_page`` opens a page in a new
+    browser context (cookies, storage and viewport of its own, as a fresh browser has),
+    ``new_context`` a context; ``close_contexts`` closes what a test opened.
+
+    A Chromium that died is launched again before the next test.
+
+    Playwright's sync API marks its event loop as this thread's running loop between its
+    calls; a session-long Playwright would then refuse every later test's ``asyncio.run``.
+    ``close_contexts`` (after each browser test) unmarks it, ``resume`` (before) marks it again.
+    """
+
+    def __init__(self, launch: Callable[[], Any]) -> None:
+        self._launch = launch
+        self._browser = launch()
+        self._contexts: list[Any] = []
+        self._loop: asyncio.AbstractEventLoop | None = asyncio._get_running_loop()
+
+    def new_context(self, **options: Any) -> Any:
+        context = self._browser.new_context(**options)
+        self._contexts.append(context)
+        return context
+
+    def new_page(self, **options: Any) -> Any:
+        return self.new_context(**options).new_page()
+
+    def resume(self) -> None:
+        """Before a test: the loop marked again, and a new Chromium if the last one died
+        (one test's crash must not fail every later browser test)."""
+        if self._loop is not None:
+            asyncio._set_running_loop(self._loop)
+        if not self._browser.is_connected():
+            self._browser = self._launch()
+
+    def close_contexts(self) -> None:
+        try:
+            while self._contexts:
+                self._contexts.pop().close()
+        finally:
+            asyncio._set_running_loop(None)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._browser, name)
 
 
 def in_root(poses: dict[str, list[float]]) -> dict[str, np.ndarray]:

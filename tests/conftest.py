@@ -18,6 +18,7 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 import pytest
+from browser_support import FreshContexts
 from support import ARGS, CHROMIUM, ROOT, Client, Process, ServerThread, load_robot
 
 from c2rviz.session import ServerLimits
@@ -113,9 +114,10 @@ def c2rviz_process() -> Iterator[Callable[..., Process]]:
             proc.popen.stdout.close()
 
 
-@pytest.fixture
-def browser() -> Iterator[Any]:
-    """A headless Chromium (Playwright); a CI run without it fails rather than skips."""
+@pytest.fixture(scope="session")
+def chromium() -> Iterator[Any]:
+    """The session's one headless Chromium (Playwright), launched on first use; a CI run
+    without it fails rather than skips. Tests take ``browser``, not this."""
     if not CHROMIUM.exists():
         if os.environ.get("CI") == "true":
             pytest.fail(f"{CHROMIUM} is missing: install Debian's chromium")
@@ -123,11 +125,25 @@ def browser() -> Iterator[Any]:
     from playwright.sync_api import sync_playwright
 
     with sync_playwright() as pw:
-        chromium = pw.chromium.launch(executable_path=str(CHROMIUM), args=ARGS)
+        browser = FreshContexts(
+            lambda: pw.chromium.launch(executable_path=str(CHROMIUM), args=ARGS)
+        )
         try:
-            yield chromium
+            yield browser
         finally:
-            chromium.close()
+            browser.resume()
+            browser.close()
+
+
+@pytest.fixture
+def browser(chromium: FreshContexts) -> Iterator[FreshContexts]:
+    """The session's Chromium for one test: each page in a new context of its own, every
+    context the test opened closed after it (one launch per session, not per test)."""
+    chromium.resume()
+    try:
+        yield chromium
+    finally:
+        chromium.close_contexts()
 
 
 BROWSER_TIMEOUT_S = 900

@@ -22,12 +22,18 @@ id); when the test fails, NAME.txt, NAME.csv and NAME.html are kept in
 ``--c2rviz-recordings`` (default ``c2rviz-recordings/`` of the rootdir) and the report
 says where; when it passes they are dropped. A test that records itself says
 ``record=False`` (a robot records one recording at a time).
+
+Under pytest-xdist (``pytest -n auto``) each worker runs its own servers on free ports,
+and a recording's name ends in the worker's id (``-gw1``), so two workers running the
+same test (``--dist each``, repeats) keep both; the summary of kept recordings is
+printed by the controller, from the reports the workers send.
 """
 
 from __future__ import annotations
 
 import re
 import shutil
+import zlib
 from collections.abc import Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -42,6 +48,7 @@ __all__ = ["c2rviz", "c2rviz_server", "recording_name"]
 
 _REPORTS = pytest.StashKey[dict[str, pytest.TestReport]]()
 _KEPT = pytest.StashKey[list[Path]]()
+_KEPT_PROPERTY = "c2rviz_recording"  # a kept recording's NAME.txt, in the report
 _NAME_CHARS = re.compile(r"[^A-Za-z0-9_.-]+")
 
 
@@ -68,6 +75,7 @@ def pytest_configure(config: pytest.Config) -> None:
         "viewer=, doors=, faults=, record=, and any c2rviz flag by its name)",
     )
     config.stash[_KEPT] = []
+    config.pluginmanager.register(_KeptRecordings(config), "c2rviz-kept-recordings")
 
 
 @pytest.hookimpl(wrapper=True, tryfirst=True)
@@ -86,10 +94,35 @@ def pytest_terminal_summary(terminalreporter: Any, config: pytest.Config) -> Non
             terminalreporter.write_line(f"{path}  (c2rviz-play {path}; open {path.stem}.html)")
 
 
-def recording_name(nodeid: str) -> str:
-    """A recording's name for a test: its id as letters, digits, ``_ . -`` (at most 100)."""
+class _KeptRecordings:
+    """Notes the recordings tests kept, from their teardown reports: under pytest-xdist a
+    worker's reports reach the controller, which prints the summary."""
+
+    def __init__(self, config: pytest.Config) -> None:
+        self.config = config
+
+    def pytest_runtest_logreport(self, report: pytest.TestReport) -> None:
+        if report.when == "teardown":
+            kept = self.config.stash[_KEPT]
+            kept += [Path(str(v)) for k, v in report.user_properties if k == _KEPT_PROPERTY]
+
+
+def recording_name(nodeid: str, worker: str = "") -> str:
+    """A recording's name for a test: its id as letters, digits, ``_ . -`` (at most 100),
+    then ``-WORKER`` under pytest-xdist (``-gw0``)."""
     name = _NAME_CHARS.sub("_", nodeid.replace("::", "-")).strip("._-") or "test"
-    return name if len(name) <= 100 else f"{name[:91]}-{abs(hash(nodeid)) % 10**8:08d}"
+    tail = f"-{_NAME_CHARS.sub('_', worker)}" if worker else ""
+    room = 100 - len(tail)
+    if len(name) > room:
+        name = f"{name[: room - 9]}-{zlib.crc32(nodeid.encode()):08x}"
+    return name + tail
+
+
+def _worker(config: pytest.Config) -> str:
+    """This pytest-xdist worker's id (``gw0``...), or "" when not under xdist (not from the
+    environment: a pytest started by a worker's test inherits that)."""
+    workerinput = getattr(config, "workerinput", None)
+    return str(workerinput.get("workerid", "")) if isinstance(workerinput, dict) else ""
 
 
 def _options(request: pytest.FixtureRequest) -> dict[str, Any]:
@@ -126,7 +159,7 @@ def c2rviz_server(
     folder = tmp_path_factory.mktemp("c2rviz-recording")
     options.setdefault("record_dir", str(folder))
     server = TestServer(options).start()
-    name = recording_name(request.node.nodeid)
+    name = recording_name(request.node.nodeid, _worker(request.config))
     if record:
         reply = server.run(f"record {name} overwrite", server.robot)
         if not reply.startswith("ok"):
@@ -158,7 +191,7 @@ def _keep(request: pytest.FixtureRequest, folder: Path, name: str) -> None:
         moved.append(target)
     txt = kept / f"{name}.txt"
     if moved:
-        request.config.stash[_KEPT].append(txt)
+        request.node.user_properties.append((_KEPT_PROPERTY, str(txt)))
         request.node.add_report_section(
             "teardown",
             "c2rviz recording",

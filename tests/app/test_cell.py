@@ -328,6 +328,7 @@ def test_an_unknown_cell_lists_the_cells(tmp_path: Path):
         load_cell("three", ini)
 
 
+@pytest.mark.xdist_group("default_ports")  # binds a default port: one at a time
 def test_the_program_serves_a_cell(tmp_path: Path):
     """``c2rviz --cell FILE``: every robot on its own port, named in the banner."""
     ini = write_ini(
@@ -527,6 +528,7 @@ def free_port_pair() -> int:
     raise AssertionError("no two free ports in a row")
 
 
+@pytest.mark.xdist_group("default_ports")  # binds a default port: one at a time
 def test_a_cell_file_and_a_users_ini_name_the_bundled_robots(tmp_path: Path):
     """Issue 30.1: a cell file of its own, and an ini with only the user's robot, can
     name motoman_sia20d and kuka_lwr (the bundled robots), from any folder."""
@@ -546,6 +548,7 @@ def test_a_cell_file_and_a_users_ini_name_the_bundled_robots(tmp_path: Path):
     stop(proc, ports["robot"])
 
 
+@pytest.mark.xdist_group("default_ports")  # binds a default port: one at a time
 def test_port_gives_a_cell_its_first_port(tmp_path: Path):
     """Issue 30.2: `--cell twoarms --port P` serves its members at P and P + 1 (the flag wins
     over the ports the ini fixes)."""

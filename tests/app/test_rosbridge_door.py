@@ -93,6 +93,7 @@ def _hold(port: int) -> socket.socket | None:
     return holder
 
 
+@pytest.mark.xdist_group("default_ports")  # binds a default port: one at a time
 def test_a_taken_default_port_costs_only_the_door() -> None:
     holder = _hold(DEFAULT_ROSBRIDGE_PORT)
     proc = subprocess.Popen(

@@ -484,6 +484,7 @@ def test_the_recorded_page_plays_in_a_browser_without_a_server(
     wait_until(lambda: ((n := page.evaluate(RECORDED_MARKERS)) == 4, n), "the recorded markers")
 
 
+@pytest.mark.xdist_group("default_ports")  # binds a default port: one at a time
 def test_recordings_land_in_the_working_directory_by_default(tmp_path: Path):
     """Issue 30.3: started from an empty folder (the project's ini is read), `record demo`
     writes ./recordings/demo.txt there, not into the project's folder."""

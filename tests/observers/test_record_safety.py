@@ -192,6 +192,7 @@ def test_record_flag_says_what_it_records_and_may_overwrite(
         assert named in text, named
 
 
+@pytest.mark.xdist_group("default_ports")  # binds a default port: one at a time
 def test_a_file_size_limit_ends_the_recording_readable(tmp_path: Path):
     """A real kernel write error (RLIMIT_FSIZE: EFBIG) mid-recording: the recording stops
     with an event, the server goes on, and every file is whole up to the error, in place."""

@@ -19,6 +19,7 @@ import asyncio
 import math
 import re
 import threading
+import time
 from collections.abc import Callable
 
 import numpy as np
@@ -55,18 +56,30 @@ def frame_count(server: ServerThread) -> int:
     return server.call(lambda: len(server.scene.joints))
 
 
+WAIT_S = 100.0
+"""How long a wait on the arm may take before it fails (the suite's limit is 120 s): a
+condition, polled; the bound only tells a stuck arm from a busy machine."""
+
+
+def ask_until(client: Client, line: str, done: Callable[[str], bool], what: str) -> str:
+    """Ask ``line`` until its reply is ``done``; fail after ``WAIT_S`` naming ``what``."""
+    deadline = time.monotonic() + WAIT_S
+    while not done(reply := client.ask(line)):
+        assert time.monotonic() < deadline, f"{what} in {WAIT_S:.0f} s (last: {reply!r})"
+    return reply
+
+
 def wait_until_moving(client: Client) -> None:
-    for _ in range(100_000):
-        if client.ask("status").startswith("ok moving"):
-            return
-    raise AssertionError("the arm never started moving")
+    ask_until(client, "status", lambda r: r.startswith("ok moving"), "the arm never moved")
 
 
 def wait_until_past(client: Client, joint: int, degrees: float) -> None:
-    for _ in range(100_000):
-        if abs(float(client.ask("where")[3:].split(",")[joint])) >= degrees:
-            return
-    raise AssertionError(f"joint {joint} never passed {degrees} degrees")
+    ask_until(
+        client,
+        "where",
+        lambda reply: abs(float(reply[3:].split(",")[joint])) >= degrees,
+        f"joint {joint} never passed {degrees} degrees",
+    )
 
 
 def fractions_along(q: np.ndarray, start: np.ndarray, goal: np.ndarray) -> np.ndarray:

@@ -228,3 +228,56 @@ def test_importing_the_plugin_loads_no_server():
         env={**os.environ, "PYTHONPATH": str(ROOT)},
     )
     assert out.stdout.strip() == "[]"
+
+
+@pytest.mark.timeout(900)
+def test_the_plugin_under_xdist_keeps_each_workers_recording(sample):
+    """Issue 36.5: under pytest-xdist each worker runs its own servers on free ports; with
+    every test on both workers (``--dist each``) the failing test fails twice and both
+    recordings are kept, each named with its worker, and the controller's summary lists
+    them."""
+    done = run_pytest(
+        sample,
+        *("-p", "c2rviz.testing.plugin", "-n", "2", "--dist", "each"),
+        *("-k", "fails_and_its_run_is_kept or marker_chooses"),
+    )
+    out = done.stdout + done.stderr
+    assert counts(out) == {"passed": 2, "failed": 2}, out
+    kept = sample / "c2rviz-recordings"
+    name = "test_controller.py-test_this_one_fails_and_its_run_is_kept"
+    for worker in ("gw0", "gw1"):
+        txt = kept / f"{name}-{worker}.txt"
+        assert {txt.with_suffix(".csv").name, txt.with_suffix(".html").name} <= {
+            path.name for path in kept.iterdir()
+        }
+        assert f"{txt}  (c2rviz-play {txt}" in out  # the controller's summary says where
+        assert "# robot: motoman_sia20d" in txt.read_text()
+
+
+def test_a_recording_name_is_short_and_names_the_worker():
+    from c2rviz.testing.plugin import recording_name
+
+    assert recording_name("t.py::test_a[1]") == "t.py-test_a_1"
+    assert recording_name("t.py::test_a[1]", "gw3") == "t.py-test_a_1-gw3"
+    long = "t.py::test_" + "x" * 200
+    named = recording_name(long, "gw12")
+    assert len(named) == 100 and named.endswith("-gw12")
+    assert named == recording_name(long, "gw12")  # the same in every process (no hash seed)
+    assert named != recording_name(long + "y", "gw12")
+
+
+def test_the_pytest_extra_brings_what_the_docs_say():
+    """Issue 39, rough edge 5: docs/testing.md says `pip install -e '.[pytest]'` brings pytest
+    and pytest-xdist; pyproject's extra does."""
+    import tomllib
+
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"][
+        "optional-dependencies"
+    ]
+    names = {re.split(r"[<>=\[ ]", spec)[0] for spec in extras["pytest"]}
+    assert {"pytest", "pytest-xdist"} <= names
+    page = (ROOT / "docs" / "testing.md").read_text()
+    assert (
+        "pip install -e '.[pytest]'" in page
+        and "installs c2rviz with pytest and pytest-xdist" in page
+    )

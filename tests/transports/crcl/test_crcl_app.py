@@ -80,6 +80,7 @@ def test_no_crcl_opens_none(c2rviz_process) -> None:
     assert proc.wait() == 0
 
 
+@pytest.mark.xdist_group("default_ports")  # binds a default port: one at a time
 def test_a_taken_default_port_costs_only_the_crcl_door(c2rviz_process) -> None:
     with socket.socket() as holder:
         holder.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
