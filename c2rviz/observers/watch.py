@@ -14,6 +14,7 @@ A connection that sent ``watch [HZ]`` also receives, between its replies::
     event resting NAME on X  part NAME came to rest on X (an object, a part, floor)
     event record-stopped NAME: WHY
     event dropped N          N events were dropped for a reader too slow to take them
+    camera NAME T SEEN       what camera NAME sees at T, at its rate (docs/cameras.md)
 
 A slow reader costs neither memory nor other clients: a stream keeps only the
 latest state (a reader that falls behind skips states) and at most
@@ -43,10 +44,12 @@ from typing import Protocol
 from ..errors import C2rvizError
 from ..protocol import replies
 from ..robot.frames import in_base, se3_pose, wxyz_se3
+from ..world.cameras import Camera
 from ..world.clock import Timer
 from ..world.effects import Marker, Observer
 from ..world.state import RobotState
 from ..world.world import World
+from .camera_feed import CameraFeed
 
 __all__ = [
     "MAX_EVENTS",
@@ -238,6 +241,8 @@ class WatchHub(Observer):
         self.active: list[WatchStream] = []
         self.listeners: list[EventListener] = []
         self._seq = 0
+        self.cameras = CameraFeed(self)
+        """The cameras' ``camera NAME T ...`` lines (``camera_feed.py``)."""
 
     @property
     def default_hz(self) -> float:
@@ -274,6 +279,7 @@ class WatchHub(Observer):
         if stream not in self.active:
             self._engage()
             self.active.append(stream)
+        self.cameras.sync()
 
     def unwatch(self, session: Watcher) -> bool:
         """Stop ``session``'s stream; False if it was not watching."""
@@ -288,6 +294,7 @@ class WatchHub(Observer):
         if stream in self.active:
             self.active.remove(stream)
             self._disengage()
+            self.cameras.sync()
 
     # Listeners: event texts for consumers without a socket.
 
@@ -361,3 +368,11 @@ class WatchHub(Observer):
 
     def on_part_event(self, robot: str | None, text: str) -> None:
         self.event(text)  # parts are the world's: every watcher hears of them
+
+    # The cameras' lines (camera_feed.py).
+
+    def on_cameras(self, cameras: Sequence[Camera]) -> None:
+        self.cameras.sync()
+
+    def on_command(self, source: str, line: str, accepted: bool) -> None:
+        self.cameras.wake()

@@ -10,9 +10,11 @@ from . import cartesian, cell, motion, observe, record, workcell
 from . import planning
 from . import gripper
 from . import parts
+from . import cameras
 # isort: on
 
 __all__ = [
+    "cameras",
     "cartesian",
     "cell",
     "connection",
