@@ -191,3 +191,26 @@ def test_registry_limit_and_unknown() -> None:
         cameras.get("z")
     cameras.remove("a")
     assert told == [["a"], ["a", "b"], ["a", "b"], ["b"]]
+
+
+def test_the_docs_limits_are_the_code() -> None:
+    from support import ROOT
+
+    from c2rviz.protocol.verbs.cameras import MAX_CAMERA_RATE_HZ, MAX_SIGMA_M
+    from c2rviz.world import cameras
+
+    table = (ROOT / "docs" / "cameras.md").read_text().split("## Limits")[1]
+    rows = {
+        line.split("|")[1].strip(): line.split("|")[2].strip()
+        for line in table.splitlines()[3:]
+        if line.startswith("|")
+    }
+    assert rows["Cameras in a world"] == str(cameras.MAX_CAMERAS)
+    assert rows["A camera's range"] == f"above 0, at most {cameras.MAX_RANGE_M:g} m"
+    assert rows["`watch` lines a second per camera"] == (
+        f"0..{cameras.MAX_RATE_HZ:g} (default {cameras.DEFAULT_RATE_HZ:g})"
+    )
+    assert MAX_CAMERA_RATE_HZ == cameras.MAX_RATE_HZ
+    assert rows["Noise"].startswith(f"0..{MAX_SIGMA_M:g} m")
+    limits = (ROOT / "docs" / "limits.md").read_text()
+    assert f"| {cameras.MAX_CAMERAS}; above 0 ..{cameras.MAX_RANGE_M:g} m;" in limits
