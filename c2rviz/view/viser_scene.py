@@ -36,10 +36,12 @@ from ..errors import C2rvizError
 from ..robot.visuals import LinkGeometry, load_link_geometry
 from ..session.services import Services
 from ..session.session import Session
+from ..world.cameras import Camera
 from ..world.effects import Marker, Scene
 from ..world.goals import Goal
 from ..world.parts import Part
 from . import adapter
+from .camera_layer import CameraLayer
 from .handle import ToolHandles
 from .instruments import Instruments
 from .markers import MarkerLayer
@@ -159,6 +161,8 @@ class ViserScene(Scene):
         self.parts = PartsLayer(server)
         self._parts: list[Part] | None = world.parts.parts.all()  # to draw at the next send
         self._goals: list[Goal] | None = world.parts.goals.all()
+        self.cameras = CameraLayer(server)
+        self._cameras: list[Camera] | None = world.cameras.all()
         self.handles = ToolHandles(server, segments, self.scheduler.request)
         self._frame_camera()
         self.page_input = PageInput(server, self.markers)
@@ -272,6 +276,10 @@ class ViserScene(Scene):
 
     def on_goals(self, goals: Sequence[Goal]) -> None:
         self._goals = list(goals)
+        self.scheduler.request()
+
+    def on_cameras(self, cameras: Sequence[Camera]) -> None:
+        self._cameras = list(cameras)
         self.scheduler.request()
 
     def _pick(self, robot: str, shape: str, instance: int) -> None:
@@ -408,6 +416,9 @@ class ViserScene(Scene):
             if self._goals is not None:
                 self.parts.show_goals(self._goals, self.world.parts.parts.all())
                 self._goals = None
+            if self._cameras is not None:
+                self.cameras.show(self._cameras, self.world.clock.now())
+                self._cameras = None
         for name, pairs in self._collisions.items():
             if name in self.workcells:
                 self.workcells[name].show_collisions(pairs)
