@@ -1,69 +1,51 @@
-"""The cameras' lines in ``watch`` streams: ``camera NAME T p1:TYPE:x,y,z,roll,pitch,yaw;...``.
+"""The cameras' reports on the world's clock: each camera whose rate is above 0 reports
+what it sees every ``1 / rate`` seconds (the first at once), while someone listens.
 
-While anyone watches, each camera whose rate is above 0 reports what it sees every
-``1 / rate`` seconds of the world's clock (the first at once), to every active stream,
-in each connection's units (``ok none``'s ``none`` when it sees nothing). T counts from
-the server's start, as ``state`` lines do. The lines go with the stream's events: a
-reader too slow to take them loses the oldest (``event dropped N``).
+``watch`` streams get them as ``camera NAME T p1:TYPE:x,y,z,roll,pitch,yaw;...`` lines
+(``WatchHub``; T counts from the server's start, as ``state`` lines do; ``none`` when
+it sees nothing), among the stream's events: a reader too slow to take them loses the
+oldest (``event dropped N``). rosbridge publishes them on each camera's topic.
 
-On virtual time a camera's next line is never the only thing that moves the clock: when
-nobody holds it and no other timer is pending, the camera waits (parked) until the next
-command anyone sends, so a server whose clients only watch does not spin.
+On virtual time a camera's next report is never the only thing that moves the clock:
+when nobody holds it and no other timer is pending, the camera waits (parked) until the
+next command anyone sends (``wake``), so a server whose clients only listen does not spin.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from typing import TYPE_CHECKING, Protocol
+from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
-from ..world.camera_sight import seen_text, sight
+from ..world.camera_sight import sight
 from ..world.clock import Timer
 
 if TYPE_CHECKING:
+    from ..world.cameras import Seen
     from ..world.world import World
 
-__all__ = ["CameraFeed"]
+__all__ = ["CameraFeed", "Report"]
 
-
-class _Units(Protocol):
-    @property
-    def angle_scale(self) -> float: ...
-
-
-class _Stream(Protocol):
-    @property
-    def session(self) -> _Units: ...
-
-    def event(self, text: str, seq: int) -> None: ...
-
-
-class _Hub(Protocol):
-    """What the feed needs of its ``watch.WatchHub``."""
-
-    world: World
-    origin: float
-
-    @property
-    def active(self) -> Sequence[_Stream]: ...
-
-    def next_seq(self) -> int: ...
+Report = Callable[[str, float, "Sequence[Seen]"], None]
+"""``report(camera, t, seen)``: what ``camera`` sees at clock time ``t`` [s]."""
 
 
 class CameraFeed:
-    """The periodic camera lines of one ``WatchHub``."""
+    """The periodic reports of every camera of a world, to one listener."""
 
-    def __init__(self, hub: _Hub) -> None:
-        self.hub = hub
+    def __init__(self, world: World, report: Report) -> None:
+        self.world = world
+        self.report = report
         self._timers: dict[str, Timer] = {}
-        self._due: dict[str, float] = {}  # when each camera's next line is due [clock s]
+        self._due: dict[str, float] = {}  # when each camera's next report is due [clock s]
         self._period: dict[str, float] = {}
         self._parked: set[str] = set()
 
-    def sync(self) -> None:
-        """Start, re-rate or stop the cameras' lines as the cameras and streams are now."""
-        world = self.hub.world
+    def sync(self, on: bool) -> None:
+        """Start, re-rate or stop the reports as the cameras are now (``on``: someone
+        listens)."""
+        world = self.world
         wanted = {}
-        if self.hub.active:
+        if on:
             wanted = {c.name: 1.0 / c.rate_hz for c in world.cameras.all() if c.rate_hz > 0}
         for name in list(self._period):
             if wanted.get(name) != self._period[name]:
@@ -77,10 +59,14 @@ class CameraFeed:
     def wake(self) -> None:
         """Someone sent a command: parked cameras go on."""
         if self._parked:
-            now = self.hub.world.clock.now()
+            now = self.world.clock.now()
             for name in sorted(self._parked):
                 self._arm(name, max(self._due[name], now))
             self._parked.clear()
+
+    def close(self) -> None:
+        for name in list(self._period):
+            self._stop(name)
 
     def _stop(self, name: str) -> None:
         timer = self._timers.pop(name, None)
@@ -92,25 +78,19 @@ class CameraFeed:
 
     def _arm(self, name: str, when: float) -> None:
         self._due[name] = when
-        self._timers[name] = self.hub.world.clock.call_at(when, self._tick, name)
+        self._timers[name] = self.world.clock.call_at(when, self._tick, name)
 
     def _tick(self, name: str) -> None:
         self._timers.pop(name, None)
-        hub = self.hub
-        world = hub.world
+        world = self.world
         if name not in self._period or name not in world.cameras:
             self._stop(name)
             return
         clock = world.clock
         now = clock.now()
-        seen = sight(world, name)
-        seq = hub.next_seq()
-        stamp = f"{max(now, self._due[name]) - hub.origin:.6f}"
-        for stream in hub.active:
-            text = seen_text(seen, stream.session.angle_scale)
-            stream.event(f"camera {name} {stamp} {text}", seq)
+        self.report(name, max(now, self._due[name]), sight(world, name))
         due = self._due[name] + self._period[name]
-        if due <= now:  # late (a busy loop on real time): no burst of catch-up lines
+        if due <= now:  # late (a busy loop on real time): no burst of catch-up reports
             due = now + self._period[name]
         next_timer = getattr(clock, "next_timer", None)
         idle = getattr(clock, "busy_count", 1) == 0

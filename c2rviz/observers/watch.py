@@ -44,7 +44,8 @@ from typing import Protocol
 from ..errors import C2rvizError
 from ..protocol import replies
 from ..robot.frames import in_base, se3_pose, wxyz_se3
-from ..world.cameras import Camera
+from ..world.camera_sight import seen_text
+from ..world.cameras import Camera, Seen
 from ..world.clock import Timer
 from ..world.effects import Marker, Observer
 from ..world.state import RobotState
@@ -241,7 +242,7 @@ class WatchHub(Observer):
         self.active: list[WatchStream] = []
         self.listeners: list[EventListener] = []
         self._seq = 0
-        self.cameras = CameraFeed(self)
+        self.cameras = CameraFeed(world, self._camera)
         """The cameras' ``camera NAME T ...`` lines (``camera_feed.py``)."""
 
     @property
@@ -279,7 +280,7 @@ class WatchHub(Observer):
         if stream not in self.active:
             self._engage()
             self.active.append(stream)
-        self.cameras.sync()
+        self.cameras.sync(bool(self.active))
 
     def unwatch(self, session: Watcher) -> bool:
         """Stop ``session``'s stream; False if it was not watching."""
@@ -294,7 +295,7 @@ class WatchHub(Observer):
         if stream in self.active:
             self.active.remove(stream)
             self._disengage()
-            self.cameras.sync()
+            self.cameras.sync(bool(self.active))
 
     # Listeners: event texts for consumers without a socket.
 
@@ -371,8 +372,15 @@ class WatchHub(Observer):
 
     # The cameras' lines (camera_feed.py).
 
+    def _camera(self, name: str, t: float, seen: Sequence[Seen]) -> None:
+        seq = self.next_seq()
+        stamp = f"{t - self.origin:.6f}"
+        for stream in self.active:
+            text = seen_text(seen, stream.session.angle_scale)
+            stream.event(f"camera {name} {stamp} {text}", seq)
+
     def on_cameras(self, cameras: Sequence[Camera]) -> None:
-        self.cameras.sync()
+        self.cameras.sync(bool(self.active))
 
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         self.cameras.wake()
