@@ -7,8 +7,9 @@ it sees nothing), among the stream's events: a reader too slow to take them lose
 oldest (``event dropped N``). rosbridge publishes them on each camera's topic.
 
 On virtual time a camera's next report is never the only thing that moves the clock:
-when nobody holds it and no other timer is pending, the camera waits (parked) until the
-next command anyone sends (``wake``), so a server whose clients only listen does not spin.
+when nobody holds it and no timer but the cameras' (of any feed) is pending, the camera
+waits (parked) until the next command anyone sends (``wake``), so a server whose clients
+only listen does not spin.
 """
 
 from __future__ import annotations
@@ -78,9 +79,10 @@ class CameraFeed:
 
     def _arm(self, name: str, when: float) -> None:
         self._due[name] = when
-        self._timers[name] = self.world.clock.call_at(when, self._tick, name)
+        self._timers[name] = self.world.clock.call_at(when, _tick, self, name)
 
-    def _tick(self, name: str) -> None:
+    def tick(self, name: str) -> None:
+        """Camera ``name``'s report is due: make it, and arm the next one."""
         self._timers.pop(name, None)
         world = self.world
         if name not in self._period or name not in world.cameras:
@@ -94,8 +96,14 @@ class CameraFeed:
             due = now + self._period[name]
         next_timer = getattr(clock, "next_timer", None)
         idle = getattr(clock, "busy_count", 1) == 0
-        if next_timer is not None and idle and next_timer(self._tick) is None:
+        if next_timer is not None and idle and next_timer(_tick) is None:
             self._due[name] = due
             self._parked.add(name)
             return
         self._arm(name, due)
+
+
+def _tick(feed: CameraFeed, name: str) -> None:
+    """Every feed's timers call this one function, so that the virtual clock can tell the
+    cameras' timers (of every feed: watch's, rosbridge's, a bag's) from the rest."""
+    feed.tick(name)

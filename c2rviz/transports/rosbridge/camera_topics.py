@@ -21,34 +21,16 @@ from functools import partial
 
 import pinocchio as pin
 
-from ...observers.bag_parts import xyz_xyzw
 from ...observers.camera_feed import CameraFeed
-from ...ros.messages import Msg, header, tf_message, transforms
+from ...observers.camera_records import CAMERA_TOPIC, POSE_ARRAY, camera_items, pose_array
+from ...ros.messages import Msg, tf_message, transforms
 from ...world.camera_sight import sight
 from ...world.cameras import Camera, Seen
 from ...world.effects import Observer
 from ...world.world import World
 from .topic_hub import TopicHub
 
-__all__ = ["CAMERA_FRAME", "CAMERA_TOPIC", "POSE_ARRAY", "CameraTopics"]
-
-POSE_ARRAY = "geometry_msgs/msg/PoseArray"
-CAMERA_TOPIC = "/c2rviz/cameras/{name}"
-CAMERA_FRAME = "cameras/{name}"
-
-
-def pose_array(t: float, name: str, seen: Sequence[Seen]) -> Msg:
-    """``geometry_msgs/msg/PoseArray`` of what camera ``name`` sees, stamped ``t`` [s]."""
-    poses = []
-    for one in seen:
-        (x, y, z), (qx, qy, qz, qw) = xyz_xyzw(one.pose)
-        poses.append(
-            {
-                "position": {"x": float(x), "y": float(y), "z": float(z)},
-                "orientation": {"x": float(qx), "y": float(qy), "z": float(qz), "w": float(qw)},
-            }
-        )
-    return {"header": header(t, CAMERA_FRAME.format(name=name)), "poses": poses}
+__all__ = ["CameraTopics"]
 
 
 class CameraTopics(Observer):
@@ -105,7 +87,5 @@ class CameraTopics(Observer):
             self.hub.publish(topic, pose_array(t, name, seen))
         if self.hub.wanted(self.tf_topic):
             camera = self.world.cameras.get(name)
-            frame = CAMERA_FRAME.format(name=name)
-            items = [(self.parent, frame, *xyz_xyzw(self.to_parent * camera.pose))]
-            items += [(frame, f"{frame}/{one.name}", *xyz_xyzw(one.pose)) for one in seen]
+            items = camera_items(self.parent, self.to_parent, camera, seen)
             self.hub.publish(self.tf_topic, tf_message(transforms(t, items)))
