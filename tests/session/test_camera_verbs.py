@@ -5,6 +5,7 @@ virtual time, and bad input that changes nothing."""
 from __future__ import annotations
 
 import re
+import time
 
 import numpy as np
 import pytest
@@ -218,3 +219,44 @@ def test_a_camera_alone_does_not_move_virtual_time(server) -> None:
         seen.append(line)
     assert line == "ok"
     assert [s for s in seen if s.startswith("camera")] == [f"camera top {start + 0.25:.6f} none"]
+
+
+def test_a_blackout_hides_everything_until_its_time(server) -> None:
+    thread, client = server
+    world = thread.world
+    assert client.ask(PART) == "ok"
+    assert client.ask(DOWN) == "ok"
+    thread.call(lambda: world.cameras.blackout("top", world.clock.now() + 0.5))
+    assert client.ask("camera top") == "ok none"
+    assert client.ask("sleep 0.5") == "ok"
+    assert client.ask("camera top").startswith("ok p1:battery:")
+
+
+def test_watch_and_a_recording_together_do_not_spin_virtual_time(tmp_path) -> None:
+    thread = ServerThread(
+        load_robot("fanuc_lrmate200id"), ServerLimits(), clock=VirtualClock(), record_dir=tmp_path
+    )
+    thread.start()
+    client = Client(thread.host, thread.port)
+    try:
+        clock = thread.world.clock
+        assert client.ask(DOWN) == "ok"
+        assert client.ask("record take").startswith("ok recording take")
+        start = thread.call(clock.now)
+        client.send("watch\n")
+        assert client.read_line() == "ok"
+        # Only watching: every feed (the watch's, the bag's) parks once nothing else is
+        # pending, instead of keeping the other's timers alive.
+        for _ in range(2000):
+            if thread.call(clock.next_timer) is None:
+                break
+            time.sleep(0.005)
+        assert thread.call(clock.next_timer) is None
+        assert thread.call(clock.now) - start < 1.0
+        client.send("record stop\n")
+        while not is_reply(line := client.read_line()):
+            pass
+        assert line.startswith("ok")
+    finally:
+        client.close()
+        thread.stop()
