@@ -41,6 +41,7 @@ __all__ = [
     "TooManyCameras",
     "UnknownCamera",
     "hidden",
+    "hidden_by",
     "in_frustum",
     "see",
 ]
@@ -148,59 +149,81 @@ def in_frustum(camera: Camera, point: np.ndarray) -> bool:
     )
 
 
-def _segment_hits(shape: str, size: Sequence[float], a: np.ndarray, b: np.ndarray) -> bool:
-    """True when the segment a->b (the shape's frame, centred on it) enters the shape."""
+_EPS = 1e-15
+
+
+def _slab(
+    a: np.ndarray, d: np.ndarray, half: float, low: np.ndarray, high: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Narrow [low, high] to where a + t d lies within -half..half (one axis, every
+    segment at once; a segment parallel to the slab and outside it gets low > high)."""
+    flat = np.abs(d) < _EPS
+    safe = np.where(flat, 1.0, d)
+    t0, t1 = (-half - a) / safe, (half - a) / safe
+    low = np.where(
+        flat, np.where(np.abs(a) <= half, low, np.inf), np.maximum(low, np.minimum(t0, t1))
+    )
+    high = np.where(flat, high, np.minimum(high, np.maximum(t0, t1)))
+    return low, high
+
+
+def _near(
+    a: np.ndarray, d: np.ndarray, radius: float, low: np.ndarray, high: np.ndarray
+) -> np.ndarray:
+    """Whether a + t d, for some t in [low, high], lies within ``radius`` of the origin
+    (``a``: (3,) or (n, 3); ``d``: (n, k), over its k axes)."""
+    a = np.broadcast_to(a, d.shape)
+    aa = np.einsum("ij,ij->i", a, a)
+    ad = np.einsum("ij,ij->i", a, d)
+    dd = np.einsum("ij,ij->i", d, d)
+    t = np.clip(-ad / np.where(dd < 1e-30, 1.0, dd), np.minimum(low, high), high)  # finite
+    return (low <= high) & (aa + 2.0 * ad * t + dd * t * t <= radius * radius)
+
+
+def segments_hit(shape: str, size: Sequence[float], a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """For each segment from ``a`` (3,) to a row of ``b`` (n, 3), both in the shape's frame
+    (centred on it), whether it enters the shape (a box, a cylinder along z, a sphere;
+    anything else: never)."""
     d = b - a
-    low, high = 0.0, 1.0
+    n = len(b)
+    low, high = np.zeros(n), np.ones(n)
     if shape == "box":
         for i in range(3):
-            half = size[i] / 2.0
-            if abs(d[i]) < 1e-15:
-                if abs(a[i]) > half:
-                    return False
-                continue
-            t0, t1 = (-half - a[i]) / d[i], (half - a[i]) / d[i]
-            low, high = max(low, min(t0, t1)), min(high, max(t0, t1))
-            if low > high:
-                return False
-        return True
+            low, high = _slab(np.full(n, a[i]), d[:, i], size[i] / 2.0, low, high)
+        return low <= high
     if shape == "sphere":
-        return _within_radius(a, d, size[0], (0, 1, 2), low, high)
+        return _near(a, d, size[0], low, high)
     if shape == "cylinder":
         radius, length = size
-        if abs(d[2]) < 1e-15:
-            if abs(a[2]) > length / 2.0:
-                return False
-        else:
-            t0, t1 = (-length / 2.0 - a[2]) / d[2], (length / 2.0 - a[2]) / d[2]
-            low, high = max(low, min(t0, t1)), min(high, max(t0, t1))
-            if low > high:
-                return False
-        return _within_radius(a, d, radius, (0, 1), low, high)
-    return False  # a mesh does not hide
+        low, high = _slab(np.full(n, a[2]), d[:, 2], length / 2.0, low, high)
+        return _near(a[:2], d[:, :2], radius, low, high)
+    return np.zeros(n, dtype=bool)  # a mesh does not hide
 
 
-def _within_radius(
-    a: np.ndarray, d: np.ndarray, radius: float, axes: tuple[int, ...], low: float, high: float
-) -> bool:
-    """True when a + t d, for some t in [low, high], lies within ``radius`` of the origin
-    (measured over ``axes``)."""
-    aa = float(sum(a[i] * a[i] for i in axes))
-    ad = float(sum(a[i] * d[i] for i in axes))
-    dd = float(sum(d[i] * d[i] for i in axes))
-    t = low if dd < 1e-30 else min(max(-ad / dd, low), high)
-    return aa + 2.0 * ad * t + dd * t * t <= radius * radius
+def hidden_by(
+    camera: Camera, targets: np.ndarray, occluders: Sequence[Occluder]
+) -> list[str | None]:
+    """For each target (rows of ``targets``, world frame [m]), the first occluder the
+    segment from the camera to it passes through, or None."""
+    found: list[str | None] = [None] * len(targets)
+    if not len(targets):
+        return found
+    origin = camera.pose.translation
+    for name, shape, size, placement in occluders:
+        rotation, place = placement.rotation, placement.translation
+        hits = segments_hit(
+            shape, size, rotation.T @ (origin - place), (targets - place) @ rotation
+        )
+        for i in np.flatnonzero(hits):
+            if found[i] is None:
+                found[i] = name
+    return found
 
 
 def hidden(camera: Camera, target: np.ndarray, occluders: Sequence[Occluder]) -> str | None:
     """The first occluder the segment from the camera to ``target`` (world frame [m])
     passes through, or None."""
-    origin = camera.pose.translation
-    for name, shape, size, placement in occluders:
-        inverse = placement.inverse()
-        if _segment_hits(shape, size, inverse.act(origin), inverse.act(target)):
-            return name
-    return None
+    return hidden_by(camera, np.asarray(target, dtype=float).reshape(1, 3), occluders)[0]
 
 
 def _noisy(camera: Camera, pose: pin.SE3) -> pin.SE3:
@@ -222,16 +245,19 @@ def see(
     """What ``camera`` sees at clock time ``now`` [s] (nothing in blackout)."""
     if camera.dark(now):
         return []
-    seen = []
     into = camera.pose.inverse()
-    for name, kind, pose in parts:
-        local = into * pose
-        if not in_frustum(camera, local.translation):
-            continue
-        if hidden(camera, pose.translation, occluders) is not None:
-            continue
-        seen.append(Seen(name, kind or name, _noisy(camera, local)))
-    return seen
+    inside = [
+        (name, kind, pose, local)
+        for name, kind, pose in parts
+        if in_frustum(camera, (local := into * pose).translation)
+    ]
+    targets = np.array([pose.translation for _, _, pose, _ in inside]).reshape(-1, 3)
+    blocked = hidden_by(camera, targets, occluders)
+    return [
+        Seen(name, kind or name, _noisy(camera, local))
+        for (name, kind, _, local), by in zip(inside, blocked)
+        if by is None
+    ]
 
 
 class Cameras:

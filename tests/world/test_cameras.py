@@ -214,3 +214,30 @@ def test_the_docs_limits_are_the_code() -> None:
     assert rows["Noise"].startswith(f"0..{MAX_SIGMA_M:g} m")
     limits = (ROOT / "docs" / "limits.md").read_text()
     assert f"| {cameras.MAX_CAMERAS}; above 0 ..{cameras.MAX_RANGE_M:g} m;" in limits
+
+
+def _inside(shape: str, size: tuple[float, ...], points: np.ndarray) -> np.ndarray:
+    if shape == "box":
+        return np.all(np.abs(points) <= np.array(size) / 2.0, axis=1)
+    if shape == "sphere":
+        return np.linalg.norm(points, axis=1) <= size[0]
+    radius, length = size
+    return (np.linalg.norm(points[:, :2], axis=1) <= radius) & (np.abs(points[:, 2]) <= length / 2)
+
+
+@pytest.mark.parametrize("shape", ["box", "sphere", "cylinder"])
+def test_the_segment_test_agrees_with_dense_sampling(shape: str) -> None:
+    from c2rviz.world.cameras import segments_hit
+
+    rng = np.random.default_rng(11)
+    size = {"box": (0.2, 0.3, 0.25), "sphere": (0.15,), "cylinder": (0.12, 0.3)}[shape]
+    steps = np.linspace(0.0, 1.0, 4001)[:, None]
+    for _ in range(40):
+        a = rng.uniform(-0.6, 0.6, 3)
+        b = rng.uniform(-0.6, 0.6, (25, 3))
+        exact = segments_hit(shape, size, a, b)
+        for k, end in enumerate(b):
+            points = a + steps * (end - a)
+            smaller = _inside(shape, tuple(v * 0.95 for v in size), points).any()
+            larger = _inside(shape, tuple(v * 1.05 for v in size), points).any()
+            assert (not smaller or exact[k]) and (not exact[k] or larger), (a, end)
