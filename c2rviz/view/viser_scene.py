@@ -36,6 +36,7 @@ from ..errors import C2rvizError
 from ..robot.visuals import LinkGeometry, load_link_geometry
 from ..session.services import Services
 from ..session.session import Session
+from ..world.camera_sight import sight
 from ..world.cameras import Camera
 from ..world.effects import Marker, Scene
 from ..world.goals import Goal
@@ -253,6 +254,8 @@ class ViserScene(Scene):
     def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
         self._objects[robot] = list(objects)
         self.instruments.on_objects(robot, objects)
+        if self.world.cameras.all():  # an object may hide a part now, or no more
+            self._cameras = self.world.cameras.all()
         self.scheduler.request()
 
     def on_refused(self, robot: str, source: str, line: str, error: C2rvizError) -> None:
@@ -272,6 +275,8 @@ class ViserScene(Scene):
 
     def on_parts(self, parts: Sequence[Part], t: float) -> None:
         self._parts = list(parts)
+        if self.world.cameras.all():  # what the cameras see may have changed
+            self._cameras = self.world.cameras.all()
         self.scheduler.request()
 
     def on_goals(self, goals: Sequence[Goal]) -> None:
@@ -417,7 +422,11 @@ class ViserScene(Scene):
                 self.parts.show_goals(self._goals, self.world.parts.parts.all())
                 self._goals = None
             if self._cameras is not None:
-                self.cameras.show(self._cameras, self.world.clock.now())
+                seen = {
+                    c.name: [s.name for s in sight(self.world, c.name, noisy=False)]
+                    for c in self._cameras
+                }
+                self.cameras.show(self._cameras, self.world.clock.now(), seen)
                 self._cameras = None
         for name, pairs in self._collisions.items():
             if name in self.workcells:

@@ -31,13 +31,15 @@ def occluders(world: World) -> list[Occluder]:
     return found
 
 
-def sight(world: World, name: str) -> list[Seen]:
-    """What camera ``name`` sees now (raises ``UnknownCamera``)."""
+def sight(world: World, name: str, noisy: bool = True) -> list[Seen]:
+    """What camera ``name`` sees now (raises ``UnknownCamera``); ``noisy`` False: the exact
+    poses, drawing nothing from its generator (the page's look, which must not change
+    what the camera reports to clients)."""
     camera = world.cameras.get(name)
     parts: list[PartLike] = [
         (p.name, p.kind or p.obj.shape, p.pose) for p in world.parts.parts.all()
     ]
-    return see(camera, parts, occluders(world), world.clock.now())
+    return see(camera, parts, occluders(world), world.clock.now(), noisy)
 
 
 def seen_text(seen: Sequence[Seen], angle_scale: float = 1.0) -> str:

@@ -240,9 +240,14 @@ PartLike = tuple[str, "str | None", pin.SE3]
 
 
 def see(
-    camera: Camera, parts: Sequence[PartLike], occluders: Sequence[Occluder], now: float
+    camera: Camera,
+    parts: Sequence[PartLike],
+    occluders: Sequence[Occluder],
+    now: float,
+    noisy: bool = True,
 ) -> list[Seen]:
-    """What ``camera`` sees at clock time ``now`` [s] (nothing in blackout)."""
+    """What ``camera`` sees at clock time ``now`` [s] (nothing in blackout); ``noisy``
+    False: the exact poses, drawing nothing from its generator."""
     if camera.dark(now):
         return []
     into = camera.pose.inverse()
@@ -254,7 +259,7 @@ def see(
     targets = np.array([pose.translation for _, _, pose, _ in inside]).reshape(-1, 3)
     blocked = hidden_by(camera, targets, occluders)
     return [
-        Seen(name, kind or name, _noisy(camera, local))
+        Seen(name, kind or name, _noisy(camera, local) if noisy else local)
         for (name, kind, _, local), by in zip(inside, blocked)
         if by is None
     ]

@@ -36,8 +36,8 @@ def test_a_camera_is_drawn_as_its_frustum_and_goes_when_removed(h: Harness) -> N
     layer = h.scene.cameras
     assert run(h, session, "camera top 0.5,0,1,0,1.5707963267948966,0 1.2,0.8,1.5") == "ok"
     h.until(lambda: "top" in layer.nodes, "the send that draws the camera")
-    node, label = layer.nodes["top"]
-    assert node.name == "/cameras/top" and label.text == "top"
+    node, label, _ = layer.nodes["top"]
+    assert node.name == "/cameras/top" and label.text == "top: none"
     np.testing.assert_allclose(node.position, [0.5, 0, 1], atol=1e-6)
     # Looking down: pitch 90 deg about y.
     half = math.sqrt(0.5)
@@ -48,5 +48,12 @@ def test_a_camera_is_drawn_as_its_frustum_and_goes_when_removed(h: Harness) -> N
     np.testing.assert_allclose(far[:, 0], 1.5, atol=1e-6)
     np.testing.assert_allclose(np.abs(far[:, 1]), 1.5 * math.tan(0.6), atol=1e-5)
     np.testing.assert_allclose(np.abs(far[:, 2]), 1.5 * math.tan(0.4), atol=1e-5)
+    assert run(h, session, "part p1 box 0.03,0.03,0.03 0.5,0,0.015,0,0,0") == "ok"
+    h.until(lambda: label.text == "top: p1", "the label naming what the camera sees")
+    assert layer.nodes["top"][0] is node  # only the label changed
+    assert run(h, session, "object lid box 0.3,0.3,0.01 0.5,0,0.5,0,0,0") == "ok"
+    h.until(lambda: label.text == "top: none", "the lid hiding p1")
+    h.call(lambda: h.world.cameras.blackout("top", math.inf))
+    h.until(lambda: layer.nodes["top"][1].text == "top: dark", "the blackout")
     assert run(h, session, "camera top remove") == "ok"
     h.until(lambda: layer.nodes == {}, "the send that removes the camera")

@@ -141,6 +141,16 @@ def test_noise_repeats_with_the_seed() -> None:
     assert all(abs(v - w) < 0.1 for v, w in zip(first[0][:3], [1, 0, 0]))
 
 
+def test_a_look_without_noise_draws_nothing() -> None:
+    part = [("p1", None, pose_se3((1.0, 0, 0, 0, 0, 0)))]
+    camera = _camera(sigma_m=0.01, sigma_rad=0.02, rng=np.random.default_rng(5))
+    exact = see(camera, part, [], 0.0, noisy=False)
+    np.testing.assert_allclose(se3_pose(exact[0].pose), [1, 0, 0, 0, 0, 0], atol=1e-12)
+    first = se3_pose(see(camera, part, [], 0.0)[0].pose)
+    again = _camera(sigma_m=0.01, sigma_rad=0.02, rng=np.random.default_rng(5))
+    assert se3_pose(see(again, part, [], 0.0)[0].pose) == first
+
+
 def test_blackout_sees_nothing_until_its_time() -> None:
     cameras = Cameras()
     cameras.put(_camera())
