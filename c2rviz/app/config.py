@@ -226,7 +226,7 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
         for name in parser.get(section, "robots", fallback="").split()
     }
     for section in parser.sections():
-        if section in ("options", "objects", "faults", "parts") or section.startswith(
+        if section in ("options", "objects", "faults", "parts", "cameras") or section.startswith(
             ("cell:", "objects:", "faults:", "parts:")
         ):
             continue

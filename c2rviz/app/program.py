@@ -30,6 +30,7 @@ from ..world.world import World
 from . import crcl_door  # noqa: F401 (its opener joins doors.OPENERS)
 from .config import Settings, replaced_bundled
 from .doors import close_doors, open_doors
+from .ini_cameras import ini_cameras, place_cameras
 from .members import Member, furnish
 from .rosbridge_door import open_rosbridge  # noqa: F401 (importing it adds it to OPENERS)
 
@@ -138,6 +139,7 @@ async def serve(
     try:
         for member in members:
             furnish(world, member)
+        place_cameras(world, services.rng, ini_cameras(settings.ini))
         _record_from_start(services, settings)
     except C2rvizError as exc:
         print(f"c2rviz: {exc}", file=sys.stderr)

@@ -1,5 +1,5 @@
 """``AsyncClient``'s methods for the scene: markers, trails, recordings, workcell objects,
-parts, goals and the score.
+parts, goals, the score and logical cameras.
 
 The one source of both clients' scene methods: ``scripts/unasync_clients.py`` writes the
 blocking ``scene_verbs.py`` from this file (edit here, then run it).
@@ -12,8 +12,10 @@ from pathlib import Path
 from typing import TypeVar
 
 from . import calls
+from . import camera_verbs as camera_calls
 from . import part_verbs as part_calls
 from .calls import Call, speaks
+from .camera_verbs import CameraInfo, Seen
 from .part_verbs import PartState, Score
 from .records import RecordingResult, RecordingStatus, TrailStatus
 
@@ -186,3 +188,42 @@ class AsyncSceneVerbs:
         """How many goals are met, and how far off the others are (mm, and degrees or
         radians as the server words it)."""
         return await self.call(part_calls.SCORE)
+
+    # Logical cameras (docs/cameras.md).
+
+    @speaks("camera")
+    async def add_camera(
+        self, name: str, pose: Sequence[float], fov: Sequence[float] | None = None
+    ) -> None:
+        """Place (or move) logical camera ``name`` at ``pose`` (x, y, z [m], roll, pitch, yaw
+        [rad, or deg], world frame; it looks along its +x axis) with ``fov`` (h_fov, v_fov
+        [rad, or deg], range [m]; default 60, 45 degrees and 2 m)."""
+        return await self.call(camera_calls.add_camera(name, pose, fov))
+
+    @speaks("camera")
+    async def camera(self, name: str) -> list[Seen]:
+        """What camera ``name`` sees now: each part's name, type and pose in the camera's
+        frame (x, y, z [m], roll, pitch, yaw [rad, or deg])."""
+        return await self.call(camera_calls.camera(name))
+
+    @speaks("camera")
+    async def remove_camera(self, name: str) -> None:
+        """Remove camera ``name``."""
+        return await self.call(camera_calls.remove_camera(name))
+
+    @speaks("camera")
+    async def camera_rate(self, name: str, hz: float) -> None:
+        """How often [Hz] camera ``name`` reports to ``watch``, rosbridge and bags."""
+        return await self.call(camera_calls.camera_rate(name, hz))
+
+    @speaks("camera")
+    async def camera_noise(self, name: str, sigma_m: float, sigma_angle: float) -> None:
+        """Noise on what camera ``name`` reports: ``sigma_m`` [m] and ``sigma_angle`` [rad,
+        or deg], drawn from the server's seed."""
+        return await self.call(camera_calls.camera_noise(name, sigma_m, sigma_angle))
+
+    @speaks("cameras")
+    async def cameras(self) -> dict[str, CameraInfo]:
+        """Every camera by name: its pose (x, y, z [m], roll, pitch, yaw [rad, or deg], world
+        frame), fields of view [rad, or deg] and range [m], and rate [Hz]."""
+        return await self.call(camera_calls.CAMERAS)

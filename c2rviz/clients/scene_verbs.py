@@ -9,8 +9,10 @@ from pathlib import Path
 from typing import TypeVar
 
 from . import calls
+from . import camera_verbs as camera_calls
 from . import part_verbs as part_calls
 from .calls import Call, speaks
+from .camera_verbs import CameraInfo, Seen
 from .part_verbs import PartState, Score
 from .records import RecordingResult, RecordingStatus, TrailStatus
 
@@ -181,3 +183,42 @@ class SceneVerbs:
         """How many goals are met, and how far off the others are (mm, and degrees or
         radians as the server words it)."""
         return self.call(part_calls.SCORE)
+
+    # Logical cameras (docs/cameras.md).
+
+    @speaks("camera")
+    def add_camera(
+        self, name: str, pose: Sequence[float], fov: Sequence[float] | None = None
+    ) -> None:
+        """Place (or move) logical camera ``name`` at ``pose`` (x, y, z [m], roll, pitch, yaw
+        [rad, or deg], world frame; it looks along its +x axis) with ``fov`` (h_fov, v_fov
+        [rad, or deg], range [m]; default 60, 45 degrees and 2 m)."""
+        return self.call(camera_calls.add_camera(name, pose, fov))
+
+    @speaks("camera")
+    def camera(self, name: str) -> list[Seen]:
+        """What camera ``name`` sees now: each part's name, type and pose in the camera's
+        frame (x, y, z [m], roll, pitch, yaw [rad, or deg])."""
+        return self.call(camera_calls.camera(name))
+
+    @speaks("camera")
+    def remove_camera(self, name: str) -> None:
+        """Remove camera ``name``."""
+        return self.call(camera_calls.remove_camera(name))
+
+    @speaks("camera")
+    def camera_rate(self, name: str, hz: float) -> None:
+        """How often [Hz] camera ``name`` reports to ``watch``, rosbridge and bags."""
+        return self.call(camera_calls.camera_rate(name, hz))
+
+    @speaks("camera")
+    def camera_noise(self, name: str, sigma_m: float, sigma_angle: float) -> None:
+        """Noise on what camera ``name`` reports: ``sigma_m`` [m] and ``sigma_angle`` [rad,
+        or deg], drawn from the server's seed."""
+        return self.call(camera_calls.camera_noise(name, sigma_m, sigma_angle))
+
+    @speaks("cameras")
+    def cameras(self) -> dict[str, CameraInfo]:
+        """Every camera by name: its pose (x, y, z [m], roll, pitch, yaw [rad, or deg], world
+        frame), fields of view [rad, or deg] and range [m], and rate [Hz]."""
+        return self.call(camera_calls.CAMERAS)

@@ -19,6 +19,9 @@ or for several robots of a cell at once:
   or changed, DELETE when removed), in the frames the page shows them in;
 - the parts (``bag_parts``): each one's frame ``parts/NAME`` on ``/tf`` as they move,
   and a marker of it (namespace ``parts``) on the first robot's marker topic;
+- each logical camera's reports (``camera_records``): ``/c2rviz/cameras/NAME``
+  (``geometry_msgs/msg/PoseArray`` in the frame ``cameras/NAME``) at its rate on the
+  world's clock, and its frames on ``/tf`` (``cameras/NAME``, ``cameras/NAME/PART``);
 - ``/c2rviz/commands``: each accepted command as ``SOURCE: LINE``, and
   ``/c2rviz/replies``: each reply as ``SOURCE: LINE -> REPLY``, from every source
   (as NAME.txt's ``# sources``); the lines of one frame (``1/hz``) are one message,
@@ -44,14 +47,17 @@ import pinocchio as pin
 
 from ..ros import markers as mk
 from ..ros.bag_writer import BagWriter
-from ..ros.messages import INT32, Msg
+from ..ros.messages import INT32, Msg, tf_message, transforms
 from ..ros.robot_bag import BagRobot
+from ..world.cameras import Camera, Seen
 from ..world.effects import Observer
 from ..world.parts import Part
 from ..world.state import MAX_MARKERS, Marker, RobotState
 from ..world.world import World
 from .bag_parts import PartFrames, part_transforms
 from .bag_topics import TextLines, marker_message, namespaces, object_message, xyz_xyzw
+from .camera_feed import CameraFeed
+from .camera_records import CAMERA_TOPIC, POSE_ARRAY, camera_items, pose_array
 
 if TYPE_CHECKING:
     from ..collision.workcell import WorkcellObject
@@ -142,6 +148,8 @@ class BagRecorder(Observer):
         self.part_frames = PartFrames(world.frame_s)
         if world.parts.parts.all():
             self.on_parts(world.parts.parts.all(), t0)
+        self.cameras = CameraFeed(world, self._camera)  # each camera's reports (camera_records)
+        self.cameras.sync(True)
 
     def _t(self) -> float:
         return max(0.0, self.world.clock.now() - self.t0)
@@ -238,6 +246,28 @@ class BagRecorder(Observer):
         if changes:
             self._markers(t_s, changes, arm)
 
+    def on_cameras(self, cameras: Sequence[Camera]) -> None:
+        if not self.closed:
+            self.cameras.sync(True)
+
+    def _camera(self, name: str, t: float, seen: Sequence[Seen]) -> None:
+        """What camera ``name`` saw at ``t``: its topic, and its frames on /tf."""
+        if self.closed or not self.arms:
+            return
+        t_s = max(0.0, t - self.t0)
+        arm = next(iter(self.arms.values()))
+        to_parent = (
+            pin.SE3.Identity() if arm.marker_frame == WORLD_FRAME else arm.state.origin.inverse()
+        )
+        camera = self.world.cameras.get(name)
+        try:
+            topic = CAMERA_TOPIC.format(name=name)
+            self.writer.write(topic, POSE_ARRAY, t_s, pose_array(t_s, name, seen))
+            items = camera_items(arm.marker_frame, to_parent, camera, seen)
+            self.writer.tf(t_s, tf_message(transforms(t_s, items)))
+        except Exception as exc:
+            self._broken(exc)
+
     def _markers(self, t_s: float, markers: list[Msg], arm: _Arm) -> None:
         try:
             self.writer.markers(t_s, mk.marker_array(markers), arm.bag.namespace)
@@ -245,6 +275,7 @@ class BagRecorder(Observer):
             self._broken(exc)
 
     def on_command(self, source: str, line: str, accepted: bool) -> None:
+        self.cameras.wake()
         if accepted and not self.closed:
             self.commands.add(f"{source}: {line}")
 
@@ -263,6 +294,7 @@ class BagRecorder(Observer):
     def _failed(self, error: str) -> None:
         self.error = self.error or error
         self.closed = True
+        self.cameras.close()
         for lines in (self.commands, self.replies):
             if lines.timer is not None:
                 lines.timer.cancel()
@@ -270,6 +302,7 @@ class BagRecorder(Observer):
 
     def stop(self) -> None:
         """Write what waits and take no more (on the asyncio thread); ``close`` ends the bag."""
+        self.cameras.close()
         pending = self.part_frames.pending
         if pending is not None and not self.closed:
             self.part_frames.last_t = None

@@ -42,10 +42,12 @@ import numpy as np
 from ..collision.workcell import WorkcellObject
 from ..protocol import replies
 from ..robot.frames import in_base, se3_pose, wxyz_se3
+from ..world.cameras import Camera
 from ..world.effects import Marker, Observer
 from ..world.faults import replay_line
 from ..world.parts import Part
 from ..world.world import World
+from .camera_records import CameraSignature, camera_changes, camera_signature
 from .record_files import RecordFiles, body_tally, cut_to_line, join_body
 from .record_parts import (
     PartSignature,
@@ -146,6 +148,8 @@ class Recorder(Observer):
             self._mark(marker)
         self._parts: PartSignature = {}
         self._workcell(world)
+        self._cameras: CameraSignature = {}
+        self.on_cameras(world.cameras.all())
         self._frame(self.state.q, self.t0)
 
     @property
@@ -214,6 +218,13 @@ class Recorder(Observer):
             self._parts = signature(parts)
         if self._csv_parts:  # a part moved (falling, carried): a frame, as if the arm did
             self.on_joints(self.robot, self.state.q, t)
+
+    def on_cameras(self, cameras: Sequence[Camera]) -> None:
+        """The cameras as commands, whenever they change (camera_records)."""
+        if not self.closed and camera_signature(cameras) != self._cameras:
+            self._catch_up(self.world.clock.now())
+            self._write(self._body, camera_changes(self._cameras, cameras))
+            self._cameras = camera_signature(cameras)
 
     def on_gripper(self, robot: str, opening: float, t: float) -> None:
         if robot == self.robot and not self.closed:

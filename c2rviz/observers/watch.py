@@ -17,6 +17,7 @@ A connection that sent ``watch [HZ]`` also receives, between its replies::
     event cleared KIND [ARGS]   it ended (``fault clear``)
     event reset              ``reset`` lifted a stop
     event dropped N          N events were dropped for a reader too slow to take them
+    camera NAME T SEEN       what camera NAME sees at T, at its rate (docs/cameras.md)
 
 A slow reader costs neither memory nor other clients: a stream keeps only the
 latest state (a reader that falls behind skips states) and at most
@@ -46,10 +47,13 @@ from typing import Protocol
 from ..errors import C2rvizError
 from ..protocol import replies
 from ..robot.frames import in_base, se3_pose, wxyz_se3
+from ..world.camera_sight import seen_text
+from ..world.cameras import Camera, Seen
 from ..world.clock import Timer
 from ..world.effects import Marker, Observer
 from ..world.state import RobotState
 from ..world.world import World
+from .camera_feed import CameraFeed
 
 __all__ = [
     "MAX_EVENTS",
@@ -242,6 +246,8 @@ class WatchHub(Observer):
         self.active: list[WatchStream] = []
         self.listeners: list[EventListener] = []
         self._seq = 0
+        self.cameras = CameraFeed(world, self._camera)
+        """The cameras' ``camera NAME T ...`` lines (``camera_feed.py``)."""
 
     @property
     def default_hz(self) -> float:
@@ -278,6 +284,7 @@ class WatchHub(Observer):
         if stream not in self.active:
             self._engage()
             self.active.append(stream)
+        self.cameras.sync(bool(self.active))
 
     def unwatch(self, session: Watcher) -> bool:
         """Stop ``session``'s stream; False if it was not watching."""
@@ -292,6 +299,7 @@ class WatchHub(Observer):
         if stream in self.active:
             self.active.remove(stream)
             self._disengage()
+            self.cameras.sync(bool(self.active))
 
     # Listeners: event texts for consumers without a socket.
 
@@ -368,3 +376,18 @@ class WatchHub(Observer):
 
     def on_part_event(self, robot: str | None, text: str) -> None:
         self.event(text)  # parts are the world's: every watcher hears of them
+
+    # The cameras' lines (camera_feed.py).
+
+    def _camera(self, name: str, t: float, seen: Sequence[Seen]) -> None:
+        seq = self.next_seq()
+        stamp = f"{t - self.origin:.6f}"
+        for stream in self.active:
+            text = seen_text(seen, stream.session.angle_scale)
+            stream.event(f"camera {name} {stamp} {text}", seq)
+
+    def on_cameras(self, cameras: Sequence[Camera]) -> None:
+        self.cameras.sync(bool(self.active))
+
+    def on_command(self, source: str, line: str, accepted: bool) -> None:
+        self.cameras.wake()

@@ -37,11 +37,14 @@ from ..errors import C2rvizError, EmergencyStop
 from ..robot.visuals import LinkGeometry, load_link_geometry
 from ..session.services import Services
 from ..session.session import Session
+from ..world.camera_sight import sight
+from ..world.cameras import Camera
 from ..world.effects import Marker, Scene
 from ..world.goals import Goal
 from ..world.parts import Part
 from ..world.world import World
 from . import adapter
+from .camera_layer import CameraLayer
 from .handle import ToolHandles
 from .instruments import Instruments
 from .markers import MarkerLayer
@@ -171,6 +174,8 @@ class ViserScene(Scene):
         self.parts = PartsLayer(server)
         self._parts: list[Part] | None = world.parts.parts.all()  # to draw at the next send
         self._goals: list[Goal] | None = world.parts.goals.all()
+        self.cameras = CameraLayer(server)
+        self._cameras: list[Camera] | None = world.cameras.all()
         self.handles = ToolHandles(server, segments, self.scheduler.request)
         self._frame_camera()
         self.page_input = PageInput(server, self.markers)
@@ -261,6 +266,8 @@ class ViserScene(Scene):
     def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
         self._objects[robot] = list(objects)
         self.instruments.on_objects(robot, objects)
+        if self.world.cameras.all():  # an object may hide a part now, or no more
+            self._cameras = self.world.cameras.all()
         self.scheduler.request()
 
     def on_refused(self, robot: str, source: str, line: str, error: C2rvizError) -> None:
@@ -286,10 +293,16 @@ class ViserScene(Scene):
 
     def on_parts(self, parts: Sequence[Part], t: float) -> None:
         self._parts = list(parts)
+        if self.world.cameras.all():  # what the cameras see may have changed
+            self._cameras = self.world.cameras.all()
         self.scheduler.request()
 
     def on_goals(self, goals: Sequence[Goal]) -> None:
         self._goals = list(goals)
+        self.scheduler.request()
+
+    def on_cameras(self, cameras: Sequence[Camera]) -> None:
+        self._cameras = list(cameras)
         self.scheduler.request()
 
     def _pick(self, robot: str, shape: str, instance: int) -> None:
@@ -426,6 +439,13 @@ class ViserScene(Scene):
             if self._goals is not None:
                 self.parts.show_goals(self._goals, self.world.parts.parts.all())
                 self._goals = None
+            if self._cameras is not None:
+                seen = {
+                    c.name: [s.name for s in sight(self.world, c.name, noisy=False)]
+                    for c in self._cameras
+                }
+                self.cameras.show(self._cameras, self.world.clock.now(), seen)
+                self._cameras = None
         for name, pairs in self._collisions.items():
             if name in self.workcells:
                 self.workcells[name].show_collisions(pairs)

@@ -23,6 +23,7 @@ if TYPE_CHECKING:
 
     from ..collision.workcell import WorkcellObject
     from ..errors import C2rvizError
+    from .cameras import Camera
     from .goals import Goal
     from .parts import Part
 
@@ -94,6 +95,9 @@ class Observer:
 
     def on_goals(self, goals: Sequence[Goal]) -> None:
         """The goals are now ``goals`` (poses in the world frame)."""
+
+    def on_cameras(self, cameras: Sequence[Camera]) -> None:
+        """The logical cameras are now ``cameras`` (poses in the world frame)."""
 
 
 class Scene(Observer):

@@ -166,6 +166,17 @@ class VirtualClock(Clock):
             self.poke()
         return timer
 
+    def next_timer(self, ignore: Callable[..., Any] | None = None) -> float | None:
+        """When the earliest timer not cancelled (and not of ``ignore``) is due [s], or None:
+        for a periodic job that should not be the only thing moving time (the cameras'
+        ``watch`` lines)."""
+        live = [
+            when
+            for when, _, timer in self._heap
+            if not timer.cancelled and (ignore is None or timer.fn != ignore)
+        ]
+        return min(live) if live else None
+
     # Holds.
 
     def hold(self) -> Hold:

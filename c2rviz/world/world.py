@@ -22,6 +22,7 @@ from ..errors import C2rvizError, UnknownRobot
 from ..motion.planner import MotionLimits, motion_limits
 from ..robot.frames import se3_wxyz
 from ..robot.model import Robot
+from .cameras import Cameras
 from .clock import Clock
 from .effects import Observer
 from .fault_rules import FaultRules
@@ -94,6 +95,8 @@ class World:
         self.parts = WorldParts(self.robots, self.contacts, self.clock, self.frame_s, self._tell)
         """The parts: grasped, carried, released (``part_world.py``)."""
         self.contacts.furnish = self.parts.furnish
+        self.cameras = Cameras(lambda cameras: self._tell("on_cameras", cameras))
+        """The logical cameras (``cameras.py``; what one sees: ``camera_sight.py``)."""
 
     def state(self, name: str | None = None) -> RobotState:
         """The robot called ``name`` (the default robot for None)."""

@@ -84,3 +84,22 @@ def test_the_async_client_places_parts(c2rviz_server):
     found, score = asyncio.run(main())
     assert list(found) == ["a"] and found["a"].pose[:3] == pytest.approx((0.4, 0.1, 0.025))
     assert score == Score(1, 1, ())
+
+
+@pytest.mark.c2rviz(clock="virtual")
+def test_the_client_places_cameras_and_reads_what_they_see(c2rviz):
+    c2rviz.degrees()
+    c2rviz.add_part("p1", "box", (0.04, 0.04, 0.04), (1, 0, 0.02, 0, 0, 0), kind="battery")
+    c2rviz.add_camera("top", (1, 0, 1.5, 0, 90, 0))
+    seen = c2rviz.camera("top")
+    assert [(s.name, s.type) for s in seen] == [("p1", "battery")]
+    assert seen[0].pose[:3] == pytest.approx((1.48, 0, 0))
+    c2rviz.add_camera("side", (1, -1, 0.02, 0, 0, 90), (60, 45, 2))
+    c2rviz.camera_rate("top", 2)
+    c2rviz.camera_noise("top", 0.001, 0.1)
+    listed = c2rviz.cameras()
+    assert listed["top"].rate == 2 and listed["side"].fov == (60, 45, 2)
+    with pytest.raises(CommandError):
+        c2rviz.add_camera("bad", (0, 0, 1, 0, 0, 0), (0, 45, 2))
+    c2rviz.remove_camera("side")
+    assert list(c2rviz.cameras()) == ["top"]

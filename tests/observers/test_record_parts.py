@@ -113,3 +113,53 @@ def test_the_bag_has_each_part_as_a_tf_frame_and_a_marker(tmp_path: Path) -> Non
     heights = [where[2] for _, where in frames["parts/p1"]]
     assert max(heights) > 0.4 and len(heights) > 20  # carried up, falling: frame by frame
     assert marked.count(("parts", 0)) == 3 and marked.count(("parts", 2)) == 1  # p2 deleted
+
+
+def test_a_recording_replays_its_cameras_and_the_bag_keeps_their_reports(tmp_path: Path) -> None:
+    from rosbags.highlevel import AnyReader
+
+    server = _server(tmp_path)
+    client = Client(server.host, server.port)
+    try:
+        for line in SETUP:
+            assert client.ask(line).startswith("ok"), line
+        assert client.ask("camera top 0.45,0,1.2,0,1.5707963267948966,0") == "ok"
+        assert client.ask("record take").startswith("ok recording take")
+        assert client.ask("camera top rate 4") == "ok"
+        assert client.ask("camera side 0.45,-1,0.2,0,0,1.5707963267948966 1,1,3") == "ok"
+        assert client.ask("sleep 1") == "ok"
+        assert client.ask("camera side remove") == "ok"
+        seen = client.ask("camera top")
+        assert seen.startswith("ok p1:block:")
+        assert client.ask("record stop").startswith("ok")
+    finally:
+        client.close()
+        server.stop()
+    text = (tmp_path / "take.txt").read_text()
+    assert "camera top 0.45,0.0,1.2,0.0,1.5707963267948966,0.0 " in text
+    assert "camera top rate 4.0" in text and "camera side remove" in text
+    reports: dict[str, list[tuple[float, int]]] = {}
+    with AnyReader([tmp_path / "take"]) as reader:
+        for conn, _, raw in reader.messages():
+            if conn.topic.startswith("/c2rviz/cameras/"):
+                message = reader.deserialize(raw, conn.msgtype)
+                assert conn.msgtype == "geometry_msgs/msg/PoseArray"
+                assert message.header.frame_id == "cameras/" + conn.topic.rsplit("/", 1)[1]
+                stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+                reports.setdefault(conn.topic, []).append((round(stamp, 6), len(message.poses)))
+    top = reports["/c2rviz/cameras/top"]
+    assert [t for t, _ in top[:5]] == [0.0, 0.0, 0.25, 0.5, 0.75]  # at 10 Hz, then at 4
+    assert all(n == 2 for _, n in top)  # p1 and p2 on the table below
+    assert reports["/c2rviz/cameras/side"][0][0] == 0.0
+    (tmp_path / "replay").mkdir()
+    second = _server(tmp_path / "replay")
+    try:
+        assert player.main([str(tmp_path / "take.txt"), "--port", str(second.port)]) == 0
+        replayed = Client(second.host, second.port)
+        try:
+            assert replayed.ask("cameras").startswith("ok top:0.45,0,1.2,0,1.570796327,0:")
+            assert replayed.ask("camera top") == seen
+        finally:
+            replayed.close()
+    finally:
+        second.stop()

@@ -13,6 +13,7 @@ from support import ROOT
 
 from c2rviz.errors import BadArguments, LineError, UnknownCommand
 from c2rviz.protocol.grammar import ForeignProtocol, parse_line
+from c2rviz.protocol.verbs.cameras import CameraEdit, CamerasQuery
 from c2rviz.protocol.verbs.cartesian import Ik, LinearSpeed, MoveL, MoveTo, Tool
 from c2rviz.protocol.verbs.cell import RobotChoice, RobotsList
 from c2rviz.protocol.verbs.connection import Bye, Quit, Sleep
@@ -185,6 +186,17 @@ GOOD = [
     ),
     ("goal all remove", GoalEdit("all", True), "goal-all-remove"),
     ("score", Score(), "score"),
+    ("camera top 0,0,1,0,90,0", CameraEdit("top", "place", (0, 0, 1, 0, 90, 0)), "camera"),
+    (
+        "camera top 0,0,1,0,90,0 60,45,2",
+        CameraEdit("top", "place", (0, 0, 1, 0, 90, 0), (60.0, 45.0, 2.0)),
+        "camera-view",
+    ),
+    ("camera top", CameraEdit("top", "look"), "camera-look"),
+    ("camera top remove", CameraEdit("top", "remove"), "camera-remove"),
+    ("camera top rate 5", CameraEdit("top", "rate", values=(5.0,)), "camera-rate"),
+    ("camera top noise 0.01,1", CameraEdit("top", "noise", values=(0.01, 1.0)), "camera-noise"),
+    ("cameras", CamerasQuery(), "cameras"),
 ]
 
 

@@ -10,10 +10,12 @@ from . import cartesian, cell, motion, observe, record, workcell
 from . import planning
 from . import gripper
 from . import parts
+from . import cameras
 from . import faults
 # isort: on
 
 __all__ = [
+    "cameras",
     "cartesian",
     "cell",
     "connection",

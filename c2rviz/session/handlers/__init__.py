@@ -6,6 +6,7 @@ Importing this package registers every handler in ``registry.HANDLERS`` (the
 """
 
 from . import (
+    cameras,
     cartesian,
     cell,
     connection,
@@ -23,6 +24,7 @@ from . import (
 )
 
 __all__ = [
+    "cameras",
     "cartesian",
     "cell",
     "connection",

@@ -28,6 +28,7 @@ DEFINITIONS: dict[str, str] = {
     "geometry_msgs/Point": _XYZ,
     "geometry_msgs/Quaternion": "float64 x 0\nfloat64 y 0\nfloat64 z 0\nfloat64 w 1\n",
     "geometry_msgs/Pose": "geometry_msgs/Point position\ngeometry_msgs/Quaternion orientation\n",
+    "geometry_msgs/PoseArray": "std_msgs/Header header\ngeometry_msgs/Pose[] poses\n",
     "geometry_msgs/Transform": (
         "geometry_msgs/Vector3 translation\ngeometry_msgs/Quaternion rotation\n"
     ),

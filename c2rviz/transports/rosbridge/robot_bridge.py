@@ -14,6 +14,7 @@ topic                              type                                 when
 ``[NS]/visualization_marker_array`` ``visualization_msgs/msg/MarkerArray`` markers, objects
 ``[NS]/c2rviz/reply``              ``std_msgs/msg/String``              each command's reply
 ``/diagnostics``                   ``diagnostic_msgs/msg/DiagnosticArray`` faults change
+``/c2rviz/cameras/NAME``           ``geometry_msgs/msg/PoseArray``      at the camera's rate
 =================================  ===================================  ===============
 
 What it takes: ``[NS]/c2rviz/command`` (``std_msgs/msg/String``, one line of
@@ -32,16 +33,19 @@ from collections.abc import Callable, Mapping, Sequence
 from functools import partial
 from typing import Any
 
+import pinocchio as pin
+
 from ...errors import C2rvizError
 from ...ros.messages import string
 from ...session.services import Services
+from .camera_topics import CameraTopics
 from .command_lines import CommandLines
 from .diagnostics import DIAGNOSTIC_ARRAY, DIAGNOSTICS_TOPIC
 from .joint_inputs import joint_command, joint_trajectory
 from .messages import COMMAND_SERVICE_TYPE, command_request, command_response, string_data
 from .messages import joint_positions as read_joint_positions
 from .messages import joint_trajectory as read_joint_trajectory
-from .robot_topics import TF_MESSAGE, RobotTopics, namespaces
+from .robot_topics import TF_MESSAGE, WORLD_FRAME, RobotTopics, namespaces
 from .topic_hub import TopicHub
 from .world_feed import TF_STATIC_TOPIC, TF_TOPIC, WorldFeed
 
@@ -100,12 +104,19 @@ class RobotBridge:
                 self._params[f"{topics.namespace}/robot_description"] = topics.robot.source.xml
         self._clients = 0
         world.add_observers([self.feed])
+        frame = first.marker_frame  # the cameras hang where the parts do (world_feed._tf)
+        to_frame = pin.SE3.Identity() if frame == WORLD_FRAME else world.state(names[0]).origin
+        self.cameras = CameraTopics(world, self.hub, frame, to_frame.inverse(), TF_TOPIC)
+        world.add_observers([self.cameras])
 
     def close(self) -> None:
         """The door stops: no more messages, every session dropped."""
         if self.feed in self.world.observers:
             self.world.remove_observer(self.feed)
         self.feed.close()
+        if self.cameras in self.world.observers:
+            self.world.remove_observer(self.cameras)
+        self.cameras.close()
         for source in {source for source, _ in self.lines.queues}:
             self.lines.closed(source)
         self._clients = 0
@@ -114,7 +125,7 @@ class RobotBridge:
     # What there is.
 
     def topics(self) -> Sequence[tuple[str, str]]:
-        return self._types
+        return [*self._types, *self.cameras.published()]
 
     def services(self) -> Sequence[tuple[str, str]]:
         return [(name, COMMAND_SERVICE_TYPE) for name in self._services]

@@ -1,0 +1,114 @@
+"""The logical cameras an ini puts in the world: ``[cameras]``, one per line, in the world
+frame (metres, degrees)::
+
+    [cameras]
+    top = 0.45,0,1.2,0,90,0                        # pose: looking straight down
+    side = 0.45,-1,0.3,0,0,90  50,40,2.5  rate=5  noise=0.002,0.5
+
+The pose, then optionally h_fov,v_fov (deg),range (m), ``rate=HZ`` and
+``noise=SIGMA_M,SIGMA_DEG``: the ``camera`` verb's words (docs/cameras.md), each checked
+again when the camera is placed (a bad one is an error that names it).
+"""
+
+from __future__ import annotations
+
+import configparser
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from ..errors import C2rvizError, ConfigError
+from ..world.cameras import DEFAULT_FOV_RAD, DEFAULT_RANGE_M, MAX_RATE_HZ, Camera
+from ..world.world import World
+from .robot_options import pose_from
+
+__all__ = ["IniCamera", "ini_cameras", "place_cameras"]
+
+
+@dataclass(frozen=True)
+class IniCamera:
+    """One ``[cameras]`` line: angles in radians, as a ``Camera`` takes them."""
+
+    name: str
+    pose: pin.SE3
+    h_fov_rad: float = DEFAULT_FOV_RAD[0]
+    v_fov_rad: float = DEFAULT_FOV_RAD[1]
+    range_m: float = DEFAULT_RANGE_M
+    rate_hz: float | None = None
+    noise: tuple[float, float] | None = None  # sigma [m], sigma [rad]
+
+
+def ini_cameras(ini: Path | None) -> list[IniCamera]:
+    """The cameras of the ini's ``[cameras]`` (none without an ini or the section)."""
+    if ini is None:
+        return []
+    parser = configparser.ConfigParser(interpolation=None, inline_comment_prefixes=("#", ";"))
+    parser.read(ini, encoding="utf-8")
+    if not parser.has_section("cameras"):
+        return []
+    found = []
+    for name, text in parser.items("cameras"):
+        where = f"[cameras] {name}"
+        words = text.split()
+        if not words:
+            raise ConfigError(f"{where} needs a pose x,y,z,roll,pitch,yaw (m, deg)")
+        view: list[float] = [*map(math.degrees, DEFAULT_FOV_RAD), DEFAULT_RANGE_M]
+        rate: float | None = None
+        noise: tuple[float, float] | None = None
+        for word in words[1:]:
+            key, _, value = word.partition("=")
+            if not value:
+                view = _numbers(where, word, 3)
+            elif key == "rate":
+                (rate,) = _numbers(where, value, 1)
+                if not 0.0 <= rate <= MAX_RATE_HZ:
+                    raise ConfigError(f"{where}: rate {rate:g} is outside 0..{MAX_RATE_HZ:g} Hz")
+            elif key == "noise":
+                sigma_m, sigma_deg = _numbers(where, value, 2)
+                if not (0.0 <= sigma_m <= 1.0 and 0.0 <= sigma_deg <= 180.0):
+                    raise ConfigError(f"{where}: noise takes 0..1 m, 0..180 deg")
+                noise = (sigma_m, math.radians(sigma_deg))
+            else:
+                raise ConfigError(
+                    f"{where}: {word!r} is not h_fov,v_fov,range or rate=HZ or noise=M,DEG"
+                )
+        found.append(
+            IniCamera(
+                name,
+                pose_from(where, words[0]),
+                math.radians(view[0]),
+                math.radians(view[1]),
+                view[2],
+                rate,
+                noise,
+            )
+        )
+    return found
+
+
+def place_cameras(world: World, rng: np.random.Generator, cameras: list[IniCamera]) -> None:
+    """Put the ini's cameras in the world (a bad one raises ``ConfigError``)."""
+    for entry in cameras:
+        try:
+            camera = Camera(entry.name, entry.pose, entry.h_fov_rad, entry.v_fov_rad, entry.range_m)
+            if entry.rate_hz is not None:
+                camera.rate_hz = entry.rate_hz
+            if entry.noise is not None:
+                camera.sigma_m, camera.sigma_rad = entry.noise
+                camera.rng = np.random.default_rng(int(rng.integers(0, 2**63)))
+            world.cameras.put(camera)
+        except C2rvizError as exc:
+            raise ConfigError(f"[cameras] {entry.name}: {exc}") from None
+
+
+def _numbers(where: str, text: str, needed: int) -> list[float]:
+    try:
+        values = [float(part) for part in text.split(",")]
+    except ValueError:
+        raise ConfigError(f"{where}: {text!r} is not a comma-separated list of numbers") from None
+    if not all(map(math.isfinite, values)) or len(values) != needed:
+        raise ConfigError(f"{where}: {text!r} must be {needed} finite numbers")
+    return values
