@@ -94,6 +94,7 @@ class World:
         self.parts = WorldParts(self.robots, self.contacts, self.clock, self.frame_s, self._tell)
         """The parts: grasped, carried, released (``part_world.py``)."""
         self.contacts.furnish = self.parts.furnish
+        self.faults.parts, self.parts.slips = self.parts, self.faults.slips  # drop, slip
 
     def state(self, name: str | None = None) -> RobotState:
         """The robot called ``name`` (the default robot for None)."""
