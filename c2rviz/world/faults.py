@@ -32,6 +32,7 @@ from ..protocol.verbs.faults import FaultSpec
 
 __all__ = [
     "to_fault",
+    "at_once",
     "INSTANT",
     "MAX_SCHEDULED",
     "replay_line",
@@ -298,6 +299,14 @@ def replay_line(text: str) -> str | None:
     if words[0] == "cleared" and len(words) > 1:
         return f"fault clear {words[1]}"
     return text if words[0] in ("fault", "reset") else None
+
+
+def at_once(line: str) -> bool:
+    """A recording writes this fault line (``replay_line``'s) at its time even while the arm
+    moves: it refuses no frame of the replay (``fault drop``: the replay drops the part
+    where the run did). Other lines wait for the arm to rest."""
+    words = line.split()
+    return len(words) > 1 and words[0] == "fault" and words[1] == "drop"
 
 
 def to_fault(
