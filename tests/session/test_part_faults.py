@@ -1,6 +1,6 @@
 """The part faults through the real server, on virtual time: ``fault drop [PART]`` (now,
 and scheduled mid-carry), ``fault slip P`` (1 always, 0 never, 0.5 the same with the same
-seed), through the text port and CRCL alike, and bad input refused with nothing changed.
+seed), a parallel gripper and a vacuum cup alike, and bad input refused with nothing changed.
 
 The scene is tests/session/test_part_verbs.py's: the bundled fanuc pointing down at a
 tall part standing on a table, the jaws around it.
@@ -213,3 +213,39 @@ def test_bad_part_faults_are_refused_and_change_nothing(fanuc, line, problem):
         "[ARGS] | clear [KIND|all])"
     )
     assert client.ask("faults") == "ok none"
+
+
+@pytest.fixture
+def vacuum():
+    from support import ROBOTS, ROOT, ServerLimits, ServerThread
+
+    from c2rviz.robot.model import Robot
+    from c2rviz.world.grasp import make_vacuum
+    from c2rviz.world.virtual_clock import VirtualClock
+
+    path, base, eelink = ROBOTS["motoman_sia20d"]
+    robot = Robot.from_urdf(ROOT / path, base, eelink)  # its own: the cached one stays bare
+    robot.gripper = make_vacuum(robot.eelink)
+    server = ServerThread(robot, ServerLimits(), clock=VirtualClock()).start()
+    client = Client(server.host, server.port)
+    try:
+        yield server, client
+    finally:
+        client.close()
+        server.stop()
+
+
+def test_a_vacuum_grasp_slips_and_a_sucked_part_drops(vacuum):
+    _, client = vacuum
+    x, y, z = [float(v) for v in client.ask("pose")[3:].split(",")[:3]]
+    assert client.ask(f"part b sphere 0.02 {x},{y},{z - 0.02}") == "ok"
+    assert client.ask("fault slip 1") == "ok"
+    assert client.ask("grip 0") == "ok"  # not `ok held`: suction on, nothing taken
+    assert client.ask("part b").endswith(" free")  # where it was put, under the cup
+    assert client.ask("grip 1") == "ok"
+    assert client.ask("fault clear slip") == "ok"
+    assert client.ask("grip 0") == "ok held"
+    assert client.ask("fault drop b") == "ok"
+    assert client.ask("part b").endswith(" free")  # falling
+    assert client.ask("sleep 3") == "ok"
+    assert client.ask("part b").endswith(" resting on floor")
