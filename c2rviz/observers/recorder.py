@@ -44,7 +44,7 @@ from ..protocol import replies
 from ..robot.frames import in_base, se3_pose, wxyz_se3
 from ..world.cameras import Camera
 from ..world.effects import Marker, Observer
-from ..world.faults import replay_line
+from ..world.faults import at_once, replay_line
 from ..world.parts import Part
 from ..world.world import World
 from .camera_records import CameraSignature, camera_changes, camera_signature
@@ -187,12 +187,13 @@ class Recorder(Observer):
 
     def on_fault(self, robot: str, text: str) -> None:
         """A fault's line goes after the frames it caused: at once, or (a protective stop
-        braking) once the arm rests, so a replay never refuses its own frames."""
+        braking) once the arm rests, so a replay never refuses its own frames; a drop at
+        once, mid-move too, so the replay drops the part where the run did."""
         line = replay_line(text)
         if robot != self.robot or self.closed or line is None:
             return
         self._faults.append(line)
-        if not self.world.moving(robot):
+        if not self.world.moving(robot) or (self._faults == [line] and at_once(line)):
             self._write_faults()
 
     def _write_faults(self) -> None:

@@ -6,7 +6,9 @@ alike: a move from any door reaches ``World.set_q`` or ``Travels.go``/``play``, 
 ``arrival_error``. What a door reports of the joints passes through ``sensed``, and a
 session's replies through ``delayed``. A fault that begins, ends or is lifted is told
 to every observer (``Observer.on_fault``: ``watch`` streams, rosbridge's
-``/diagnostics``, the page) and listener (the TCP door, for ``disconnect``).
+``/diagnostics``, the page) and listener (the TCP door, for ``disconnect``). A ``drop``
+releases what the robot holds through the world's parts (``WorldParts.release``), and
+the parts ask ``slips`` before each grasp the rule would make.
 
 Scheduled faults are timers on the world's clock, so virtual time runs them exactly.
 """
@@ -16,15 +18,20 @@ from __future__ import annotations
 import asyncio
 import itertools
 from collections.abc import Awaitable, Callable, Mapping
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..errors import C2rvizError
+from ..errors import BadArguments, C2rvizError, shown
+from ..protocol.registry import usage
 from .clock import Clock, Timer
 from .faults import Fault, RobotFaults, Scheduled
 from .move_rules import MoveRules
 from .moves import Travels
 from .state import RobotState
+
+if TYPE_CHECKING:
+    from .part_world import WorldParts
 
 __all__ = ["FaultRules"]
 
@@ -64,6 +71,8 @@ class FaultRules(MoveRules):
         self.listeners: list[Callable[[str, str], None]] = []
         """Called as observers are (``listener(robot, text)``), by what is no observer: the
         TCP door, which closes a robot's clients on ``fault disconnect``."""
+        self.parts: WorldParts | None = None
+        """The world's parts, which ``fault drop`` releases (the world sets it)."""
 
     def bind(self, rng: np.random.Generator, origin: float) -> None:
         """Draw from ``rng`` and count times from ``origin`` [s] from now on."""
@@ -103,6 +112,11 @@ class FaultRules(MoveRules):
         faults = self.robots[robot]
         return faults.sensed(q, self.rng) if faults.active else q
 
+    def slips(self, robot: str) -> bool:
+        """A grasp by ``robot`` that the rule would make fails now (``slip P``: a draw)."""
+        faults = self.robots[robot]
+        return faults.slips(self.rng) if faults.active else False
+
     def delayed(self, robot: str, reply: str | Awaitable[str]) -> str | Awaitable[str]:
         """``reply`` to a client of ``robot``, late by its latency fault (if on)."""
         delay = self.robots[robot].delay_s(self.rng)
@@ -117,8 +131,15 @@ class FaultRules(MoveRules):
 
     # What the verbs do.
 
-    def start(self, robot: str, fault: Fault) -> None:
-        """``fault`` begins on ``robot`` now."""
+    def start(self, robot: str, fault: Fault, *, strict: bool = True) -> None:
+        """``fault`` begins on ``robot`` now.
+
+        Raises:
+            BadArguments: with ``strict`` (a client's ``fault``, not a scheduled one coming
+                due), ``drop PART`` of a part the robot does not hold; nothing changes.
+        """
+        if fault.kind == "drop" and fault.word and strict:
+            self._held(robot, fault.word)
         state = self.states[robot]
         travels = self.travels
         faults = self.robots[robot]
@@ -131,6 +152,11 @@ class FaultRules(MoveRules):
             travels.resync(state)
         elif fault.kind == "disconnect":  # after this reply is written
             self.clock.call_later(0.0, self._tell, robot, events)
+            return
+        elif fault.kind == "drop":  # the event first, then what it released
+            self._tell(robot, events)
+            if self.parts is not None:
+                self.parts.release(robot, fault.word or None)
             return
         self.late = any("latency" in f.active for f in self.robots.values())
         self._tell(robot, events)
@@ -183,8 +209,17 @@ class FaultRules(MoveRules):
     def _fire(self, robot: str) -> None:
         self._timers.pop(robot, None)
         for entry in self.robots[robot].due_now(self.clock.now()):
-            self.start(robot, entry.fault)
+            self.start(robot, entry.fault, strict=False)
         self._arm(robot)
+
+    def _held(self, robot: str, name: str) -> None:
+        """Raise unless ``robot`` holds the part ``name``."""
+        held = [p.name for p in self.parts.parts.held_by(robot)] if self.parts else []
+        if name not in held:
+            holds = ", ".join(held) if held else "nothing"
+            raise BadArguments(
+                "fault", f"{robot} does not hold {shown(name)} (it holds {holds})", usage("fault")
+            )
 
     def _tell(self, robot: str, events: list[str]) -> None:
         for text in events:

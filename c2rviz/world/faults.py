@@ -14,6 +14,9 @@ The rules, one per kind (docs/faults.md):
 - ``noise SIGMA``: reported values get Gaussian noise of SIGMA (``sensed``).
 - ``latency MS,JITTER``: replies come ``MS + U(0, JITTER)`` late (``delay_s``).
 - ``disconnect``: happens once (nothing to keep).
+- ``drop [PART]``: happens once: the gripper lets go of what it holds (``fault_rules``
+  releases it by the parts' release rule).
+- ``slip P``: a grasp the rule would make fails with chance P (``slips``).
 """
 
 from __future__ import annotations
@@ -29,6 +32,8 @@ from ..protocol.verbs.faults import FaultSpec
 
 __all__ = [
     "to_fault",
+    "at_once",
+    "INSTANT",
     "MAX_SCHEDULED",
     "replay_line",
     "STALL_TOLERANCE",
@@ -40,6 +45,8 @@ __all__ = [
 
 MAX_SCHEDULED = 100
 """Faults scheduled at once per robot (``fault at``/``after``); past it one is refused."""
+INSTANT = frozenset({"disconnect", "drop"})
+"""Kinds that happen once when they begin: nothing is kept (``FaultKind.lasting``)."""
 STALL_TOLERANCE = 1e-6
 """A target this close to a stalled joint's value [rad or m] does not need it to move."""
 
@@ -64,8 +71,8 @@ class Fault:
         sigma: ``noise``: the standard deviation [rad, or m for a prismatic joint].
         delay_s: ``latency``: the base delay [s].
         jitter_s: ``latency``: the most added at random [s].
-        word: A kind's word argument as given (a part's, a camera's name: kinds to come).
-        values: A kind's numbers, SI (kinds to come).
+        word: A kind's word argument as given (``drop``'s part; a camera's name).
+        values: A kind's numbers, SI (``slip``'s chance).
     """
 
     kind: str
@@ -149,7 +156,7 @@ class RobotFaults:
     def start(self, fault: Fault, t: float, q: tuple[float, ...]) -> list[str]:
         """``fault`` begins at clock time ``t`` [s], the arm at ``q`` [rad or m]."""
         events = [f"fault {fault.text(self.joint_names)}"]
-        if fault.kind == "disconnect":
+        if fault.kind in INSTANT:
             return events
         if fault.key not in self.active:
             self.active[fault.key] = (fault, t)
@@ -254,6 +261,14 @@ class RobotFaults:
         noise = rng.normal(0.0, entry[0].sigma, len(q))
         return tuple(float(v) for v in np.asarray(q, dtype=float) + noise)
 
+    def slips(self, rng: np.random.Generator) -> bool:
+        """A grasp the rule would make fails now (a ``slip P`` fault: one draw, true with
+        chance P; no draw without the fault)."""
+        entry = self.active.get("slip")
+        if entry is None:
+            return False
+        return float(rng.random()) < entry[0].values[0]
+
     def delay_s(self, rng: np.random.Generator) -> float:
         """How late the next reply comes [s] (0: latency is off)."""
         entry = self.active.get("latency")
@@ -284,6 +299,14 @@ def replay_line(text: str) -> str | None:
     if words[0] == "cleared" and len(words) > 1:
         return f"fault clear {words[1]}"
     return text if words[0] in ("fault", "reset") else None
+
+
+def at_once(line: str) -> bool:
+    """A recording writes this fault line (``replay_line``'s) at its time even while the arm
+    moves: it refuses no frame of the replay (``fault drop``: the replay drops the part
+    where the run did). Other lines wait for the arm to rest."""
+    words = line.split()
+    return len(words) > 1 and words[0] == "fault" and words[1] == "drop"
 
 
 def to_fault(

@@ -79,6 +79,9 @@ class WorldParts:
         self._data: dict[str, pin.Data] = {}  # each robot's, for the parts it carries
         self.falls = Falls(clock, frame_s, self._rest, lambda done: self.changed(models=done))
         self.goals = GoalBook()
+        self.slips: Callable[[str], bool] = lambda robot: False
+        """``slips(robot)``: a grasp the rule would make fails now (``fault slip``; the
+        world sets it to its faults')."""
 
     # --- goals ------------------------------------------------------------------------
 
@@ -168,7 +171,7 @@ class WorldParts:
             return target, None
         candidates = [p for p in self.parts.all() if p.holder != robot]
         part = take(found, gripper, target, candidates)
-        if part is None:
+        if part is None or self._slipped(robot, part):
             return target, None
         half = extent(part.obj.shape, part.obj.size, part.pose.rotation, found.axis)
         along = float((part.pose.translation - found.centre) @ found.axis)
@@ -184,9 +187,17 @@ class WorldParts:
             return None
         cup = state.base * state.robot.ee_pose(state.q) * state.tool
         part = at_cup(cup, [p for p in self.parts.all() if p.holder != robot])
-        if part is not None:
-            self.hold(robot, part, state.robot.eelink)
+        if part is None or self._slipped(robot, part):
+            return None
+        self.hold(robot, part, state.robot.eelink)
         return part
+
+    def _slipped(self, robot: str, part: Part) -> bool:
+        """The grasp of ``part`` fails (``fault slip``): say so, take nothing."""
+        if not self.slips(robot):
+            return False
+        self.tell("on_part_event", robot, f"slipped {part.name}")
+        return True
 
     def hold(self, robot: str, part: Part, link: str) -> None:
         """Fix ``part`` to ``robot``'s ``link`` where it is (taking it from whoever had it)."""
@@ -202,9 +213,10 @@ class WorldParts:
         self._unsupport(part.name)
         self.changed()
 
-    def release(self, robot: str) -> list[Part]:
-        """Robot ``robot`` lets go of what it holds: each part rests or falls."""
-        let_go = self.parts.held_by(robot)
+    def release(self, robot: str, only: str | None = None) -> list[Part]:
+        """Robot ``robot`` lets go of what it holds (``only``: of that part, if it holds
+        it): each part rests or falls."""
+        let_go = [p for p in self.parts.held_by(robot) if only is None or p.name == only]
         for part in let_go:
             part.holder = part.link = None
             self.tell("on_part_event", robot, f"released {part.name}")

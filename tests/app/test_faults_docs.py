@@ -9,6 +9,8 @@ from test_docs_transcripts import Step, same, transcripts
 
 from c2rviz.testing.server import TestServer
 
+PARTS_ROBOT = "fanuc_lrmate200id"
+"""The robot of a session with parts (docs/parts.md's: its parallel gripper)."""
 BLOCKS = transcripts(ROOT / "docs" / "faults.md")
 
 
@@ -18,7 +20,10 @@ def test_the_page_holds_sessions():
 
 @pytest.mark.parametrize("steps", BLOCKS, ids=[f"faults.md-{k}" for k in range(len(BLOCKS))])
 def test_a_documented_fault_session_replies_as_shown(steps: list[Step]):
-    server = TestServer({"clock": "virtual", "record": False}).start()
+    options: dict[str, object] = {"clock": "virtual", "record": False}
+    if any(step.command.startswith("part ") for step in steps):
+        options["robot"] = PARTS_ROBOT  # the part faults' sessions: a robot with a gripper
+    server = TestServer(options).start()
     try:
         client = Client(server.host, server.port)
         try:

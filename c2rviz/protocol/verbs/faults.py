@@ -44,8 +44,8 @@ class FaultSpec:
 
     Attributes:
         kind: A name of ``FAULT_KINDS``.
-        word: A word argument: ``stall``'s joint (its name or index).
-        values: Numbers: ``noise``'s SIGMA; ``latency``'s MS and JITTER [ms].
+        word: A word argument: ``stall``'s joint (its name or index); ``drop``'s part.
+        values: Numbers: ``noise``'s SIGMA; ``latency``'s MS and JITTER [ms]; ``slip``'s P.
     """
 
     kind: str
@@ -119,6 +119,21 @@ def _latency(words: list[str]) -> FaultSpec:
     return FaultSpec("latency", values=(values[0], values[1] if len(values) == 2 else 0.0))
 
 
+def _drop(words: list[str]) -> FaultSpec:
+    if len(words) > 1:
+        raise _bad("drop takes at most one PART")
+    return FaultSpec("drop", words[0] if words else "")
+
+
+def _slip(words: list[str]) -> FaultSpec:
+    values = numbers("fault", words[0]) if len(words) == 1 else ()
+    if len(values) != 1:
+        raise _bad("slip needs one P (a chance per grasp, 0..1)")
+    if not 0.0 <= values[0] <= 1.0:
+        raise _bad(f"slip P {values[0]:g} is outside 0..1 (a chance per grasp)")
+    return FaultSpec("slip", values=values)
+
+
 FAULT_KINDS: dict[str, FaultKind] = {
     kind.name: kind
     for kind in (
@@ -163,6 +178,21 @@ FAULT_KINDS: dict[str, FaultKind] = {
             _none("disconnect"),
             lasting=False,
         ),
+        FaultKind(
+            "drop",
+            "[PART]",
+            "the gripper lets go of what it holds now (only PART, which it must hold); it "
+            "rests or falls as if the fingers opened",
+            _drop,
+            lasting=False,
+        ),
+        FaultKind(
+            "slip",
+            "P",
+            "each grasp the rule would make fails with chance P (0..1, drawn from the seed): "
+            "the fingers close on nothing",
+            _slip,
+        ),
     )
 }
 """Every kind of fault, by name, in the order docs and errors list them."""
@@ -193,7 +223,8 @@ def _time(word: str, what: str) -> float:
     "[at T|after S] KIND [ARGS] | clear [KIND|all]",
     "make a fault happen on this connection's robot, now, at world time T [s] or S [s] "
     "from now: `estop`, `protective`, `stall JOINT`, `noise SIGMA`, `latency MS[,JITTER]`, "
-    "`disconnect` (docs/faults.md); `clear` ends one kind (or all, scheduled ones too)",
+    "`disconnect`, `drop [PART]`, `slip P` (docs/faults.md); `clear` ends one kind (or all, "
+    "scheduled ones too)",
 )
 @dataclass(frozen=True, slots=True)
 class FaultVerb:
