@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import asyncio
 import itertools
+import math
 from collections.abc import Awaitable, Callable, Mapping
 from typing import TYPE_CHECKING
 
@@ -31,6 +32,7 @@ from .moves import Travels
 from .state import RobotState
 
 if TYPE_CHECKING:
+    from .cameras import Cameras
     from .part_world import WorldParts
 
 __all__ = ["FaultRules"]
@@ -73,6 +75,8 @@ class FaultRules(MoveRules):
         TCP door, which closes a robot's clients on ``fault disconnect``."""
         self.parts: WorldParts | None = None
         """The world's parts, which ``fault drop`` releases (the world sets it)."""
+        self.cameras: Cameras | None = None
+        """The world's cameras, which ``fault blackout`` darkens (the world sets it)."""
 
     def bind(self, rng: np.random.Generator, origin: float) -> None:
         """Draw from ``rng`` and count times from ``origin`` [s] from now on."""
@@ -140,6 +144,9 @@ class FaultRules(MoveRules):
         """
         if fault.kind == "drop" and fault.word and strict:
             self._held(robot, fault.word)
+        if fault.kind == "blackout":
+            self._blackout(robot, fault, strict)
+            return
         state = self.states[robot]
         travels = self.travels
         faults = self.robots[robot]
@@ -175,6 +182,11 @@ class FaultRules(MoveRules):
         faults = self.robots[robot]
         stalled = bool(faults.held)
         events = faults.clear(what)
+        if what in ("blackout", "all") and self.cameras is not None:
+            for camera in self.cameras.all():
+                if camera.blackout_until > self.clock.now():
+                    self.cameras.blackout(camera.name, -math.inf)
+                    events.append(f"cleared blackout {camera.name}")
         if stalled and not faults.held:
             self.travels.resync(self.states[robot])
         self.late = any("latency" in f.active for f in self.robots.values())
@@ -211,6 +223,32 @@ class FaultRules(MoveRules):
         for entry in self.robots[robot].due_now(self.clock.now()):
             self.start(robot, entry.fault, strict=False)
         self._arm(robot)
+
+    def _blackout(self, robot: str, fault: Fault, strict: bool) -> None:
+        """Darken camera ``fault.word`` for ``fault.values[0]`` s (none: until cleared).
+
+        Raises:
+            UnknownCamera: with ``strict`` (a scheduled one coming due is no error).
+        """
+        cameras = self.cameras
+        if cameras is None or (not strict and fault.word not in cameras):
+            return
+        cameras.get(fault.word)  # raises, naming the cameras there are
+        now = self.clock.now()
+        until = now + fault.values[0] if fault.values else math.inf
+        cameras.blackout(fault.word, until)
+        if math.isfinite(until):  # the page and feeds hear when it ends
+            self.clock.call_at(until, self._light, fault.word, until)
+        self._tell(
+            robot,
+            [f"fault blackout {fault.word}" + (f" {fault.values[0]:g}" if fault.values else "")],
+        )
+
+    def _light(self, name: str, until: float) -> None:
+        """A blackout's time is over (unless a newer one or a clear changed it)."""
+        cameras = self.cameras
+        if cameras is not None and name in cameras and cameras.get(name).blackout_until == until:
+            cameras.blackout(name, -math.inf)
 
     def _held(self, robot: str, name: str) -> None:
         """Raise unless ``robot`` holds the part ``name``."""

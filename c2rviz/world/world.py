@@ -98,6 +98,7 @@ class World:
         self.cameras = Cameras(lambda cameras: self._tell("on_cameras", cameras))
         """The logical cameras (``cameras.py``; what one sees: ``camera_sight.py``)."""
         self.faults.parts, self.parts.slips = self.parts, self.faults.slips  # drop, slip
+        self.faults.cameras = self.cameras  # blackout
 
     def state(self, name: str | None = None) -> RobotState:
         """The robot called ``name`` (the default robot for None)."""

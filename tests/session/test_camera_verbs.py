@@ -232,6 +232,53 @@ def test_a_blackout_hides_everything_until_its_time(server) -> None:
     assert client.ask("camera top").startswith("ok p1:battery:")
 
 
+def test_fault_blackout_darkens_a_camera_for_its_time_on_the_world_clock(server) -> None:
+    _, client = server
+    assert client.ask(PART) == "ok"
+    assert client.ask(DOWN) == "ok"
+    assert client.ask("fault blackout top 2") == "ok"
+    assert client.ask("camera top") == "ok none"
+    assert client.ask("sleep 1.9") == "ok"
+    assert client.ask("camera top") == "ok none"
+    assert client.ask("sleep 0.2") == "ok"
+    assert client.ask("camera top").startswith("ok p1:battery:")
+
+
+def test_fault_blackout_until_cleared_and_scheduled(server) -> None:
+    _, client = server
+    assert client.ask(PART) == "ok"
+    assert client.ask(DOWN) == "ok"
+    assert client.ask("fault blackout top") == "ok"
+    assert client.ask("sleep 100") == "ok"
+    assert client.ask("camera top") == "ok none"
+    assert client.ask("fault clear blackout") == "ok"
+    assert client.ask("camera top").startswith("ok p1:battery:")
+    assert client.ask("fault after 1 blackout top 1") == "ok"
+    assert client.ask("camera top").startswith("ok p1:battery:")
+    assert client.ask("sleep 1.5") == "ok"
+    assert client.ask("camera top") == "ok none"
+    assert client.ask("sleep 1") == "ok"
+    assert client.ask("camera top").startswith("ok p1:battery:")
+
+
+@pytest.mark.parametrize(
+    ("line", "error"),
+    [
+        ("fault blackout nope", "error: no camera named 'nope' (cameras: top)"),
+        ("fault blackout top 0", "error: fault: blackout S '0' is not a time in (0, 1e+06] s"),
+        ("fault blackout top -1", "error: fault: blackout S '-1' is not a time"),
+        ("fault blackout", "error: fault: blackout needs a CAMERA"),
+        ("fault blackout top 1 2", "error: fault: blackout needs a CAMERA"),
+    ],
+)
+def test_a_bad_blackout_is_refused_and_changes_nothing(server, line, error) -> None:
+    _, client = server
+    assert client.ask(PART) == "ok"
+    assert client.ask(DOWN) == "ok"
+    assert client.ask(line).startswith(error)
+    assert client.ask("camera top").startswith("ok p1:battery:")
+
+
 def test_watch_and_a_recording_together_do_not_spin_virtual_time(tmp_path) -> None:
     thread = ServerThread(
         load_robot("fanuc_lrmate200id"), ServerLimits(), clock=VirtualClock(), record_dir=tmp_path

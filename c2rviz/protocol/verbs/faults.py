@@ -44,8 +44,10 @@ class FaultSpec:
 
     Attributes:
         kind: A name of ``FAULT_KINDS``.
-        word: A word argument: ``stall``'s joint (its name or index); ``drop``'s part.
-        values: Numbers: ``noise``'s SIGMA; ``latency``'s MS and JITTER [ms]; ``slip``'s P.
+        word: A word argument: ``stall``'s joint (its name or index); ``drop``'s part;
+            ``blackout``'s camera.
+        values: Numbers: ``noise``'s SIGMA; ``latency``'s MS and JITTER [ms]; ``slip``'s P;
+            ``blackout``'s S [s].
     """
 
     kind: str
@@ -134,6 +136,17 @@ def _slip(words: list[str]) -> FaultSpec:
     return FaultSpec("slip", values=values)
 
 
+def _blackout(words: list[str]) -> FaultSpec:
+    if len(words) not in (1, 2):
+        raise _bad("blackout needs a CAMERA and, if it ends by itself, S [s]")
+    if len(words) == 1:
+        return FaultSpec("blackout", words[0])
+    values = numbers("fault", words[1])
+    if len(values) != 1 or not 0.0 < values[0] <= FAULT_TIME_S:
+        raise _bad(f"blackout S {shown(words[1])} is not a time in (0, {FAULT_TIME_S:g}] s")
+    return FaultSpec("blackout", words[0], values)
+
+
 FAULT_KINDS: dict[str, FaultKind] = {
     kind.name: kind
     for kind in (
@@ -192,6 +205,14 @@ FAULT_KINDS: dict[str, FaultKind] = {
             "each grasp the rule would make fails with chance P (0..1, drawn from the seed): "
             "the fingers close on nothing",
             _slip,
+        ),
+        FaultKind(
+            "blackout",
+            "CAMERA [S]",
+            "the logical camera reports nothing (for S seconds of the world's clock, else "
+            "until `fault clear blackout`)",
+            _blackout,
+            lasting=False,
         ),
     )
 }
