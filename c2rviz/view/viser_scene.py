@@ -26,7 +26,7 @@ import logging
 import socket
 import time
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import pinocchio as pin
@@ -89,6 +89,7 @@ class ViserScene(Scene):
         *,
         policy: DoorPolicy | None = None,
         title: str | None = None,
+        page_session: Callable[[Services, str], Session] | None = None,
     ) -> None:
         """Start the viser server on ``host:port`` (0 picks a free port) and draw the world.
 
@@ -100,6 +101,8 @@ class ViserScene(Scene):
             hz: Most sends per second [1/s].
             policy: Who may open the page and what it may send.
             title: The cell's or robot's name (default: the robots' names).
+            page_session: Makes the page's session of a robot (default: a ``Session``
+                of source ``page``; the page process's hands its lines on).
 
         Raises:
             OSError: ``host`` cannot be listened on.
@@ -127,6 +130,7 @@ class ViserScene(Scene):
         self._state_dirty = True
         self._objects: dict[str, Sequence[WorkcellObject]] = {}  # to draw at the next send
         self._collisions: dict[str, Sequence[tuple[str, str]]] = {}
+        self._page_session = page_session or _page_session
         self.scheduler = SendScheduler(1.0 / hz, self._send)
         try:
             self._build()
@@ -161,9 +165,7 @@ class ViserScene(Scene):
         self.panels: dict[str, RobotPanel] = {}
         self.sessions: dict[str, Session] = {}
         for name, state in world.robots.items():
-            session = Session(self.services, source="page", robot=name)
-            session.set_degrees(True)
-            session.motion = "off" if self.services.defaults.motion == "off" else "follow"
+            session = self._page_session(self.services, name)
             self.sessions[name] = session
             self.panels[name] = RobotPanel(server.gui, state, session.speed)
             self.page_input.add_robot(self.panels[name], session)
@@ -258,6 +260,11 @@ class ViserScene(Scene):
 
     def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
         self._collisions[robot] = list(pairs)
+        self.scheduler.request()
+
+    def redraw(self, robot: str) -> None:
+        """Draw ``robot`` at the next send (its target or motion changed)."""
+        self._dirty.add(robot)
         self.scheduler.request()
 
     def _pick(self, robot: str, shape: str, instance: int) -> None:
@@ -403,6 +410,14 @@ class ViserScene(Scene):
         for view in self.views.values():
             view.show_collision(shown)
         self.server.flush()
+
+
+def _page_session(services: Services, robot: str) -> Session:
+    """The page's session of ``robot``: source ``page``, degrees, moves that follow."""
+    session = Session(services, source="page", robot=robot)
+    session.set_degrees(True)
+    session.motion = "off" if services.defaults.motion == "off" else "follow"
+    return session
 
 
 def _check_host(host: str) -> None:
