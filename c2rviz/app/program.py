@@ -13,6 +13,7 @@ import signal
 import sys
 from collections.abc import Awaitable, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -63,7 +64,11 @@ def write_page(recorded: Recorded, state: RobotState) -> Path:
 
 
 def _open_scene(
-    settings: Settings, services: Services, title: str | None, page_process: bool = False
+    settings: Settings,
+    services: Services,
+    title: str | None,
+    page_process: bool = False,
+    spawned: Any = None,
 ) -> Scene:
     if not settings.viewer:
         return NullScene()
@@ -72,8 +77,7 @@ def _open_scene(
         token = secrets.token_urlsafe(16)
     if page_process:  # the page in a process of its own: viser is never loaded here
         from ..view.page_link import PageLink
-        from ..view.page_snapshot import PageConfig
-        from ..view.panel import RECENT_COMMANDS
+        from ..view.page_snapshot import RECENT_COMMANDS, PageConfig
 
         config = PageConfig(
             settings.viewer_host,
@@ -88,7 +92,7 @@ def _open_scene(
             logging.getLogger().getEffectiveLevel(),
             RECENT_COMMANDS,
         )
-        return PageLink(services, config)
+        return PageLink(services, config, spawned)
     from ..view.policy import DoorPolicy
     from ..view.viser_scene import ViserScene  # viser is heavy: import only when it is used
 
@@ -138,6 +142,7 @@ async def serve(
     """
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
+    spawned = _spawn_page() if page_process and settings.viewer else None
     srdf = read_srdf(settings.srdf) if settings.srdf is not None else None
     if clock is None:
         clock = parse_clock(settings.clock)
@@ -189,7 +194,7 @@ async def serve(
         return 2
     scene: Scene = NullScene()
     try:
-        scene = _open_scene(settings, services, cell, page_process)
+        scene = _open_scene(settings, services, cell, page_process, spawned)
         world.add_observers([scene])  # no client is served before this: nothing awaited since
         scene.start(loop)
         await _page_opened(scene)
@@ -263,6 +268,17 @@ async def serve(
             scene.stop()
     print("c2rviz: stopped", flush=True)
     return 0
+
+
+def _spawn_page() -> Any:
+    """The page process, started first: it loads viser while we set up (it then waits for
+    the world); None if it cannot be started now (the scene tries again, and says why)."""
+    from ..view.page_link import spawn
+
+    try:
+        return spawn()
+    except OSError:
+        return None
 
 
 async def _page_opened(scene: Scene) -> None:

@@ -36,6 +36,7 @@ from collections import deque
 from collections.abc import Awaitable, Sequence
 from typing import Any
 
+import numpy as np
 import pinocchio as pin
 
 from ..collision.workcell import WorkcellObject
@@ -56,6 +57,9 @@ BACKLOG = 8 << 20
 SAMPLES_KEPT = 256
 """Joint samples of one robot kept for one frame (the newest; a flood of ``joints``
 lines is thinned for the page's plots, never for the robot)."""
+PATH_ROWS = 128
+"""Rows a ghost's timed path is sampled at (``ghost.PATH_POINTS // 2``, as the page does;
+not imported: ``ghost`` loads viser, which this process never needs)."""
 START_TIMEOUT_S = 60.0
 """Longest wait for the page process to serve the page [s]."""
 STOP_TIMEOUT_S = 2.0
@@ -76,7 +80,14 @@ class PageLink(Scene):
         process: The page process running now, if any.
     """
 
-    def __init__(self, services: Services, config: PageConfig) -> None:
+    def __init__(
+        self,
+        services: Services,
+        config: PageConfig,
+        spawned: tuple[subprocess.Popen[bytes], socket.socket] | None = None,
+    ) -> None:
+        """Set up; ``spawned``: a page process started early (``spawn``), to use first."""
+        self._spawned = spawned
         self.services = services
         self.world = world = services.world
         self.config = config
@@ -98,6 +109,7 @@ class PageLink(Scene):
         self._events: list[list[Any]] = []
         self._commands: deque[tuple[str, bool]] = deque(maxlen=config.recent_commands)
         self._trails: list[str] = []
+        self._paths: dict[str, object] = {}  # the path each robot's ghost was last sent
         self._writer: asyncio.StreamWriter | None = None
         self._behind = False  # frames were dropped: a snapshot is due
         self._loop: asyncio.AbstractEventLoop | None = None
@@ -153,6 +165,9 @@ class PageLink(Scene):
         crashes: deque[float] = deque(maxlen=len(RESTART_S))
         while not self._stopping:
             status = await self._run_once()
+            if self._ready is not None and not self._ready.done():  # it never served
+                self._fail(OSError(0, f"the page process ended at start (status {status})"))
+                self._stopping = True
             if self._stopping:
                 return
             now = time.monotonic()
@@ -165,26 +180,20 @@ class PageLink(Scene):
             await asyncio.sleep(RESTART_S[min(quick, len(RESTART_S)) - 1])
 
     async def _run_once(self) -> int | None:
-        """Start one page process, feed it until it ends; its exit status."""
-        ours, theirs = socket.socketpair()
+        """Start one page process (or take the one started early), feed it until it ends;
+        its exit status."""
         config = self.config
         if self.port is not None:  # again: where the tabs look
             config = config.again(self.port)
-        try:
-            self.process = subprocess.Popen(
-                [sys.executable, "-m", "c2rviz.view.page_process", str(theirs.fileno())],
-                pass_fds=(theirs.fileno(),),
-                stdin=subprocess.DEVNULL,
-                stdout=subprocess.DEVNULL,
-            )
-        except OSError as exc:
-            ours.close()
-            theirs.close()
-            self._fail(OSError(exc.errno, f"cannot start the page process: {exc.strerror}"))
-            self._stopping = True
-            return None
-        finally:
-            theirs.close()
+        if self._spawned is not None:
+            (self.process, ours), self._spawned = self._spawned, None
+        else:
+            try:
+                self.process, ours = spawn()
+            except OSError as exc:
+                self._fail(OSError(exc.errno, f"cannot start the page process: {exc.strerror}"))
+                self._stopping = True
+                return None
         self.starts += 1
         process = self.process
         reader, writer = await asyncio.open_connection(sock=ours)
@@ -208,6 +217,8 @@ class PageLink(Scene):
         self._dirty.clear()
         self._events.clear()
         self._trails = sorted(self.services.trails.trails)
+        self._paths.clear()
+        self._dirty.update(self.world.robots)  # the first frame says each ghost's path
         self._behind = False
         self._writer = writer
 
@@ -361,6 +372,10 @@ class PageLink(Scene):
                 ]
             )
             samples.clear()
+            path = world.travel(name).path if robots[-1][4] else None
+            if path is not self._paths.get(name):
+                self._paths[name] = path
+                self._events.append(["path", name, path_rows(path, world.clock.now())])
         self._dirty.clear()
         trails = sorted(self.services.trails.trails)
         if trails != self._trails:
@@ -380,3 +395,40 @@ class PageLink(Scene):
     def pid(self) -> int | None:
         """The page process's id, if one runs."""
         return self.process.pid if self.process is not None else None
+
+
+def path_rows(path: Any, now: float) -> list[list[float]] | None:
+    """The joint rows of a ghost's path (``ghost.tool_path`` draws them), or None."""
+    if path is None:
+        return None
+    rows = getattr(path, "joint_path", None)
+    if rows is None:
+        rows = getattr(path, "qs", None)
+    if rows is None or len(rows) < 2:
+        times = np.linspace(now, max(float(path.arrival), now), PATH_ROWS)
+        rows = [path.sample(float(t)) for t in times]
+    return np.asarray(rows, dtype=float).tolist()  # type: ignore[no-any-return]
+
+
+def spawn() -> tuple[subprocess.Popen[bytes], socket.socket]:
+    """Start a page process; it and our end of its channel. It loads viser and waits for
+    its ``hello`` meanwhile, so the program starts it as early as it can.
+
+    Raises:
+        OSError: it cannot be started.
+    """
+    ours, theirs = socket.socketpair()
+    try:
+        process = subprocess.Popen(
+            [sys.executable, "-m", "c2rviz.view.page_process", str(theirs.fileno())],
+            pass_fds=(theirs.fileno(),),
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            start_new_session=True,  # a Ctrl-C is ours to act on: we stop it in order
+        )
+    except OSError:
+        ours.close()
+        raise
+    finally:
+        theirs.close()
+    return process, ours

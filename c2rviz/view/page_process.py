@@ -60,12 +60,20 @@ class MirrorClock(Clock):
         self.offset = t - time.monotonic()
 
 
+class _Path:
+    """A ghost's path as the command process sent it: joint rows (``ghost.tool_path``)."""
+
+    def __init__(self, rows: list[list[float]]) -> None:
+        self.joint_path = np.asarray(rows, dtype=float)
+        self.arrival = 0.0
+
+
 class _Travel:
-    """A robot's motion as the command process last said: moving or not."""
+    """A robot's motion as the command process last said: moving or not, its path."""
 
     def __init__(self) -> None:
         self.active = False
-        self.path = None
+        self.path: _Path | None = None
         self.seconds_left = 0.0
 
 
@@ -259,6 +267,10 @@ class PageProcess:
             scene.on_ghost(event[1], event[2])
         elif kind == "trails":
             self.trails(event[1])
+        elif kind == "path":
+            travel = world.travels.by_robot[event[1]]
+            travel.path = None if event[2] is None else _Path(event[2])  # type: ignore[assignment]
+            scene.redraw(event[1])
 
     def trails(self, on: Sequence[str]) -> None:
         keeper = self.services.trails

@@ -23,7 +23,11 @@ from ..session.session import Session
 from ..session.settings import SessionDefaults
 from ..world.state import Marker
 
-__all__ = ["Hello", "PageConfig", "RobotSnapshot", "Snapshot", "snapshot"]
+__all__ = ["RECENT_COMMANDS", "Hello", "PageConfig", "RobotSnapshot", "Snapshot", "snapshot"]
+
+RECENT_COMMANDS = 8
+"""Lines the 'last commands' readout keeps: ``panel.RECENT_COMMANDS`` (not imported, as
+``panel`` loads viser, which the program never needs with ``--page-process``)."""
 
 
 @dataclass(frozen=True)

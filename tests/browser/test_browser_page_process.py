@@ -28,6 +28,14 @@ SAME: list[tuple[ModuleType, str]] = [
     (test_browser_trail, "test_a_move_leaves_a_trail_on_the_page"),
     (test_browser_motion, "test_a_move_in_motion_is_drawn_as_it_goes_and_ends_at_the_target"),
     (test_browser_instruments, "test_the_plot_shows_a_joints_command_within_a_frame"),
+    (
+        test_browser_instruments,
+        "test_ghost_off_hides_the_ghost_and_path_and_on_shows_them_until_arrival",
+    ),
+    (
+        test_browser_instruments,
+        "test_looking_back_in_the_live_page_shows_the_arm_as_the_csv_has_it",
+    ),
 ]
 
 

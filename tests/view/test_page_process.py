@@ -201,3 +201,38 @@ def test_no_viewer_starts_no_page_process(c2rviz_process: Callable[..., Any]) ->
     finally:
         tcp.close()
     assert children(proc.popen.pid) == []
+
+
+def test_a_page_that_cannot_be_served_stops_the_program_as_before(tmp_path: Path) -> None:
+    """An address the page cannot listen on: one sentence, status 2, no process left."""
+    import subprocess
+    import sys
+
+    from support import ROOT
+
+    done = subprocess.run(
+        [sys.executable, "-m", "c2rviz", "--port", "0", "--no-crcl", "--no-rosbridge"]
+        + ["--viser-host", "203.0.113.7", "--viser-port", "0", "--page-process"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=DEADLINE_S,
+    )
+    assert done.returncode == 2, done
+    assert "c2rviz: cannot serve the viewer on 203.0.113.7:0:" in done.stderr
+    assert "viewer at" not in done.stdout
+
+
+def test_the_program_side_never_loads_viser() -> None:
+    """With ``--page-process`` viser lives in the page process only; the two processes'
+    readouts keep the same number of last commands."""
+    import subprocess
+    import sys
+
+    from c2rviz.view import page_snapshot, panel
+
+    assert page_snapshot.RECENT_COMMANDS == panel.RECENT_COMMANDS
+    check = (
+        "import sys, c2rviz.app.program, c2rviz.view.page_link; sys.exit('viser' in sys.modules)"
+    )
+    assert subprocess.run([sys.executable, "-c", check], timeout=DEADLINE_S).returncode == 0
