@@ -18,6 +18,7 @@ from __future__ import annotations
 from typing import Any
 
 import msgspec
+import numpy as np
 
 from ..errors import C2rvizError
 
@@ -27,7 +28,16 @@ MAX_MESSAGE = 64 << 20
 """Largest message either side accepts [bytes] (a snapshot of many robots' markers)."""
 
 _HEADER = 4
-_encoder = msgspec.msgpack.Encoder()
+
+
+def _plain(value: object) -> object:
+    """numpy's numbers and arrays as msgpack's (a joint value may be a ``np.float64``)."""
+    if isinstance(value, np.generic | np.ndarray):
+        return value.tolist()
+    raise NotImplementedError(f"a page message cannot carry {type(value).__name__}")
+
+
+_encoder = msgspec.msgpack.Encoder(enc_hook=_plain)
 _decoder = msgspec.msgpack.Decoder(list)
 
 
@@ -37,7 +47,10 @@ class ChannelError(C2rvizError):
 
 def encode(message: list[Any]) -> bytes:
     """``message`` framed for the channel: its length, then its msgpack bytes."""
-    body = _encoder.encode(message)
+    try:
+        body = _encoder.encode(message)
+    except (TypeError, NotImplementedError) as exc:
+        raise ChannelError(str(exc)) from None
     if len(body) > MAX_MESSAGE:
         raise ChannelError(f"a page message of {len(body)} bytes is over {MAX_MESSAGE}")
     return len(body).to_bytes(_HEADER, "big") + body

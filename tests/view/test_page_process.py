@@ -38,6 +38,18 @@ def test_messages_come_whole_however_the_bytes_are_cut() -> None:
     assert got == sent
 
 
+def test_numpy_numbers_go_as_plain_ones() -> None:
+    """A joint value may be a ``np.float64`` (a plan's sample): it goes, as a float."""
+    import numpy as np
+
+    message = ["frame", 0.5, [["r", [[np.float64(0.5), *np.zeros(2)]]]], np.arange(2)]
+    assert FrameReader().feed(encode(message)) == [
+        ["frame", 0.5, [["r", [[0.5, 0.0, 0.0]]]], [0, 1]]
+    ]
+    with pytest.raises(ChannelError, match="cannot carry object"):
+        encode(["frame", object()])
+
+
 def test_a_message_that_is_not_one_ends_the_channel() -> None:
     with pytest.raises(ChannelError, match="over"):
         FrameReader().feed((MAX_MESSAGE + 1).to_bytes(4, "big"))
