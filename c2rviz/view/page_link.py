@@ -355,6 +355,9 @@ class PageLink(Scene):
             self._behind = False
             now = snapshot(self.services, self.sessions, self._commands)
             writer.write(encode(["state", pickle.dumps(now)]))
+            self._events.clear()  # the snapshot has them: none twice (a marker)
+            for samples in self._samples.values():
+                samples.clear()
         world = self.world
         robots = []
         for name in self._dirty:

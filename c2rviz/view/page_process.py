@@ -133,11 +133,20 @@ class ForwardingSession(Session):
     """``send(message)``: puts a message on the channel (set once the channel is open)."""
 
     def run(self, line: str) -> Reply | None:
+        """Hand ``line`` on; what it will do is assumed meanwhile (a slider's target, the
+        speed), so the page answers its tabs at once; the next frame says the truth."""
         if self.send is not None:
             self.send(["line", self.state.name, line])
-        if line.startswith("speed "):  # shown at once; the next frame says the truth
-            with contextlib.suppress(ValueError):
-                self.speed = float(line.split()[1])
+        words = line.split()
+        with contextlib.suppress(ValueError, IndexError, C2rvizError):
+            if words[0] == "speed":
+                self.speed = float(words[1])
+            elif words[0] == "move" and len(words) == 3:  # the page's slider: move I V
+                index = int(words[1])
+                value = self.to_si([index], [float(words[2])])[0]
+                target = list(self.state.target)
+                target[index] = value
+                self.state.target = tuple(target)
         return None
 
 
