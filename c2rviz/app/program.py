@@ -198,7 +198,7 @@ async def serve(
         world.add_observers([scene])  # no client is served before this: nothing awaited since
         scene.start(loop)
         await _page_opened(scene)
-    except (OSError, C2rvizError, asyncio.TimeoutError) as exc:
+    except (OSError, C2rvizError) as exc:
         problem = exc.strerror or exc if isinstance(exc, OSError) else exc
         print(
             f"c2rviz: cannot serve the viewer on {settings.viewer_host}:{settings.viewer_port}: "

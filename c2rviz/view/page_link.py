@@ -135,7 +135,12 @@ class PageLink(Scene):
             OSError: the page cannot be served (the page process's reason).
         """
         assert self._ready is not None, "start() first"
-        return await asyncio.wait_for(asyncio.shield(self._ready), START_TIMEOUT_S)
+        try:
+            return await asyncio.wait_for(asyncio.shield(self._ready), START_TIMEOUT_S)
+        except asyncio.TimeoutError:
+            raise OSError(
+                0, f"the page process did not serve the page within {START_TIMEOUT_S:g} s"
+            ) from None
 
     def stop(self) -> None:
         """Stop the page process (``STOP_TIMEOUT_S``, then killed); later calls do nothing."""
