@@ -1,6 +1,7 @@
 """The browser tests of the page, run again with the page in a process of its own
 (``--page-process``, issue 40): the same page, the same guards, the sliders, handles and
-buttons through the channel back to the command process."""
+buttons through the channel back to the command process. Every browser test that starts
+the program is here (the recorded page's are the program's own, unchanged)."""
 
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ SAME: list[tuple[ModuleType, str]] = [
     (test_browser, "test_the_page_follows_commands_and_commands_the_robot"),
     (test_browser, "test_a_page_from_another_origin_cannot_reach_the_viewer"),
     (test_browser, "test_an_object_is_drawn_and_a_link_in_it_turns_red"),
+    (test_browser, "test_long_joint_names_stay_on_one_line"),
     (test_browser_cartesian, "test_dragging_the_tool_handle_moves_the_arm"),
     (test_browser_cartesian, "test_clicking_a_marker_and_go_to_puts_the_tool_on_it"),
     (test_browser_trail, "test_a_move_leaves_a_trail_on_the_page"),
