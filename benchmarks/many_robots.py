@@ -2,7 +2,7 @@
 gets on the page, and a bystander's round trips.
 
 Usage: ``python benchmarks/many_robots.py [--robots 64] [--seconds 10] [--quick]
-[--no-pin] [--page-process]``.
+[--no-pin] [--page-process [--page-anywhere]]``.
 
 A temporary ini holds ``[cell:many]`` with N motoman_sia20d members on a grid, every
 port 0 (the program picks free ones). The program runs with its viewer; one websocket
@@ -16,8 +16,9 @@ Figures, printed beside their goals (issue 30): the server's CPU [share of one c
 frames/s reaching the page per robot (the lowest and the median), the bystander's p50
 and p99 [ms]. The server is pinned to one CPU and the clients to the other, as in
 ``run.py``. ``--page-process`` runs the program with ``--page-process`` (docs/page.md):
-the page process is let loose on every CPU (the command process stays pinned) and its
-CPU is a row of its own; "server CPU" is then the command process's alone.
+the page process shares the server's CPU (it inherits the pin; ``--page-anywhere`` lets
+it run on every CPU, where it competes with the page client's decoding) and its CPU is a
+row of its own; "server CPU" is then the command process's alone.
 """
 
 from __future__ import annotations
@@ -175,7 +176,9 @@ def let_loose(pid: int) -> None:
             os.sched_setaffinity(int(task.name), every)
 
 
-def measure(count: int, seconds: float, page: bool = False) -> dict[str, float]:
+def measure(
+    count: int, seconds: float, page: bool = False, loose: bool = False
+) -> dict[str, float]:
     with tempfile.TemporaryDirectory() as folder:
         ini = write_cell(Path(folder), count)
         argv = [sys.executable, "-m", "c2rviz", "--cell", str(ini), "--port", "0"]
@@ -184,7 +187,7 @@ def measure(count: int, seconds: float, page: bool = False) -> dict[str, float]:
         try:
             ports = member_ports(proc, count)
             drawer = page_process(proc.popen.pid) if page else None
-            if drawer is not None:
+            if drawer is not None and loose:
                 let_loose(drawer)
             counter = PageCounter(loadgen.ws_url(proc.url))  # type: ignore[arg-type]
             names = sorted(ports, key=lambda n: int(n[1:]))
@@ -229,12 +232,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument(
         "--page-process", action="store_true", help="the page in a process of its own"
     )
+    parser.add_argument(
+        "--page-anywhere",
+        action="store_true",
+        help="with --page-process: let the page process run on every CPU (default: the "
+        "server's, as it inherits)",
+    )
     args = parser.parse_args(argv)
     count, seconds = (8, 2.0) if args.quick else (args.robots, args.seconds)
     print(machine())
-    how = "; the page in its own process (on any CPU)" if args.page_process else ""
+    where = "any CPU" if args.page_anywhere else "the server's CPU"
+    how = f"; the page in its own process (on {where})" if args.page_process else ""
     print(f"{count} motoman_sia20d moving, a page open; {pin_cpus(not args.no_pin)}{how}")
-    got = measure(count, seconds, args.page_process)
+    got = measure(count, seconds, args.page_process, args.page_anywhere)
     rows = [
         ("server CPU [cores]", got["cpu"], "<=", GOALS["cpu"]),
         *([("page process CPU [cores]", got["page_cpu"], "", None)] if args.page_process else []),

@@ -41,9 +41,14 @@ from .page_snapshot import Hello, Snapshot
 from .policy import DoorPolicy
 from .viser_scene import ViserScene
 
-__all__ = ["ForwardingSession", "MirrorWorld", "main"]
+__all__ = ["REST_PER_WORK", "ForwardingSession", "MirrorWorld", "main"]
 
 log = logging.getLogger("c2rviz.view")
+
+REST_PER_WORK = 0.25
+"""The page's sends leave its loop this much time per second of work (the program's
+page leaves 1.0, ``scheduler.REST_PER_WORK``, for its clients' lines): here the loop
+serves no client, only the channel, whose frames wait in the socket meanwhile."""
 
 
 class MirrorClock(Clock):
@@ -171,6 +176,7 @@ class PageProcess:
             title=config.title,
             page_session=_forwarding,
         )
+        self.scene.scheduler.rest_per_work = REST_PER_WORK
         world.add_observers([self.scene])
         self.apply_state(snap, fresh=True)
 
