@@ -123,11 +123,13 @@ def read_until(proc: Any, text: str) -> list[str]:
 
 def scene(url: str) -> list[dict[str, Any]]:
     """What a tab opened now gets, retried while the page is not served yet."""
+    from websockets.exceptions import WebSocketException
+
     deadline = time.monotonic() + DEADLINE_S
     while True:
         try:
             return asyncio.run(scene_messages(url))
-        except OSError:
+        except (OSError, WebSocketException):  # not listening yet, or starting
             assert time.monotonic() < deadline, "the page did not come back"
             time.sleep(0.2)
 
