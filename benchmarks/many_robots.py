@@ -2,7 +2,7 @@
 gets on the page, and a bystander's round trips.
 
 Usage: ``python benchmarks/many_robots.py [--robots 64] [--seconds 10] [--quick]
-[--no-pin]``.
+[--no-pin] [--page-process [--page-anywhere]]``.
 
 A temporary ini holds ``[cell:many]`` with N motoman_sia20d members on a grid, every
 port 0 (the program picks free ones). The program runs with its viewer; one websocket
@@ -15,7 +15,10 @@ bystander process does ``where`` request/reply on the first robot's port meanwhi
 Figures, printed beside their goals (issue 30): the server's CPU [share of one core],
 frames/s reaching the page per robot (the lowest and the median), the bystander's p50
 and p99 [ms]. The server is pinned to one CPU and the clients to the other, as in
-``run.py``.
+``run.py``. ``--page-process`` runs the program with ``--page-process`` (docs/page.md):
+the page process shares the server's CPU (it inherits the pin; ``--page-anywhere`` lets
+it run on every CPU, where it competes with the page client's decoding) and its CPU is a
+row of its own; "server CPU" is then the command process's alone.
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import os
 import re
 import sys
 import tempfile
@@ -140,14 +144,52 @@ def drive(port: int, names: Sequence[str], until: float) -> int:
     return sent
 
 
-def measure(count: int, seconds: float) -> dict[str, float]:
+def page_process(pid: int) -> int | None:
+    """The page process of the program ``pid`` (``--page-process``), if it runs one."""
+    for entry in Path("/proc").iterdir():
+        with contextlib.suppress(OSError, ValueError, IndexError):
+            if (
+                entry.name.isdigit()
+                and int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1]) == pid
+                and b"page_process" in (entry / "cmdline").read_bytes()
+            ):
+                return int(entry.name)
+    return None
+
+
+def tasks_cpu_s(pid: int | None) -> float:
+    """CPU time [s] of every thread of ``pid`` (0 for None)."""
+    if pid is None:
+        return 0.0
+    total = 0
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        with contextlib.suppress(OSError):
+            total += int((task / "schedstat").read_text().split()[0])
+    return total / 1e9
+
+
+def let_loose(pid: int) -> None:
+    """Every thread of ``pid`` may run on every CPU (it inherited the server's pin)."""
+    every = set(range(os.cpu_count() or 1))
+    for task in Path(f"/proc/{pid}/task").iterdir():
+        with contextlib.suppress(OSError):
+            os.sched_setaffinity(int(task.name), every)
+
+
+def measure(
+    count: int, seconds: float, page: bool = False, loose: bool = False
+) -> dict[str, float]:
     with tempfile.TemporaryDirectory() as folder:
         ini = write_cell(Path(folder), count)
         argv = [sys.executable, "-m", "c2rviz", "--cell", str(ini), "--port", "0"]
+        argv += ["--page-process"] if page else []
         proc = launch([*argv, "--viser-port", str(free_port())], viewer=True, timeout_s=180)
         try:
             ports = member_ports(proc, count)
-            page = PageCounter(loadgen.ws_url(proc.url))  # type: ignore[arg-type]
+            drawer = page_process(proc.popen.pid) if page else None
+            if drawer is not None and loose:
+                let_loose(drawer)
+            counter = PageCounter(loadgen.ws_url(proc.url))  # type: ignore[arg-type]
             names = sorted(ports, key=lambda n: int(n[1:]))
             warm = time.perf_counter() + 3.0
             driver = threading.Thread(
@@ -158,17 +200,20 @@ def measure(count: int, seconds: float) -> dict[str, float]:
                 time.sleep(0.05)
             bystander = Bystander((HOST, ports[names[0]]), seconds, "where")
             cpu0, t0 = proc.cpu_s(), time.perf_counter()
-            page.counting = True
+            drew0 = tasks_cpu_s(drawer)
+            counter.counting = True
             while bystander.running():
                 time.sleep(0.05)
-            page.counting = False
+            counter.counting = False
             cpu1, t1 = proc.cpu_s(), time.perf_counter()
+            drew1 = tasks_cpu_s(drawer)
             times, _ = bystander.result()
             driver.join(timeout=60)
-            page.stop()
-            rates = sorted(page.frames.get(n.lower(), 0) / (t1 - t0) for n in names)
+            counter.stop()
+            rates = sorted(counter.frames.get(n.lower(), 0) / (t1 - t0) for n in names)
             return {
                 "cpu": (cpu1 - cpu0) / (t1 - t0),
+                "page_cpu": (drew1 - drew0) / (t1 - t0),
                 "fps_min": rates[0],
                 "fps_median": rates[len(rates) // 2],
                 "p50_ms": percentile(times, 50) * 1e3,
@@ -184,13 +229,25 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--seconds", type=float, default=10.0, help="measured time (10)")
     parser.add_argument("--quick", action="store_true", help="8 robots for 2 s (the tests)")
     parser.add_argument("--no-pin", action="store_true", help="let the OS place the processes")
+    parser.add_argument(
+        "--page-process", action="store_true", help="the page in a process of its own"
+    )
+    parser.add_argument(
+        "--page-anywhere",
+        action="store_true",
+        help="with --page-process: let the page process run on every CPU (default: the "
+        "server's, as it inherits)",
+    )
     args = parser.parse_args(argv)
     count, seconds = (8, 2.0) if args.quick else (args.robots, args.seconds)
     print(machine())
-    print(f"{count} motoman_sia20d moving, a page open; {pin_cpus(not args.no_pin)}")
-    got = measure(count, seconds)
+    where = "any CPU" if args.page_anywhere else "the server's CPU"
+    how = f"; the page in its own process (on {where})" if args.page_process else ""
+    print(f"{count} motoman_sia20d moving, a page open; {pin_cpus(not args.no_pin)}{how}")
+    got = measure(count, seconds, args.page_process, args.page_anywhere)
     rows = [
         ("server CPU [cores]", got["cpu"], "<=", GOALS["cpu"]),
+        *([("page process CPU [cores]", got["page_cpu"], "", None)] if args.page_process else []),
         ("page frames/s, lowest robot", got["fps_min"], ">=", GOALS["fps"]),
         ("page frames/s, median robot", got["fps_median"], ">=", GOALS["fps"]),
         ("bystander where p50 [ms]", got["p50_ms"], "", None),

@@ -1,6 +1,7 @@
 """Benchmark c2rviz against the raw-socket ceiling, in one run; print one table.
 
-Usage: ``python benchmarks/run.py [--quick] [--reps N] [--no-viewer] [--no-pin]``.
+Usage: ``python benchmarks/run.py [--quick] [--reps N] [--no-viewer] [--no-pin] [--tab]
+[--page-process]``.
 
 Each repetition launches, as separate processes, the real program
 (``python -m c2rviz --port 0 --viser-port P``) and the ceiling
@@ -9,21 +10,29 @@ Each repetition launches, as separate processes, the real program
 clients from this process, and stops them. The table gives the median over the
 repetitions, the spread (min..max) and ours/ceiling. Figures only: nothing here
 passes or fails on time; the "met" column just reads the targets.
+
+``--tab`` measures the TCP rows of c2rviz with a tab open and its arm moving (a
+``ViewerClient`` decoding every frame, and a second client keeping joint 0 moving
+with ``move``), as issue 40 asks; the ceiling is measured as always.
+``--page-process`` runs c2rviz with ``--page-process`` (the page in a process of its
+own, docs/page.md).
 """
 
 from __future__ import annotations
 
 import argparse
 import asyncio
+import contextlib
 import os
 import socket
 import sys
+import threading
 import time
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 import loadgen
-from processes import ROOT, Launched, launch_ceiling, launch_ours, pin_cpus
+from processes import ROOT, Launched, free_port, launch, launch_ceiling, pin_cpus
 from report import Figures, machine, table
 
 N_JOINTS = 7  # the default robot, motoman_sia20d
@@ -200,16 +209,65 @@ def run_ceiling(plan: Plan, viewer: bool) -> Figures:
     return figures
 
 
-def run_ours(plan: Plan, viewer: bool) -> Figures:
-    """c2rviz, with its viewer when there is one: every row."""
+@contextlib.contextmanager
+def tab_and_motion(proc: Launched) -> Iterator[None]:
+    """A tab open (a ``ViewerClient`` decoding every frame) and joint 0 kept moving by a
+    client of its own, on a thread, for the time of the block."""
+    assert proc.url is not None
+    done = threading.Event()
+    ready = threading.Event()
+
+    async def keep_moving() -> None:
+        viewer = loadgen.ViewerClient(loadgen.ws_url(proc.url or ""))
+        shown = asyncio.Event()
+        task = asyncio.create_task(viewer.run(shown))
+        reader, writer = await asyncio.open_connection(*proc.address)
+        try:
+            await asyncio.wait_for(shown.wait(), 30)
+            for line in (b"degrees\n", b"motion on\n", b"speed 100\n"):
+                writer.write(line)
+                await reader.readline()
+            ready.set()
+            k = 0
+            while not done.is_set():
+                writer.write(f"move 0 {(-1) ** k * 90}\n".encode())  # ok at arrival
+                await reader.readline()
+                k += 1
+        finally:
+            ready.set()
+            writer.close()
+            task.cancel()
+            await asyncio.gather(task, return_exceptions=True)
+
+    thread = threading.Thread(target=lambda: asyncio.run(keep_moving()), daemon=True)
+    thread.start()
+    ready.wait(60)
+    try:
+        yield
+    finally:
+        done.set()
+        thread.join(timeout=30)
+
+
+def launch_ours(viewer: bool, page_process: bool = False) -> Launched:
+    argv = [sys.executable, "-m", "c2rviz", "--port", "0"]
+    argv += ["--viser-port", str(free_port())] if viewer else ["--no-viewer"]
+    argv += ["--page-process"] if page_process and viewer else []
+    return launch(argv, viewer)
+
+
+def run_ours(plan: Plan, viewer: bool, tab: bool = False, page_process: bool = False) -> Figures:
+    """c2rviz, with its viewer when there is one: every row (``tab``: the TCP rows with a
+    tab open and the arm moving)."""
     figures: Figures = {}
-    proc = launch_ours(viewer)
+    proc = launch_ours(viewer, page_process)
     try:
         assert proc.port_open_s is not None
         figures["port_open"] = proc.port_open_s
         if viewer:
             figures["scene_ready"] = asyncio.run(_scene_ready(proc))
-        measure_tcp(proc, plan, figures)
+        with tab_and_motion(proc) if tab and viewer else contextlib.nullcontext():
+            measure_tcp(proc, plan, figures)
         if viewer:
             figures["flood_rate"] = measure_viewer(proc, plan, figures)
         else:
@@ -227,6 +285,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--reps", type=int, help="repetitions (default 5; 1 with --quick)")
     parser.add_argument("--no-viewer", action="store_true", help="TCP rows only")
     parser.add_argument("--no-pin", action="store_true", help="let the OS place the processes")
+    parser.add_argument(
+        "--tab", action="store_true", help="c2rviz's TCP rows with a tab open and the arm moving"
+    )
+    parser.add_argument(
+        "--page-process", action="store_true", help="c2rviz with the page in its own process"
+    )
     args = parser.parse_args(argv)
     plan = SMOKE if args.smoke else QUICK if args.quick else FULL
     if args.reps is not None:
@@ -245,9 +309,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         # Alternate who goes first, so a drift in the machine's load favours neither.
         if rep % 2 == 0:
             ceiling.append(run_ceiling(plan, viewer))
-            ours.append(run_ours(plan, viewer))
+            ours.append(run_ours(plan, viewer, args.tab, args.page_process))
         else:
-            ours.append(run_ours(plan, viewer))
+            ours.append(run_ours(plan, viewer, args.tab, args.page_process))
             ceiling.append(run_ceiling(plan, viewer))
         log(
             f"c2rviz {ours[-1]['pipelined']:,.0f} cmd/s pipelined, "
@@ -258,6 +322,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"{plan.round_trips:,} round trips; {plan.clients} clients x {plan.per_client:,}; "
         f"{plan.frame_samples} command->frame samples; flood {plan.flood_s:g} s"
         + ("" if viewer else "; viewer rows skipped (no c2rviz/view/viser_scene.py or --no-viewer)")
+        + ("; c2rviz's TCP rows with a tab open and the arm moving" if args.tab else "")
+        + ("; c2rviz with --page-process" if args.page_process else "")
     )
     print(
         "ours/ceil is the ratio of the medians: higher is better for rates, lower for times "

@@ -192,6 +192,12 @@ def build_parser() -> argparse.ArgumentParser:
         const=False,
         help="run the command server alone",
     )
+    add(
+        "--page-process",
+        action="store_true",
+        help="serve the page from a process of its own, so drawing never delays a command "
+        "(docs/page.md)",
+    )
     add("--max-clients", type=int, metavar="N", help="clients at once (default 64)")
     add("--max-line", type=int, metavar="BYTES", help="longest line (default 8192)")
     add(
@@ -247,7 +253,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     overrides = {
         k: v
         for k, v in vars(args).items()
-        if k not in ("config", "verbose", "list_robots", *MOTION_FLAGS)
+        if k not in ("config", "verbose", "list_robots", "page_process", *MOTION_FLAGS)
     }
     overrides["motion_flags"] = tuple(
         (k, getattr(args, k)) for k in MOTION_FLAGS if getattr(args, k) is not None
@@ -268,7 +274,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"c2rviz: {exc}", file=sys.stderr)
         return 2
     try:
-        return asyncio.run(serve(settings, robots, cell))
+        return asyncio.run(serve(settings, robots, cell, page_process=args.page_process))
     except KeyboardInterrupt:  # a second Ctrl-C while stopping
         return 130
 

@@ -13,6 +13,7 @@ import signal
 import sys
 from collections.abc import Awaitable, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -63,15 +64,39 @@ def write_page(recorded: Recorded, state: RobotState) -> Path:
     return write_html(recorded, state)
 
 
-def _open_scene(settings: Settings, services: Services, title: str | None) -> Scene:
+def _open_scene(
+    settings: Settings,
+    services: Services,
+    title: str | None,
+    page_process: bool = False,
+    spawned: Any = None,
+) -> Scene:
     if not settings.viewer:
         return NullScene()
-    from ..view.policy import DoorPolicy
-    from ..view.viser_scene import ViserScene  # viser is heavy: import only when it is used
-
     token = settings.viewer_token
     if token is None and not _is_loopback(settings.viewer_host):
         token = secrets.token_urlsafe(16)
+    if page_process:  # the page in a process of its own: viser is never loaded here
+        from ..view.page_link import PageLink
+        from ..view.page_snapshot import RECENT_COMMANDS, PageConfig
+
+        config = PageConfig(
+            settings.viewer_host,
+            settings.viewer_port,
+            settings.hz,
+            settings.viewer_origins,
+            token,
+            settings.max_viewers,
+            title,
+            settings.session,
+            settings.trail_points,
+            logging.getLogger().getEffectiveLevel(),
+            RECENT_COMMANDS,
+        )
+        return PageLink(services, config, spawned)
+    from ..view.policy import DoorPolicy
+    from ..view.viser_scene import ViserScene  # viser is heavy: import only when it is used
+
     policy = DoorPolicy(settings.viewer_origins, token, settings.max_viewers)
     return ViserScene(
         services,
@@ -105,8 +130,12 @@ async def serve(
     members: Sequence[Member],
     cell: str | None = None,
     clock: Clock | None = None,
+    page_process: bool = False,
 ) -> int:
     """Run the viewer and a command server per robot until ``quit``, SIGINT or SIGTERM.
+
+    ``page_process``: the page runs in a process of its own (``--page-process``,
+    docs/page.md), started here and stopped last.
 
     ``members`` are the robots, each by the name the user chose (``--robot kuka_lwr``,
     or a cell's member name), which the banner and ``names`` say. Every command port
@@ -115,6 +144,7 @@ async def serve(
     """
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
+    spawned = _spawn_page() if page_process and settings.viewer else None
     srdf = read_srdf(settings.srdf) if settings.srdf is not None else None
     if clock is None:
         clock = parse_clock(settings.clock)
@@ -165,8 +195,12 @@ async def serve(
         for server in servers:
             await server.stop()
         return 2
+    scene: Scene = NullScene()
     try:
-        scene = _open_scene(settings, services, cell)
+        scene = _open_scene(settings, services, cell, page_process, spawned)
+        world.add_observers([scene])  # no client is served before this: nothing awaited since
+        scene.start(loop)
+        await _page_opened(scene)
     except (OSError, C2rvizError) as exc:
         problem = exc.strerror or exc if isinstance(exc, OSError) else exc
         print(
@@ -177,11 +211,10 @@ async def serve(
         await close_doors(doors)
         for server in servers:
             await server.stop()
+        scene.stop()
         return 2
-    world.add_observers([scene])  # no client is served before this: nothing awaited since
     for server in servers:
         server.viewer_url = scene.url
-    scene.start(loop)
     for sig in _STOP_SIGNALS:
         loop.add_signal_handler(sig, stop.set)
     for name in replaced_bundled(settings.robots):
@@ -238,6 +271,24 @@ async def serve(
             scene.stop()
     print("c2rviz: stopped", flush=True)
     return 0
+
+
+def _spawn_page() -> Any:
+    """The page process, started first: it loads viser while we set up (it then waits for
+    the world); None if it cannot be started now (the scene tries again, and says why)."""
+    from ..view.page_link import spawn
+
+    try:
+        return spawn()
+    except OSError:
+        return None
+
+
+async def _page_opened(scene: Scene) -> None:
+    """Wait until a page in a process of its own serves the page (its URL is then known)."""
+    opened = getattr(scene, "opened", None)
+    if opened is not None:
+        await opened()
 
 
 async def _step(what: str, step: Awaitable[None]) -> None:

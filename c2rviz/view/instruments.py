@@ -288,6 +288,9 @@ class Instruments:
         return start, self.world.clock.now()
 
     def _objects_now(self, name: str) -> list[WorkcellObject]:
+        mirrored = getattr(self.world, "objects", None)  # the page process's mirror
+        if mirrored is not None:
+            return list(mirrored.get(name, ()))
         model = self.world.contacts.models.get(name)
         return model.object_list() if model is not None else []
 

@@ -34,6 +34,9 @@ class SendScheduler:
     Attributes:
         period_s: Shortest time between two sends' starts [s].
         sends: How many sends have run to their end.
+        rest_per_work: The loop's time left to other work after a send, per second the
+            send worked (``REST_PER_WORK``; the page process, which serves no client,
+            leaves less).
         work_s: The last send's time at work, its slices summed [s of this thread's CPU
             time: a wait for the GIL while viser's thread encodes is not work].
     """
@@ -43,6 +46,7 @@ class SendScheduler:
         self.period_s = period_s
         self.sends = 0
         self.work_s = 0.0
+        self.rest_per_work = REST_PER_WORK
         self._send = send
         self._loop: asyncio.AbstractEventLoop | None = None
         self._timer: asyncio.Handle | None = None
@@ -103,7 +107,7 @@ class SendScheduler:
         """A send is over: rest as long as it worked, then send again if asked meanwhile."""
         self._slicing = False
         self.work_s = self._work
-        self._rest_until = loop.time() + REST_PER_WORK * self._work
+        self._rest_until = loop.time() + self.rest_per_work * self._work
         self.sends += 1
         if self._again:
             self._again = False

@@ -27,7 +27,7 @@ import logging
 import socket
 import time
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import pinocchio as pin
@@ -98,6 +98,7 @@ class ViserScene(Scene):
         policy: DoorPolicy | None = None,
         title: str | None = None,
         port_named: bool = False,
+        page_session: Callable[[Services, str], Session] | None = None,
     ) -> None:
         """Start the viser server on ``host:port`` (0 picks a free port) and draw the world.
 
@@ -112,6 +113,8 @@ class ViserScene(Scene):
             title: The cell's or robot's name (default: the robots' names).
             port_named: The user chose ``port`` (``--viser-port``, the ini): when it is
                 taken the page does not move to another (``doors.open_port``'s rule).
+            page_session: Makes the page's session of a robot (default: a ``Session``
+                of source ``page``; the page process's hands its lines on).
 
         Raises:
             OSError: ``host`` cannot be listened on, or a named ``port`` is taken.
@@ -145,6 +148,7 @@ class ViserScene(Scene):
         self._state_dirty = True
         self._objects: dict[str, Sequence[WorkcellObject]] = {}  # to draw at the next send
         self._collisions: dict[str, Sequence[tuple[str, str]]] = {}
+        self._page_session = page_session or _page_session
         self.scheduler = SendScheduler(1.0 / hz, self._send)
         try:
             self._build()
@@ -184,9 +188,7 @@ class ViserScene(Scene):
         self.panels: dict[str, RobotPanel] = {}
         self.sessions: dict[str, Session] = {}
         for name, state in world.robots.items():
-            session = Session(self.services, source="page", robot=name)
-            session.set_degrees(True)
-            session.set_motion("off" if self.services.defaults.motion == "off" else "follow")
+            session = self._page_session(self.services, name)
             self.sessions[name] = session
             self.panels[name] = RobotPanel(server.gui, state, session.speed)
             self.page_input.add_robot(self.panels[name], session)
@@ -303,6 +305,10 @@ class ViserScene(Scene):
 
     def on_cameras(self, cameras: Sequence[Camera]) -> None:
         self._cameras = list(cameras)
+
+    def redraw(self, robot: str) -> None:
+        """Draw ``robot`` at the next send (its target or motion changed)."""
+        self._dirty.add(robot)
         self.scheduler.request()
 
     def _pick(self, robot: str, shape: str, instance: int) -> None:
@@ -474,6 +480,14 @@ def fault_banner(world: World, robot: str) -> str:
         return f"**PROTECTIVE STOP** — `{stop}`"
     active = [fault.text(faults.joint_names) for fault, _ in faults.active.values()]
     return "**Faults:** " + ", ".join(f"`{text}`" for text in active) if active else ""
+
+
+def _page_session(services: Services, robot: str) -> Session:
+    """The page's session of ``robot``: source ``page``, degrees, moves that follow."""
+    session = Session(services, source="page", robot=robot)
+    session.set_degrees(True)
+    session.set_motion("off" if services.defaults.motion == "off" else "follow")
+    return session
 
 
 def _check_host(host: str) -> None:

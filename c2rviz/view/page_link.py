@@ -1,0 +1,442 @@
+"""The page in a process of its own (``--page-process``): the command process's side.
+
+``PageLink`` is the scene the world tells its effects to. It draws nothing: it
+notes what changed (every joint sample of every robot, markers, objects,
+collisions, the tool, the ghost, refusals, the clients and the last commands)
+and, at most once per frame (``1/hz``), publishes one ``frame`` message on the
+channel (``page_channel``) to the page process (``page_process``), which owns
+viser, builds the scene and serves the tabs. So the command loop does only I/O
+and bookkeeping: a frame costs it one msgpack encoding and one socket write,
+whatever the number of tabs.
+
+The page process is started fresh (``python -m c2rviz.view.page_process``, so it
+inherits neither the loop nor its threads) and is handed a ``hello``: how to
+serve the page (host, port, hz, the door's policy) and a snapshot of the world
+(``page_snapshot``). Input from the page (sliders, handles, buttons) comes back
+as ``line`` messages and runs on the page's ``Session`` of that robot, like any
+other door's lines. When the page process exits or crashes, the link logs it
+and starts another on the same port (tabs reconnect by themselves) with a fresh
+snapshot; commands go on meanwhile. While the page falls behind (its socket's
+buffer past ``BACKLOG``) frames are dropped and a snapshot follows once it
+catches up.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import functools
+import logging
+import pickle
+import socket
+import subprocess
+import sys
+import time
+from collections import deque
+from collections.abc import Awaitable, Sequence
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from ..collision.workcell import WorkcellObject
+from ..errors import C2rvizError, MotionInterrupted, PathCollides
+from ..session.services import Services
+from ..session.session import Session
+from ..world.effects import Marker, Scene
+from .page_channel import ChannelError, FrameReader, encode
+from .page_snapshot import Hello, PageConfig, snapshot
+from .ratelog import RateLimitedLog
+
+__all__ = ["BACKLOG", "SAMPLES_KEPT", "PageLink"]
+
+log = logging.getLogger("c2rviz.view")
+
+BACKLOG = 8 << 20
+"""Bytes waiting for the page process past which frames are dropped (then a snapshot)."""
+SAMPLES_KEPT = 256
+"""Joint samples of one robot kept for one frame (the newest; a flood of ``joints``
+lines is thinned for the page's plots, never for the robot)."""
+PATH_ROWS = 128
+"""Rows a ghost's timed path is sampled at (``ghost.PATH_POINTS // 2``, as the page does;
+not imported: ``ghost`` loads viser, which this process never needs)."""
+START_TIMEOUT_S = 60.0
+"""Longest wait for the page process to serve the page [s]."""
+STOP_TIMEOUT_S = 2.0
+"""Longest wait for the page process to stop before it is killed [s]."""
+RESTART_S = (0.2, 1.0, 5.0)
+"""Pauses before starting the page process again after quick successive crashes [s]."""
+
+
+class PageLink(Scene):
+    """The world's scene when the page runs in its own process; see the module docstring.
+
+    Attributes:
+        url: Where the page is served (None until the page process says).
+        port: The page's port (None until then).
+        sessions: The page's ``Session`` per robot (source ``page``).
+        starts: Page processes started so far.
+        frames: Frames published so far.
+        process: The page process running now, if any.
+    """
+
+    def __init__(
+        self,
+        services: Services,
+        config: PageConfig,
+        spawned: tuple[subprocess.Popen[bytes], socket.socket] | None = None,
+    ) -> None:
+        """Set up; ``spawned``: a page process started early (``spawn``), to use first."""
+        self._spawned = spawned
+        self.services = services
+        self.world = world = services.world
+        self.config = config
+        self.url: str | None = None
+        self.port: int | None = None
+        self.starts = 0
+        self.frames = 0
+        self.process: subprocess.Popen[bytes] | None = None
+        self.sessions: dict[str, Session] = {}
+        for name in world.robots:
+            session = Session(services, source="page", robot=name)
+            session.set_degrees(True)
+            session.motion = "off" if services.defaults.motion == "off" else "follow"
+            self.sessions[name] = session
+        self._samples: dict[str, deque[list[float]]] = {
+            name: deque(maxlen=SAMPLES_KEPT) for name in world.robots
+        }
+        self._dirty: set[str] = set()
+        self._events: list[list[Any]] = []
+        self._commands: deque[tuple[str, bool]] = deque(maxlen=config.recent_commands)
+        self._trails: list[str] = []
+        self._paths: dict[str, object] = {}  # the path each robot's ghost was last sent
+        self._writer: asyncio.StreamWriter | None = None
+        self._behind = False  # frames were dropped: a snapshot is due
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._flush: asyncio.TimerHandle | None = None
+        self._last_flush = 0.0
+        self._task: asyncio.Task[None] | None = None
+        self._ready: asyncio.Future[str] | None = None
+        self._stopping = False
+        self._log = RateLimitedLog(log)
+
+    # lifecycle
+
+    def start(self, loop: asyncio.AbstractEventLoop) -> None:
+        """Start the page process and keep one running until ``stop``."""
+        self._loop = loop
+        self._ready = loop.create_future()
+        self._task = loop.create_task(self._supervise())
+
+    async def opened(self) -> str:
+        """The page's URL, once the first page process serves it.
+
+        Raises:
+            OSError: the page cannot be served (the page process's reason).
+        """
+        assert self._ready is not None, "start() first"
+        try:
+            return await asyncio.wait_for(asyncio.shield(self._ready), START_TIMEOUT_S)
+        except asyncio.TimeoutError:
+            raise OSError(
+                0, f"the page process did not serve the page within {START_TIMEOUT_S:g} s"
+            ) from None
+
+    def stop(self) -> None:
+        """Stop the page process (``STOP_TIMEOUT_S``, then killed); later calls do nothing."""
+        if self._stopping:
+            return
+        self._stopping = True
+        if self._flush is not None:
+            self._flush.cancel()
+        writer, self._writer = self._writer, None
+        if writer is not None:
+            with contextlib.suppress(Exception):
+                writer.write(encode(["stop"]))
+                writer.close()
+        if self._task is not None:
+            self._task.cancel()
+        process = self.process
+        if process is not None:
+            try:
+                process.wait(timeout=STOP_TIMEOUT_S)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait(timeout=STOP_TIMEOUT_S)
+
+    # the page process
+
+    async def _supervise(self) -> None:
+        crashes: deque[float] = deque(maxlen=len(RESTART_S))
+        while not self._stopping:
+            status = await self._run_once()
+            if self._ready is not None and not self._ready.done():  # it never served
+                self._fail(OSError(0, f"the page process ended at start (status {status})"))
+                self._stopping = True
+            if self._stopping:
+                return
+            now = time.monotonic()
+            crashes.append(now)
+            quick = sum(1 for t in crashes if now - t < 10.0)
+            log.warning(
+                "the page process stopped (status %s); starting it again (commands go on)",
+                status,
+            )
+            await asyncio.sleep(RESTART_S[min(quick, len(RESTART_S)) - 1])
+
+    async def _run_once(self) -> int | None:
+        """Start one page process (or take the one started early), feed it until it ends;
+        its exit status."""
+        config = self.config
+        if self.port is not None:  # again: where the tabs look
+            config = config.again(self.port)
+        if self._spawned is not None:
+            (self.process, ours), self._spawned = self._spawned, None
+        else:
+            try:
+                self.process, ours = spawn()
+            except OSError as exc:
+                self._fail(OSError(exc.errno, f"cannot start the page process: {exc.strerror}"))
+                self._stopping = True
+                return None
+        self.starts += 1
+        process = self.process
+        reader, writer = await asyncio.open_connection(sock=ours)
+        try:
+            self._send_hello(writer, config)
+            await self._read(reader)
+        except (ChannelError, ConnectionError) as exc:
+            log.warning("the page process's channel: %s", exc)
+        finally:
+            self._writer = None
+            writer.close()
+        while process.poll() is None and not self._stopping:
+            await asyncio.sleep(0.02)
+        return process.poll()
+
+    def _send_hello(self, writer: asyncio.StreamWriter, config: PageConfig) -> None:
+        hello = Hello(config, snapshot(self.services, self.sessions, self._commands))
+        writer.write(encode(["hello", pickle.dumps(hello)]))
+        for samples in self._samples.values():
+            samples.clear()
+        self._dirty.clear()
+        self._events.clear()
+        self._trails = sorted(self.services.trails.trails)
+        self._paths.clear()
+        self._dirty.update(self.world.robots)  # the first frame says each ghost's path
+        self._behind = False
+        self._writer = writer
+
+    async def _read(self, reader: asyncio.StreamReader) -> None:
+        frames = FrameReader()
+        while data := await reader.read(1 << 16):
+            for message in frames.feed(data):
+                kind = message[0]
+                if kind == "line" and len(message) == 3:
+                    self._line(str(message[1]), str(message[2]))
+                elif kind == "ready":
+                    self.port, self.url = int(message[1]), str(message[2])
+                    if self._ready is not None and not self._ready.done():
+                        self._ready.set_result(self.url)
+                elif kind == "error":
+                    self._fail(OSError(int(message[1]), str(message[2])))
+                    self._stopping = True
+
+    def _fail(self, exc: OSError) -> None:
+        if self._ready is not None and not self._ready.done():
+            self._ready.set_exception(exc)
+        else:
+            log.error("the page process: %s", exc.strerror or exc)
+
+    # input from the page: a line on the page's session of that robot
+
+    def _line(self, robot: str, line: str) -> None:
+        session = self.sessions.get(robot)
+        if session is None:
+            return
+        self._dirty.add(robot)  # the page learns the true target and speed
+        self._request()
+        try:
+            reply = session.run(line)
+        except C2rvizError as exc:
+            self._log.warning("refused", f"refused from the page: {line}: {exc}")
+            return
+        if isinstance(reply, Awaitable):  # a reply that comes later: the page does not wait
+            future = asyncio.ensure_future(reply)
+            future.add_done_callback(functools.partial(self._answered, line))
+
+    def _answered(self, line: str, future: asyncio.Future[Any]) -> None:
+        error = None if future.cancelled() else future.exception()
+        if isinstance(error, MotionInterrupted):
+            return
+        if isinstance(error, C2rvizError):
+            self._log.warning("refused", f"refused from the page: {line}: {error}")
+        elif error is not None:
+            self._log.warning("failed", f"a page command failed: {line}: {error!r}")
+
+    # the Observer protocol (asyncio thread, O(1) each)
+
+    def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
+        self._samples[robot].append([t, *q])
+        self._dirty.add(robot)
+        self._request()
+
+    def on_gripper(self, robot: str, opening: float, t: float) -> None:
+        self._dirty.add(robot)
+        self._request()
+
+    def on_motion(self, robot: str, t: float) -> None:
+        self._dirty.add(robot)
+        self._request()
+
+    def on_arrived(self, robot: str) -> None:
+        self.on_motion(robot, 0.0)
+
+    def on_stopped(self, robot: str) -> None:
+        self.on_motion(robot, 0.0)
+
+    def on_marker(self, robot: str, marker: Marker) -> None:
+        self._event(["marker", robot, marker.position, marker.wxyz, marker.rgb, marker.shape])
+
+    def on_clear_markers(self, robot: str) -> None:
+        self._event(["clear", robot])
+
+    def on_clients(self, count: int) -> None:
+        self._event(["clients", count])
+
+    def on_command(self, source: str, line: str, accepted: bool) -> None:
+        self._commands.appendleft((line, accepted))
+        self._event(["command", source, line, accepted])
+
+    def on_tool(self, robot: str, tool: pin.SE3) -> None:
+        self._event(["tool", robot, tool.homogeneous.ravel().tolist()])
+
+    def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
+        self._event(["objects", robot, pickle.dumps(list(objects))])
+
+    def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
+        self._event(["collisions", robot, [list(p) for p in pairs]])
+
+    def on_refused(self, robot: str, source: str, line: str, error: C2rvizError) -> None:
+        pair: list[str] | None = None
+        target: list[float] | None = None
+        if isinstance(error, PathCollides):
+            pair = list(error.pair)
+            target = list(error.target) if error.target is not None else None
+        self._event(["refused", robot, source, line, str(error), pair, target])
+
+    def on_ghost(self, robot: str, shown: bool) -> None:
+        self._event(["ghost", robot, shown])
+
+    def _event(self, event: list[Any]) -> None:
+        if self._writer is not None:
+            self._events.append(event)
+            self._request()
+
+    # publishing
+
+    def _request(self) -> None:
+        if self._flush is not None or self._loop is None or self._writer is None:
+            return
+        wait = self._last_flush + self.config.frame_s - time.perf_counter()
+        self._flush = self._loop.call_later(max(wait, 0.0), self._publish)
+
+    def _publish(self) -> None:
+        """One ``frame`` message: each changed robot's samples and state, then the events."""
+        self._flush = None
+        self._last_flush = time.perf_counter()
+        writer = self._writer
+        if writer is None or writer.is_closing():
+            return
+        if writer.transport.get_write_buffer_size() > BACKLOG:
+            self._behind = True  # the page is stuck: drop, and send it all when it is not
+            self._dirty.clear()
+            self._events.clear()
+            for samples in self._samples.values():
+                samples.clear()
+            self._flush = self._loop.call_later(0.1, self._publish) if self._loop else None
+            return
+        if self._behind:
+            self._behind = False
+            now = snapshot(self.services, self.sessions, self._commands)
+            writer.write(encode(["state", pickle.dumps(now)]))
+            self._events.clear()  # the snapshot has them: none twice (a marker)
+            for samples in self._samples.values():
+                samples.clear()
+        world = self.world
+        robots = []
+        for name in self._dirty:
+            state = world.robots[name]
+            samples = self._samples[name]
+            robots.append(
+                [
+                    name,
+                    list(samples),
+                    state.opening,
+                    state.target,
+                    world.moving(name),
+                    world.travels.seconds_left(state),
+                    self.sessions[name].speed,
+                ]
+            )
+            samples.clear()
+            path = world.travel(name).path if robots[-1][4] else None
+            if path is not self._paths.get(name):
+                self._paths[name] = path
+                self._events.append(["path", name, path_rows(path, world.clock.now())])
+        self._dirty.clear()
+        trails = sorted(self.services.trails.trails)
+        if trails != self._trails:
+            self._trails = trails
+            self._events.append(["trails", trails])
+        events, self._events = self._events, []
+        try:
+            writer.write(encode(["frame", world.clock.now(), robots, events]))
+        except ChannelError as exc:  # a frame too big to send: the page gets a snapshot
+            self._log.warning("frame", f"a page frame was dropped: {exc}")
+            self._behind = True
+        self.frames += 1
+
+    # what tests read
+
+    @property
+    def pid(self) -> int | None:
+        """The page process's id, if one runs."""
+        return self.process.pid if self.process is not None else None
+
+
+def path_rows(path: Any, now: float) -> list[list[float]] | None:
+    """The joint rows of a ghost's path (``ghost.tool_path`` draws them), or None."""
+    if path is None:
+        return None
+    rows = getattr(path, "joint_path", None)
+    if rows is None:
+        rows = getattr(path, "qs", None)
+    if rows is None or len(rows) < 2:
+        times = np.linspace(now, max(float(path.arrival), now), PATH_ROWS)
+        rows = [path.sample(float(t)) for t in times]
+    return np.asarray(rows, dtype=float).tolist()  # type: ignore[no-any-return]
+
+
+def spawn() -> tuple[subprocess.Popen[bytes], socket.socket]:
+    """Start a page process; it and our end of its channel. It loads viser and waits for
+    its ``hello`` meanwhile, so the program starts it as early as it can.
+
+    Raises:
+        OSError: it cannot be started.
+    """
+    ours, theirs = socket.socketpair()
+    try:
+        process = subprocess.Popen(
+            [sys.executable, "-m", "c2rviz.view.page_process", str(theirs.fileno())],
+            pass_fds=(theirs.fileno(),),
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            start_new_session=True,  # a Ctrl-C is ours to act on: we stop it in order
+        )
+    except OSError:
+        ours.close()
+        raise
+    finally:
+        theirs.close()
+    return process, ours

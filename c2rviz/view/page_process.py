@@ -1,0 +1,376 @@
+"""The page process (``--page-process``): viser, the scene and the tabs, off the command loop.
+
+Started by ``page_link.PageLink`` as ``python -m c2rviz.view.page_process FD``, FD being
+its end of the channel (``page_channel``). It reads a ``Hello`` (``page_snapshot``),
+builds a mirror of the world from it (``MirrorWorld``: the same robots, placed and
+posed as they are, fed by the frames that follow, never moving on its own), and serves
+the page with the usual ``ViserScene`` over it: the same door, origin check, token and
+limits, the same panel, plots and handles. A page's control runs a line on its robot's
+``ForwardingSession``, which hands it back over the channel to the command process,
+where it runs on the page's real ``Session``. The frames then bring what it did.
+
+It stops when told (``stop``), when the channel ends (the command process is gone), or
+on SIGTERM/SIGINT.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+import pickle
+import signal
+import socket
+import sys
+import time
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from ..collision.workcell import WorkcellObject
+from ..errors import C2rvizError, PathCollides
+from ..session.services import Services
+from ..session.session import Reply, Session
+from ..world.clock import Clock
+from ..world.state import Marker, RobotState
+from ..world.world import World
+from .page_channel import FrameReader, encode
+from .page_snapshot import Hello, Snapshot
+from .policy import DoorPolicy
+from .viser_scene import ViserScene
+
+__all__ = ["REST_PER_WORK", "ForwardingSession", "MirrorWorld", "main"]
+
+log = logging.getLogger("c2rviz.view")
+
+REST_PER_WORK = 0.25
+"""The page's sends leave its loop this much time per second of work (the program's
+page leaves 1.0, ``scheduler.REST_PER_WORK``, for its clients' lines): here the loop
+serves no client, only the channel, whose frames wait in the socket meanwhile."""
+
+
+class MirrorClock(Clock):
+    """The command process's clock, as last heard of, running on at real speed."""
+
+    def __init__(self, t: float) -> None:
+        self.offset = t - time.monotonic()
+
+    def now(self) -> float:
+        return time.monotonic() + self.offset
+
+    def heard(self, t: float) -> None:
+        """The command process's clock read ``t`` just now."""
+        self.offset = t - time.monotonic()
+
+
+class _Path:
+    """A ghost's path as the command process sent it: joint rows (``ghost.tool_path``)."""
+
+    def __init__(self, rows: list[list[float]]) -> None:
+        self.joint_path = np.asarray(rows, dtype=float)
+        self.arrival = 0.0
+
+
+class _Travel:
+    """A robot's motion as the command process last said: moving or not, its path."""
+
+    def __init__(self) -> None:
+        self.active = False
+        self.path: _Path | None = None
+        self.seconds_left = 0.0
+
+
+class _Travels:
+    """Stands in for ``world.moves.Travels``: what the page reads of it."""
+
+    def __init__(self, names: Sequence[str]) -> None:
+        self.by_robot = {name: _Travel() for name in names}
+
+    def seconds_left(self, state: RobotState) -> float:
+        return self.by_robot[state.name].seconds_left
+
+    def now(self, state: RobotState) -> tuple[float, ...]:
+        return state.q
+
+    def stop_all(self) -> None:
+        pass
+
+
+class MirrorWorld(World):
+    """The world of the command process, as the frames tell it; see the module docstring.
+
+    Attributes:
+        objects: Each robot's workcell objects (there is no collision model here).
+    """
+
+    def __init__(self, snap: Snapshot, hz: float) -> None:
+        super().__init__(
+            {name: r.robot for name, r in snap.robots.items()},
+            clock=MirrorClock(snap.t),
+            hz=1.0 / snap.frame_s,
+            origins={name: r.origin for name, r in snap.robots.items()},
+            limits={name: r.limits for name, r in snap.robots.items()},
+        )
+        self.travels = _Travels(list(snap.robots))  # type: ignore[assignment]
+        self.observers = []  # no collision checks here: the scene, and a trail when on
+        self.objects: dict[str, list[WorkcellObject]] = {}
+        for name, r in snap.robots.items():
+            state = self.robots[name]
+            state.q, state.target, state.opening = r.q, r.target, r.opening
+            state.tool, state.ghost = r.tool, r.ghost
+            state.markers.extend(r.markers)
+            self.objects[name] = list(r.objects)
+            self.moved(name, r.moving, r.seconds_left)
+
+    def moved(self, name: str, moving: bool, seconds_left: float) -> None:
+        travel = self.travels.by_robot[name]
+        travel.active = moving
+        travel.seconds_left = seconds_left  # type: ignore[attr-defined]
+
+
+class ForwardingSession(Session):
+    """The page's session of one robot in the page process: its lines go to the command
+    process (``send``), which runs them on its own page session."""
+
+    send: Any = None
+    """``send(message)``: puts a message on the channel (set once the channel is open)."""
+
+    def run(self, line: str) -> Reply | None:
+        """Hand ``line`` on; what it will do is assumed meanwhile (a slider's target, the
+        speed), so the page answers its tabs at once; the next frame says the truth."""
+        if self.send is not None:
+            self.send(["line", self.state.name, line])
+        words = line.split()
+        with contextlib.suppress(ValueError, IndexError, C2rvizError):
+            if words[0] == "speed":
+                self.speed = float(words[1])
+            elif words[0] == "move" and len(words) == 3:  # the page's slider: move I V
+                index = int(words[1])
+                value = self.to_si([index], [float(words[2])])[0]
+                target = list(self.state.target)
+                target[index] = value
+                self.state.target = tuple(target)
+        return None
+
+
+class PageProcess:
+    """The page process's state: the mirror, the scene, the channel."""
+
+    def __init__(self, hello: Hello, writer: asyncio.StreamWriter) -> None:
+        config, snap = hello.config, hello.snapshot
+        self.writer = writer
+        self.world = world = MirrorWorld(snap, config.hz)
+        self.services = Services(world, defaults=config.defaults, trail_points=config.trail_points)
+        world.observers = []  # drop what Services added (guards): the page only draws
+        self.services.watch.origin = snap.watch_origin
+        ForwardingSession.send = self.send
+        policy = DoorPolicy(config.origins, config.token, config.max_viewers)
+        self.scene = ViserScene(
+            self.services,
+            config.host,
+            config.port,
+            config.hz,
+            policy=policy,
+            title=config.title,
+            page_session=_forwarding,
+        )
+        self.scene.scheduler.rest_per_work = REST_PER_WORK
+        world.add_observers([self.scene])
+        self.apply_state(snap, fresh=True)
+
+    def send(self, message: list[Any]) -> None:
+        if not self.writer.is_closing():
+            self.writer.write(encode(message))
+
+    # what the command process says
+
+    def apply(self, message: list[Any]) -> bool:
+        """Apply one message; False: stop."""
+        kind = message[0]
+        if kind == "frame":
+            self.apply_frame(message[1], message[2], message[3])
+        elif kind == "state":
+            self.apply_state(pickle.loads(message[1]), fresh=False)
+        elif kind == "stop":
+            return False
+        return True
+
+    def apply_state(self, snap: Snapshot, fresh: bool) -> None:
+        world, scene = self.world, self.scene
+        assert isinstance(world.clock, MirrorClock)
+        world.clock.heard(snap.t)
+        for name, r in snap.robots.items():
+            state = world.robots[name]
+            if not fresh:
+                state.markers.clear()
+                scene.on_clear_markers(name)
+                for marker in r.markers:
+                    state.markers.append(marker)
+                    scene.on_marker(name, marker)
+                state.tool, state.ghost = r.tool, r.ghost
+                scene.on_tool(name, r.tool)
+                scene.on_ghost(name, r.ghost)
+            state.target = r.target
+            world.moved(name, r.moving, r.seconds_left)
+            self.sessions_speed(name, r.speed)
+            world._show(state, r.q, snap.t)
+            world._show_opening(state, r.opening, snap.t)
+            world.objects[name] = list(r.objects)
+            scene.on_objects(name, r.objects)
+            scene.on_collisions(name, r.collisions)
+        self.trails(snap.trails)
+        scene.on_clients(snap.clients)
+        for line, accepted in reversed(snap.commands):
+            scene.on_command("", line, accepted)
+
+    def sessions_speed(self, name: str, speed: float) -> None:
+        session = self.scene.sessions.get(name)
+        if session is not None:
+            session.speed = speed
+
+    def apply_frame(self, t: float, robots: list[Any], events: list[Any]) -> None:
+        world, scene = self.world, self.scene
+        assert isinstance(world.clock, MirrorClock)
+        world.clock.heard(t)
+        for name, samples, opening, target, moving, seconds_left, speed in robots:
+            state = world.robots.get(name)
+            if state is None:
+                continue
+            state.target = tuple(target)
+            world.moved(name, moving, seconds_left)
+            self.sessions_speed(name, speed)
+            for sample in samples:
+                world._show(state, tuple(sample[1:]), sample[0])
+            if opening != state.opening:
+                world._show_opening(state, opening, t)
+            scene.redraw(name)
+        for event in events:
+            self.apply_event(event)
+
+    def apply_event(self, event: list[Any]) -> None:
+        world, scene = self.world, self.scene
+        kind = event[0]
+        if kind == "marker":
+            _, name, position, wxyz, rgb, shape = event
+            marker = Marker(tuple(position), tuple(wxyz), tuple(rgb), shape)
+            world.robots[name].markers.append(marker)
+            scene.on_marker(name, marker)
+        elif kind == "clear":
+            world.robots[event[1]].markers.clear()
+            scene.on_clear_markers(event[1])
+        elif kind == "clients":
+            scene.on_clients(event[1])
+        elif kind == "command":
+            scene.on_command(event[1], event[2], event[3])
+        elif kind == "tool":
+            tool = pin.SE3(np.array(event[2], dtype=float).reshape(4, 4))
+            world.robots[event[1]].tool = tool
+            scene.on_tool(event[1], tool)
+        elif kind == "objects":
+            objects = pickle.loads(event[2])
+            world.objects[event[1]] = objects
+            scene.on_objects(event[1], objects)
+        elif kind == "collisions":
+            scene.on_collisions(event[1], [(a, b) for a, b in event[2]])
+        elif kind == "refused":
+            _, name, source, line, text, pair, target = event
+            scene.on_refused(name, source, line, _error(text, pair, target))
+        elif kind == "ghost":
+            world.robots[event[1]].ghost = event[2]
+            scene.on_ghost(event[1], event[2])
+        elif kind == "trails":
+            self.trails(event[1])
+        elif kind == "path":
+            travel = world.travels.by_robot[event[1]]
+            travel.path = None if event[2] is None else _Path(event[2])  # type: ignore[assignment]
+            scene.redraw(event[1])
+
+    def trails(self, on: Sequence[str]) -> None:
+        keeper = self.services.trails
+        for name in set(keeper.trails) - set(on):
+            keeper.stop(name)
+        for name in on:
+            if name not in keeper.trails and name in self.world.robots:
+                keeper.start(name)
+
+
+def _forwarding(services: Services, robot: str) -> Session:
+    session = ForwardingSession(services, source="page", robot=robot)
+    session.set_degrees(True)
+    return session
+
+
+def _error(text: str, pair: list[str] | None, target: list[float] | None) -> C2rvizError:
+    """A refusal as the command process told it (a guard's keeps its pair and target)."""
+    if pair is None:
+        return C2rvizError(text)
+    error = PathCollides(pair[0], pair[1], 1.0, True, target)
+    error.args = (text,)
+    return error
+
+
+async def serve(sock: socket.socket) -> int:
+    """Serve the page until told to stop or the channel ends; the exit status."""
+    loop = asyncio.get_running_loop()
+    reader, writer = await asyncio.open_connection(sock=sock)
+    frames = FrameReader()
+    stop = asyncio.Event()
+    for sig in (signal.SIGTERM, signal.SIGINT):
+        loop.add_signal_handler(sig, stop.set)
+    page: PageProcess | None = None
+    pending: list[list[Any]] = []
+    reading = asyncio.ensure_future(reader.read(1 << 16))
+    stopping = asyncio.ensure_future(stop.wait())
+    try:
+        while True:
+            done, _ = await asyncio.wait({reading, stopping}, return_when=asyncio.FIRST_COMPLETED)
+            if stopping in done:
+                return 0
+            data = reading.result()
+            if not data:
+                return 0
+            pending += frames.feed(data)
+            reading = asyncio.ensure_future(reader.read(1 << 16))
+            while pending:
+                message = pending.pop(0)
+                if page is None:
+                    if message[0] != "hello":
+                        continue
+                    hello = pickle.loads(message[1])
+                    logging.getLogger().setLevel(hello.config.log_level)
+                    try:
+                        page = PageProcess(hello, writer)
+                    except OSError as exc:
+                        writer.write(encode(["error", exc.errno or 0, str(exc.strerror or exc)]))
+                        await writer.drain()
+                        return 1
+                    page.scene.start(loop)
+                    writer.write(encode(["ready", page.scene.port, page.scene.url or ""]))
+                elif not page.apply(message):
+                    return 0
+    finally:
+        reading.cancel()
+        stopping.cancel()
+        if page is not None:
+            page.scene.stop()
+        writer.close()
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m c2rviz.view.page_process FD``: serve the page over channel FD."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    if len(args) != 1 or not args[0].isdigit():
+        print("usage: python -m c2rviz.view.page_process FD (started by c2rviz)", file=sys.stderr)
+        return 2
+    logging.basicConfig(level=logging.WARNING, format="c2rviz: %(levelname)s: %(message)s")
+    sock = socket.socket(fileno=int(args[0]))
+    try:
+        return asyncio.run(serve(sock))
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
