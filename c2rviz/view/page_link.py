@@ -100,7 +100,7 @@ class PageLink(Scene):
         for name in world.robots:
             session = Session(services, source="page", robot=name)
             session.set_degrees(True)
-            session.motion = "off" if services.defaults.motion == "off" else "follow"
+            session.set_motion("off" if services.defaults.motion == "off" else "follow")
             self.sessions[name] = session
         self._samples: dict[str, deque[list[float]]] = {
             name: deque(maxlen=SAMPLES_KEPT) for name in world.robots

@@ -23,7 +23,7 @@ import signal
 import socket
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -134,18 +134,20 @@ class ForwardingSession(Session):
     """The page's session of one robot in the page process: its lines go to the command
     process (``send``), which runs them on its own page session."""
 
-    send: Any = None
-    """``send(message)``: puts a message on the channel (set once the channel is open)."""
+    def __init__(self, services: Services, robot: str, send: Callable[[list[Any]], None]) -> None:
+        """The page's session of ``robot``; ``send(message)`` puts a message on the channel."""
+        super().__init__(services, source="page", robot=robot)
+        self.send = send
+        self.set_degrees(True)
 
     def run(self, line: str) -> Reply | None:
         """Hand ``line`` on; what it will do is assumed meanwhile (a slider's target, the
         speed), so the page answers its tabs at once; the next frame says the truth."""
-        if self.send is not None:
-            self.send(["line", self.state.name, line])
+        self.send(["line", self.state.name, line])
         words = line.split()
         with contextlib.suppress(ValueError, IndexError, C2rvizError):
             if words[0] == "speed":
-                self.speed = float(words[1])
+                self.set_speed(float(words[1]))
             elif words[0] == "move" and len(words) == 3:  # the page's slider: move I V
                 index = int(words[1])
                 value = self.to_si([index], [float(words[2])])[0]
@@ -165,7 +167,6 @@ class PageProcess:
         self.services = Services(world, defaults=config.defaults, trail_points=config.trail_points)
         world.observers = []  # drop what Services added (guards): the page only draws
         self.services.watch.origin = snap.watch_origin
-        ForwardingSession.send = self.send
         policy = DoorPolicy(config.origins, config.token, config.max_viewers)
         self.scene = ViserScene(
             self.services,
@@ -174,7 +175,7 @@ class PageProcess:
             config.hz,
             policy=policy,
             title=config.title,
-            page_session=_forwarding,
+            page_session=lambda services, robot: ForwardingSession(services, robot, self.send),
         )
         self.scene.scheduler.rest_per_work = REST_PER_WORK
         world.add_observers([self.scene])
@@ -228,7 +229,7 @@ class PageProcess:
     def sessions_speed(self, name: str, speed: float) -> None:
         session = self.scene.sessions.get(name)
         if session is not None:
-            session.speed = speed
+            session.set_speed(speed)
 
     def apply_frame(self, t: float, robots: list[Any], events: list[Any]) -> None:
         world, scene = self.world, self.scene
@@ -294,12 +295,6 @@ class PageProcess:
         for name in on:
             if name not in keeper.trails and name in self.world.robots:
                 keeper.start(name)
-
-
-def _forwarding(services: Services, robot: str) -> Session:
-    session = ForwardingSession(services, source="page", robot=robot)
-    session.set_degrees(True)
-    return session
 
 
 def _error(text: str, pair: list[str] | None, target: list[float] | None) -> C2rvizError:

@@ -305,6 +305,7 @@ class ViserScene(Scene):
 
     def on_cameras(self, cameras: Sequence[Camera]) -> None:
         self._cameras = list(cameras)
+        self.scheduler.request()
 
     def redraw(self, robot: str) -> None:
         """Draw ``robot`` at the next send (its target or motion changed)."""
