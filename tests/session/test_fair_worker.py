@@ -309,6 +309,16 @@ def test_a_stop_in_the_same_read_as_its_plan_cancels_it(server: ServerThread, ch
     assert planner.read_line() == "ok"
 
 
+def test_a_stop_behind_a_sleep_or_an_arrival_waits_its_turn(server: ServerThread, connect):
+    """Read ahead, a ``stop`` cuts short only plans: a ``sleep`` or a move's arrival
+    ahead of it answers as before, then the ``stop``."""
+    client = connect(server)
+    assert client.ask("motion on") == "ok"
+    client.send("sleep 0.2\nstop\njoints 0.2,0,0,0,0,0,0\nstop\nwhere\n")
+    replies = [client.read_line() for _ in range(5)]
+    assert replies == ["ok", "ok", "ok", "ok", "ok 0.2,0,0,0,0,0,0"]
+
+
 def test_a_closed_connections_plan_frees_the_plan_lane(server: ServerThread, chimney):
     """The text port sees a client close behind its plan's reply: the plan stops, and the
     lane (one thread here) serves the next client's plan."""
