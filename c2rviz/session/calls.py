@@ -39,6 +39,7 @@ __all__ = [
     "Plan",
     "WaypointError",
     "check_path",
+    "check_trajectory",
     "plan_through",
     "plan_to",
     "play",
@@ -119,18 +120,41 @@ def play(session: Session, plan: Plan, speed: float | None) -> Reply:
     return play_straight(session, line, speed)
 
 
-def play_trajectory(session: Session, planned: PlannedTrajectory) -> Reply:
+def play_trajectory(session: Session, planned: PlannedTrajectory, checked: bool = False) -> Reply:
     """``Session.play_trajectory``: see there."""
     world, state = session.world, session.state
+    if session.guard and not checked:
+        _trajectory_check(session, planned, MoveChecker())()
+    world.travels.play(state, TrajectoryPlay(planned, world.clock.now()), session.source, False)
+    return replies.OK
+
+
+async def check_trajectory(session: Session, planned: PlannedTrajectory) -> None:
+    """``Session.check_trajectory``: see there."""
     if session.guard:
-        count = min(MAX_TRAJECTORY_CHECKS, max(2, int(planned.duration / world.frame_s) + 1))
+        await session.services.worker.run(_trajectory_check(session, planned), owner=session)
+
+
+def _trajectory_check(
+    session: Session, planned: PlannedTrajectory, checker: MoveChecker | None = None
+) -> Callable[[], None]:
+    """The guard's check of ``planned`` against the cell now: at most
+    ``MAX_TRAJECTORY_CHECKS`` instants and every knot, sampled where it runs (``checker``
+    given: here; else on the worker's thread, with its own checker)."""
+    count = min(MAX_TRAJECTORY_CHECKS, max(2, int(planned.duration / session.world.frame_s) + 1))
+    q = tuple(planned.sample(planned.duration).tolist())
+    start = session.now()
+    asked = request(session, start, [q])
+    chosen = checker if checker is not None else checker_of(session.services.worker)
+
+    def check() -> None:
         times = np.unique(
             np.concatenate([np.linspace(0.0, planned.duration, count), planned.times])
         )
-        path = [tuple(planned.sample(float(s)).tolist()) for s in times]
-        check_path(session, path[-1], path=path)
-    world.travels.play(state, TrajectoryPlay(planned, world.clock.now()), session.source, False)
-    return replies.OK
+        path = np.array([planned.sample(float(s)) for s in times], dtype=float)
+        _check(chosen, asked, start, path, False, q)
+
+    return check
 
 
 def check_path(session: Session, q: Sequence[float], path: Sequence[Sequence[float]] = ()) -> None:

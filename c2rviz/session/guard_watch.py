@@ -24,6 +24,7 @@ import functools
 import logging
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -32,6 +33,7 @@ from ..collision.model import CollisionModel, Pair
 from ..collision.other_robots import first_hit_between
 from ..motion.path_play import PathPlay
 from ..planning import EdgeResolution, MoveChecker, MoveRequest, first_blocked
+from ..world.clock import Hold
 from ..world.effects import Observer
 from ..world.world import World
 from .worker import Superseded, Worker, WorkerBusy
@@ -169,6 +171,9 @@ class GuardWatch(Observer):
         )
         checker = self._checker()
         self._rechecking[robot] = None
+        # a virtual clock stands still until the re-check answers (else nobody holds it: it
+        # would jump to the move's end while the check runs, through what it finds)
+        hold = world.clock.hold()
         try:
             done = self.worker.run(
                 functools.partial(_first_hit, checker, snapshot),
@@ -179,6 +184,7 @@ class GuardWatch(Observer):
             done = asyncio.get_running_loop().create_future()
             done.set_result(None)
         done.add_done_callback(functools.partial(self._checked, robot, run, cause))
+        done.add_done_callback(functools.partial(_let_go, hold))
 
     def _checker(self) -> MoveChecker:
         checker = self.worker.cache.get("moves")
@@ -245,3 +251,8 @@ def _first_hit(checker: MoveChecker, snap: _Recheck) -> Hit | None:
                 hit = (float(t), found[1])
                 break
     return hit
+
+
+def _let_go(hold: Hold, done: asyncio.Future[Any]) -> None:
+    """A re-check answered (its ``_checked`` ran first): time may run on."""
+    hold.close()

@@ -195,10 +195,13 @@ class Lane:
         self, loop: asyncio.AbstractEventLoop, job: Job, result: asyncio.Future[Any]
     ) -> None:
         self.running.remove(job)
+        # read the outcome even when nobody awaits it any more (its client went away), or
+        # asyncio logs "Future exception was never retrieved"
+        error = None if result.cancelled() else result.exception()
         if not job.future.done():
             if result.cancelled():
                 job.future.cancel()
-            elif (error := result.exception()) is not None:
+            elif error is not None:
                 job.future.set_exception(error)
             else:
                 job.future.set_result(result.result())

@@ -239,11 +239,26 @@ class Session(UnitEdge, Modes):
         return recorded(self, said, functools.partial(calls.play, self, plan, speed))
 
     def play_trajectory(
-        self, trajectory: PlannedTrajectory, *, said: str | Said | None = None
+        self,
+        trajectory: PlannedTrajectory,
+        *,
+        checked: bool = False,
+        said: str | Said | None = None,
     ) -> Reply:
         """Play a checked timed trajectory from now (the arm at rest at its start), checked
-        for collisions first with the guard (``calls.MAX_TRAJECTORY_CHECKS`` instants)."""
-        return recorded(self, said, functools.partial(calls.play_trajectory, self, trajectory))
+        for collisions first with the guard (``calls.MAX_TRAJECTORY_CHECKS`` instants) unless
+        ``checked`` (``check_trajectory`` checked it, off the loop, just before)."""
+        play = functools.partial(calls.play_trajectory, self, trajectory, checked)
+        return recorded(self, said, play)
+
+    async def check_trajectory(self, trajectory: PlannedTrajectory) -> None:
+        """With the guard, check ``trajectory`` for collisions as ``play_trajectory`` would,
+        off the loop on the session's worker; nothing moves.
+
+        Raises:
+            PathCollides: an instant of it collides.
+        """
+        await calls.check_trajectory(self, trajectory)
 
     def stop(self, *, fingers: bool = False, said: str | Said | None = None) -> Reply:
         """Brake the arm to rest within its limits (``fingers``: stop the gripper too)."""

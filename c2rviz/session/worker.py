@@ -43,7 +43,7 @@ from collections.abc import Callable, Hashable
 from typing import Any, TypeVar
 
 from ..ik.solver import IkSolver
-from ..planning.cancel import Cancel
+from ..planning.cancel import Cancel, PlanCancelled
 from ..world.state import RobotState
 from .lanes import Job, Lane, Superseded, WorkerBusy
 
@@ -87,6 +87,7 @@ class Worker:
         self.work = Lane("work", 1, max_queue, MAX_PER_OWNER)
         self.plans = Lane("plan", plan_threads, max_queue, MAX_PER_OWNER, one_per_owner=True)
         self._solvers: dict[str, IkSolver] = {}
+        self._halted: dict[object, str] = {}  # owners whose plans are cancelled as they come
         self.cache: dict[Hashable, Any] = {}
         """What work-lane jobs keep between runs (checkers by robot); use it on that thread."""
         if sys.getswitchinterval() > SWITCH_S:
@@ -171,6 +172,9 @@ class Worker:
         if lane.closed:
             future.cancel()
             return future
+        if lane is self.plans and owner in self._halted:
+            future.set_exception(PlanCancelled(self._halted[owner]))
+            return future
         if key is not None:
             self.work.supersede(key)
             self.plans.supersede(key)
@@ -182,6 +186,21 @@ class Worker:
         """Stop ``owner``'s plans, waiting or searching (``stop``, its client closing): they
         end with ``PlanCancelled``; how many were stopped."""
         return self.plans.cancel(owner, why)
+
+    def planning(self, owner: object) -> bool:
+        """``owner`` has a plan waiting or searching."""
+        plans = self.plans
+        return any(job.owner is owner for job in (*plans.running, *plans.jobs()))
+
+    def halt(self, owner: object, why: str) -> None:
+        """Stop ``owner``'s plans (``cancel``) and every plan it sends until ``go_on``: its
+        client's ``stop`` or close was seen behind a reply that waits (``tcp_text``)."""
+        self.cancel(owner, why)
+        self._halted[owner] = why
+
+    def go_on(self, owner: object) -> None:
+        """``owner``'s plans run again (the ``stop`` that halted them has had its turn)."""
+        self._halted.pop(owner, None)
 
     def close(self) -> None:
         """The program stops: no more work (queued work is dropped, plans are stopped)."""

@@ -23,9 +23,11 @@ from typing import Protocol
 
 from ..errors import C2rvizError, LineTooLong
 from ..observers.watch import STREAM_ALLOWANCE_BYTES
+from ..planning.cancel import STOPPED, WENT_AWAY
 from ..protocol import replies
 from ..protocol.framing import Line, LineFramer
 from ..protocol.grammar import ForeignProtocol, parse_line
+from ..protocol.verbs.motion import Stop
 from ..session.services import Services
 from ..session.session import BATCHED, Session
 from ..session.settings import ServerLimits
@@ -55,8 +57,12 @@ class Connection(asyncio.Protocol):
     """One TCP client: its buffer, its session and its timers.
 
     Lines run in order. A reply that waits (an awaitable from the handler, such as
-    ``sleep``'s) stops reading: the lines read behind it wait in ``backlog`` and run
-    when it comes, while other connections go on.
+    ``sleep``'s) holds the lines read behind it in ``backlog`` (and the framer) until it
+    comes, while other connections go on. Reading goes on behind it, up to
+    ``LOOK_AHEAD_BYTES`` buffered, to see two things at once: a ``stop`` line cancels the
+    connection's plans (searching, and those it sent before the ``stop``: ``Worker.halt``;
+    the ``stop`` itself still runs in its turn), and the end of the stream cancels them
+    all (its client went away: the plan lane is free for the others).
     """
 
     def __init__(self, server: Host) -> None:
@@ -73,6 +79,8 @@ class Connection(asyncio.Protocol):
         self.linger_timer: asyncio.TimerHandle | None = None
         self.closing = False
         self.eof = False
+        self.halted = False  # a stop or the end was seen ahead: this client's plans stop
+        self.scanned = 0  # bytes of the framer's buffer looked at ahead for a `stop`
         self.closed = asyncio.get_running_loop().create_future()
         self.stream = server.services.watch.open(self.session, self)  # idle until `watch`
         clock = server.services.world.clock
@@ -113,6 +121,7 @@ class Connection(asyncio.Protocol):
         self.server.services.watch.close(self.session)
         if self.pending is not None:
             self.pending.cancel()
+        self.server.services.worker.go_on(self.session)
         server = self.server
         server.open.discard(self)
         if self in server.connections:
@@ -125,6 +134,10 @@ class Connection(asyncio.Protocol):
     def data_received(self, data: bytes) -> None:
         if self.closing:
             return
+        if self.pending is not None:  # read ahead behind a reply (the class's docstring)
+            self.framer.feed(data)
+            self._look_ahead()
+            return
         self.hold.take()  # it speaks: busy (it may have only listened since `watch`)
         self.framer.feed(data)
         if not self.waiting:  # else reading is paused; the wake-up goes on from here
@@ -134,6 +147,9 @@ class Connection(asyncio.Protocol):
         self.eof = True
         if self.closing:
             return False  # done lingering: asyncio closes the transport
+        if self.pending is not None:  # it went away (or sends no more): its plans stop
+            self.halted = True
+            self.server.services.worker.halt(self.session, WENT_AWAY)
         if not self.waiting:
             self._finish()
         return True  # keep the write side open until the replies are out
@@ -201,6 +217,9 @@ class Connection(asyncio.Protocol):
             try:
                 if not isinstance(line, str):
                     raise line
+                if self.halted and not self.eof and _is_stop(line):
+                    self.halted = False  # its turn: the plans sent after it run
+                    session.services.worker.go_on(session)
                 if line.startswith(BATCHED):
                     taken = batch(lines, i)
                     if taken:
@@ -247,10 +266,45 @@ class Connection(asyncio.Protocol):
     def _wait(self, answer: Awaitable[str], rest: Sequence[Line]) -> None:
         """Stop reading until ``answer`` is ready; then reply and run ``rest``."""
         self.backlog = rest
-        self._pause_reading()
         pending = asyncio.ensure_future(answer)
         self.pending = pending
         pending.add_done_callback(self._answered)
+        self.scanned = 0
+        if not self.halted and any(map(_is_stop, rest)):
+            self._stop_ahead()
+        self._look_ahead()
+
+    def _look_ahead(self) -> None:
+        """Behind a reply that waits: act on a ``stop`` read ahead (``_stop_ahead``), and
+        stop reading once ``LOOK_AHEAD_BYTES`` wait (the lines run in their turn)."""
+        framer = self.framer
+        buffer = framer.buffer
+        if not self.halted:
+            cut = buffer.rfind(b"\n")
+            if cut >= self.scanned:
+                fresh = framer.decode(buffer[self.scanned : cut])
+                self.scanned = cut + 1
+                if any(map(_is_stop, fresh)):
+                    self._stop_ahead()
+        transport = self.transport
+        if transport is None or self.closing:
+            return
+        if len(buffer) >= LOOK_AHEAD_BYTES:
+            if transport.is_reading():
+                transport.pause_reading()
+        elif not self.eof and not transport.is_reading():  # (paused by a yield or the bound)
+            transport.resume_reading()
+
+    def _stop_ahead(self) -> None:
+        """A ``stop`` waits behind the reply: its plan stops now, through the session's
+        ``stop`` if one searches, and so do the plans sent before the ``stop``."""
+        session, worker = self.session, self.session.services.worker
+        self.halted = True
+        if worker.planning(session):
+            braked = session.stop()
+            if not isinstance(braked, str):  # (the arm was moving: its rest is not awaited)
+                asyncio.ensure_future(braked).add_done_callback(_quiet)
+        worker.halt(session, STOPPED)
 
     def _answered(self, pending: asyncio.Future[str]) -> None:
         if pending is not self.pending:
@@ -284,6 +338,7 @@ class Connection(asyncio.Protocol):
     def _go_on(self) -> None:
         """Run the lines that waited, then what is buffered; resume reading when done."""
         backlog, self.backlog = self.backlog, []
+        self.scanned = 0
         self._run(backlog)
         if self.closing or self.waiting:
             return
@@ -387,6 +442,22 @@ class Connection(asyncio.Protocol):
         return sum(map(_is_command, chain(rest, self.framer.complete())))
 
 
+def _is_stop(line: Line) -> bool:
+    """True for a ``stop`` line."""
+    if not isinstance(line, str) or "stop" not in line.lower():
+        return False
+    try:
+        return isinstance(parse_line(line), Stop)
+    except C2rvizError:
+        return False
+
+
+def _quiet(future: asyncio.Future[str]) -> None:
+    """A reply nobody awaits: read its outcome (asyncio logs one never read)."""
+    if not future.cancelled():
+        future.exception()
+
+
 def _is_command(line: Line) -> bool:
     """True for a line that would get a reply (not blank, not only a comment)."""
     if not isinstance(line, str):
@@ -398,5 +469,6 @@ def _is_command(line: Line) -> bool:
 
 
 TURN_S = 0.002  # work per client per loop turn [s]: then the others go first
+LOOK_AHEAD_BYTES = 16384  # read behind a reply that waits at most [bytes], then reading pauses
 _TURN_CHECK = 32  # lines between looks at the clock
 _LINGER_S = 2.0  # after the last reply, how long a closing client's input is read and dropped

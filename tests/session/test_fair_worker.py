@@ -286,6 +286,52 @@ def test_stop_and_a_newer_plan_cancel_a_plan(server: ServerThread, chimney):
     assert server.q == (0.0,) * 7
 
 
+def test_a_stop_sent_behind_a_plan_cancels_it_at_once(server: ServerThread, chimney):
+    """The text port reads on behind a plan's reply: the ``stop`` the client sent after its
+    ``plan`` stops the search now (not after its 15 s), and still answers in its turn."""
+    planner = chimney("plan timeout 15")
+    planner.send(f"plan joints {GOAL}\n")
+    (plan,) = wait_for_plans(server, 1)
+    planner.send("stop\nwhere\n")
+    assert planner.read_line() == f"error: plan cancelled ({STOPPED}); nothing moved"
+    assert planner.read_line() == "ok"  # the stop, in its turn
+    assert planner.read_line() == "ok 0,0,0,0,0,0,0"  # nothing moved
+    assert plan.cancel() and plan.cancel.why == STOPPED
+    assert planner.ask("plan timeout 0.2") == "ok"  # after the stop's turn, plans run again
+    reply = planner.ask(f"plan joints {GOAL}")
+    assert reply.startswith("error: ") and "cancelled" not in reply  # its own search's end
+
+
+def test_a_stop_in_the_same_read_as_its_plan_cancels_it(server: ServerThread, chimney):
+    planner = chimney("plan timeout 15")
+    planner.send(f"plan joints {GOAL}\nstop\n")
+    assert planner.read_line() == f"error: plan cancelled ({STOPPED}); nothing moved"
+    assert planner.read_line() == "ok"
+
+
+def test_a_stop_behind_a_sleep_or_an_arrival_waits_its_turn(server: ServerThread, connect):
+    """Read ahead, a ``stop`` cuts short only plans: a ``sleep`` or a move's arrival
+    ahead of it answers as before, then the ``stop``."""
+    client = connect(server)
+    assert client.ask("motion on") == "ok"
+    client.send("sleep 0.2\nstop\njoints 0.2,0,0,0,0,0,0\nstop\nwhere\n")
+    replies = [client.read_line() for _ in range(5)]
+    assert replies == ["ok", "ok", "ok", "ok", "ok 0.2,0,0,0,0,0,0"]
+
+
+def test_a_closed_connections_plan_frees_the_plan_lane(server: ServerThread, chimney):
+    """The text port sees a client close behind its plan's reply: the plan stops, and the
+    lane (one thread here) serves the next client's plan."""
+    server.call(lambda: setattr(server.services.worker.plans, "threads", 1))
+    planner, other = chimney("plan timeout 15"), chimney("plan timeout 0.2")
+    planner.send(f"plan joints {GOAL}\n")
+    (plan,) = wait_for_plans(server, 1)
+    planner.close()
+    reply = other.ask(f"plan joints {GOAL}")  # waits for the lane's one thread
+    assert plan.cancel() and plan.cancel.why == WENT_AWAY
+    assert reply.startswith("error: ") and "cancelled" not in reply  # its own search's end
+
+
 def test_plan_shows_the_path_of_the_last_guard_plan_move(server: ServerThread, connect):
     client = connect(server)
     for line in ("degrees", "guard plan", "motion on", "speed 100"):

@@ -101,3 +101,34 @@ def test_a_cancelled_job_is_skipped_and_close_cancels_the_rest() -> None:
         assert worker.run(lambda: 3).cancelled()
 
     run(main())
+
+
+def test_a_failed_job_whose_reply_was_cancelled_logs_nothing_at_close() -> None:
+    """The executor's exception is read even when nobody awaits the job any more (its
+    client went away): asyncio logs no "Future exception was never retrieved"."""
+    import gc
+
+    seen: list[dict[str, object]] = []
+
+    async def main() -> None:
+        asyncio.get_running_loop().set_exception_handler(lambda _loop, ctx: seen.append(ctx))
+        worker = Worker()
+        gate = threading.Event()
+
+        def boom() -> None:
+            gate.wait()
+            raise ValueError("boom after its client left")
+
+        future = worker.run(boom, owner="client")
+        await asyncio.sleep(0)
+        future.cancel()  # the client closed while it ran
+        after = worker.run(lambda: "next")  # the lane's thread is free again after boom
+        gate.set()
+        assert await after == "next"
+        worker.close()
+        gc.collect()
+        await asyncio.sleep(0)
+
+    run(main())
+    gc.collect()
+    assert not [ctx for ctx in seen if "never retrieved" in str(ctx.get("message"))], seen

@@ -95,12 +95,15 @@ def joint_command(session: Session, command: JointPositions) -> None:
     session.set_joints(q, said=said)  # motion on: nobody waits for the arrival
 
 
-def joint_trajectory(session: Session, trajectory: JointTrajectory) -> None:
-    """Check ``trajectory`` whole, then play it from now on the world's clock.
+async def joint_trajectory(session: Session, trajectory: JointTrajectory) -> None:
+    """Check ``trajectory`` whole, then play it from now on the world's clock. Its plan,
+    its limit check and (``guard on``) its collision check run off the event loop, on the
+    session's worker: a trajectory of thousands of points stalls no other client.
 
     Raises:
         UnknownJointName: A name that is not a chain joint.
-        ArmMoved: The arm is moving (a trajectory starts from rest).
+        ArmMoved: The arm is moving (a trajectory starts from rest), or it moved (another
+            door drives it) while the trajectory was checked.
         TrajectoryError: A point or an instant between points breaks a limit.
         PathCollides: With ``guard on``, an instant of it collides.
     """
@@ -109,22 +112,34 @@ def joint_trajectory(session: Session, trajectory: JointTrajectory) -> None:
         f"/joint_trajectory {len(points)} points, {points[-1].time_from_start_s:g} s"
     )
     try:
-        planned = _plan(session, trajectory)
+        start, planned = await _plan(session, trajectory)
+        await session.check_trajectory(planned)
+        _at_rest(session, start)  # (another door may have moved it meanwhile)
     except C2rvizError as error:
         said.refuse(error)
         raise
-    session.play_trajectory(planned, said=said)
+    session.play_trajectory(planned, checked=True, said=said)
 
 
-def _plan(session: Session, trajectory: JointTrajectory) -> PlannedTrajectory:
-    indices = _indices(session, "joint_names", trajectory.joint_names)
-    if session.travel.active:
+def _at_rest(session: Session, start: np.ndarray | None = None) -> None:
+    """A trajectory starts from rest (at ``start``, where it was planned from)."""
+    if session.travel.active or (start is not None and not np.array_equal(session.state.q, start)):
         raise ArmMoved(
             "a trajectory starts from rest and the arm is moving: send stop (or wait) first"
         )
+
+
+async def _plan(
+    session: Session, trajectory: JointTrajectory
+) -> tuple[np.ndarray, PlannedTrajectory]:
+    """Where the arm starts, and the trajectory planned and checked against the limits
+    from there on the session's worker."""
+    indices = _indices(session, "joint_names", trajectory.joint_names)
+    _at_rest(session)
     robot, state, world = session.robot, session.state, session.world
     start = np.asarray(state.q, dtype=float)
     zeros = np.zeros(robot.n)
+    limits = world.motion_limits(state.name)
 
     def chain(values: Sequence[float], base: np.ndarray) -> np.ndarray:
         full = base.copy()
@@ -134,14 +149,17 @@ def _plan(session: Session, trajectory: JointTrajectory) -> PlannedTrajectory:
     def given(values: Sequence[float] | None) -> np.ndarray | None:
         return None if values is None else chain(values, zeros)
 
-    points = trajectory.points
-    return plan_trajectory(
-        start,
-        [p.time_from_start_s for p in points],
-        [chain(p.positions, start) for p in points],
-        [given(p.velocities) for p in points],
-        [given(p.accelerations) for p in points],
-        world.motion_limits(state.name),
-        robot.joint_names,
-        _units(robot),
-    )
+    def plan() -> PlannedTrajectory:
+        points = trajectory.points
+        return plan_trajectory(
+            start,
+            [p.time_from_start_s for p in points],
+            [chain(p.positions, start) for p in points],
+            [given(p.velocities) for p in points],
+            [given(p.accelerations) for p in points],
+            limits,
+            robot.joint_names,
+            _units(robot),
+        )
+
+    return start, await session.services.worker.run(plan, owner=session)

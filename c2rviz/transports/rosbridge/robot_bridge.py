@@ -179,7 +179,7 @@ class RobotBridge:
         elif kind == "joint_command":
             joint_command(self.lines.session(source, robot), read_joint_positions(msg))
         else:
-            joint_trajectory(self.lines.session(source, robot), read_joint_trajectory(msg))
+            await joint_trajectory(self.lines.session(source, robot), read_joint_trajectory(msg))
 
     async def call_service(self, source: str, service: str, args: dict[str, Any]) -> dict[str, Any]:
         robot = self._services.get(service)

@@ -205,3 +205,38 @@ def test_a_foreign_browser_and_a_missing_token_are_refused() -> None:
             assert command(ok, "where")["values"]["ok"]
     finally:
         server.stop()
+
+
+def test_a_trajectorys_plan_and_checks_run_off_the_loop(
+    world_server: WorldServer, ws: ClientConnection, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Issue 35, stall 3: a long trajectory's plan, limit check and guard check run on the
+    session's worker, not on the event loop (whose other clients would wait for them)."""
+    import threading
+
+    from c2rviz.session import calls
+    from c2rviz.transports.rosbridge import joint_inputs
+
+    threads: list[tuple[str, str]] = []
+
+    def spy(name: str, real: Any) -> Any:
+        def wrapped(*args: Any, **kwargs: Any) -> Any:
+            threads.append((name, threading.current_thread().name))
+            return real(*args, **kwargs)
+
+        return wrapped
+
+    monkeypatch.setattr(joint_inputs, "plan_trajectory", spy("plan", joint_inputs.plan_trajectory))
+    monkeypatch.setattr(calls, "_check", spy("check", calls._check))
+    assert command(ws, "guard on")["values"]["ok"]
+    assert command(ws, "object wall box 0.05,2,2 0.6,0,0.9,0,0,0")["values"]["ok"]
+    swing = trajectory((2.0, [0.0, 1.2]), (4.0, [0.0, 0.0]))  # through the wall and back
+    status = ask(ws, publish("/joint_trajectory", swing))
+    assert "would hit wall" in status["msg"]  # the same refusal
+    assert world_server.q() == HOME
+    assert [name for name, _ in threads] == ["plan", "check"]
+    assert all(thread.startswith("c2rviz-work") for _, thread in threads), threads
+    ws.send(publish("/joint_trajectory", trajectory((1.0, [0.1, 0.1]))))  # taken, then played
+    assert command(ws, "where")["values"]["ok"]
+    assert [name for name, _ in threads] == ["plan", "check"] * 2
+    assert all(thread.startswith("c2rviz-work") for _, thread in threads), threads
