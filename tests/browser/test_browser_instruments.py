@@ -126,21 +126,26 @@ def test_looking_back_in_the_live_page_shows_the_arm_as_the_csv_has_it(
         page,
         tcp,
     ):
-        watcher = socket.create_connection(("127.0.0.1", proc.port), timeout=60)
-        stream = watcher.makefile("rb")
-        watcher.sendall(b"watch\n")
-        assert stream.readline() == b"ok\n"
-        for line in ("record take", "degrees", "motion on", "speed 40"):
-            assert tcp.ask(line).startswith("ok"), line
-        assert tcp.ask("j 90,45,0,-30,0,60,0") == "ok"  # the reply comes on arrival
-        assert tcp.ask("record stop").startswith("ok recorded take")
-        watcher.sendall(b"unwatch\n")
-        states = []  # (T [s since the server started], q [rad]) of every frame of the move
-        for raw in iter(stream.readline, b"ok\n"):
-            words = raw.decode().split()
-            if words[0] == "state":  # the watcher speaks radians
-                states.append((float(words[1]), np.array([float(v) for v in words[2].split(",")])))
-        watcher.close()
+        # Both closed here: a socket closed while its file is open stays open until the
+        # file is collected, and the garbage collector's ResourceWarning then failed
+        # whichever test ran next (test_ghost_off_hides_..., at its setup).
+        with (
+            socket.create_connection(("127.0.0.1", proc.port), timeout=60) as watcher,
+            watcher.makefile("rb") as stream,
+        ):
+            watcher.sendall(b"watch\n")
+            assert stream.readline() == b"ok\n"
+            for line in ("record take", "degrees", "motion on", "speed 40"):
+                assert tcp.ask(line).startswith("ok"), line
+            assert tcp.ask("j 90,45,0,-30,0,60,0") == "ok"  # the reply comes on arrival
+            assert tcp.ask("record stop").startswith("ok recorded take")
+            watcher.sendall(b"unwatch\n")
+            states = []  # (T [s since the server started], q [rad]) of every frame of the move
+            for raw in iter(stream.readline, b"ok\n"):
+                words = raw.decode().split()
+                if words[0] == "state":  # the watcher speaks radians
+                    q = np.array([float(v) for v in words[2].split(",")])
+                    states.append((float(words[1]), q))
         assert len(states) > 50
         with open(tmp_path / "take.csv", newline="") as file:
             rows = np.array(list(csv.reader(file))[1:], dtype=float)[:, 1:8]

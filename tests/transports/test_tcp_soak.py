@@ -127,8 +127,10 @@ def is_command(line: bytes) -> bool:
 
 
 def drive(server, k: int, lines: list[bytes], expected: list[str], problems: list[str]) -> None:
-    with socket.create_connection((server.host, server.port), timeout=30) as sock:
-        stream = sock.makefile("rb")
+    with (
+        socket.create_connection((server.host, server.port), timeout=30) as sock,
+        sock.makefile("rb") as stream,  # closed with it: no socket left for the collector
+    ):
         wanted = iter(expected)
         for start in range(0, len(lines), BATCH):
             batch = lines[start : start + BATCH]
