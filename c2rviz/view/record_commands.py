@@ -2,14 +2,15 @@
 
 ``read_commands`` streams the command file the recorder wrote (``radians``,
 ``motion off``, then ``joints``, ``sleep``, ``mark``, ``color``, ``marker``,
-``clear`` and, when a recording holds them, ``object`` lines) in
+``clear`` and, when a recording holds them, ``object``, ``part`` and ``grip`` lines) in
 ``record_rows.CHUNK_BYTES`` pieces. Most of a long recording is ``joints`` and
 ``sleep`` lines: a piece with nothing else in it costs a regular-expression pass
 to add up its sleeps. The rest is parsed line by line (``protocol.parse_line``).
 
 It returns the markers' changes and the objects' changes, each timed by the
 sleeps before it (at most ``MAX_HTML_MARKS`` and ``MAX_HTML_OBJECTS`` distinct
-objects; the rest is left out and said), the header's robot and duration, the
+objects; the rest is left out and said), each part's shape (its first ``part`` line
+adding it: NAME.csv has its poses), the header's robot and duration, the
 time the sleeps add up to and the last ``joints`` line, which the page checks
 against NAME.csv: a command file that does not belong to its frames is said in
 the page.
@@ -29,15 +30,26 @@ from ..protocol.grammar import MARKER_SHAPES, parse_line
 from ..protocol.verbs.connection import Sleep
 from ..protocol.verbs.joints import Units
 from ..protocol.verbs.markers import Clear, Color, Mark, MarkerShape
+from ..protocol.verbs.parts import PartEdit
 from ..protocol.verbs.workcell import ObjectEdit
 from .record_rows import CHUNK_BYTES
 
-__all__ = ["MAX_HTML_MARKS", "MAX_HTML_OBJECTS", "Commands", "ObjectVersion", "read_commands"]
+__all__ = [
+    "MAX_HTML_MARKS",
+    "MAX_HTML_OBJECTS",
+    "PART_RGB",
+    "Commands",
+    "ObjectVersion",
+    "PartShape",
+    "read_commands",
+]
 
 MAX_HTML_MARKS = 100_000
 """Most marker changes (a mark, a clear) the page holds; later ones are left out."""
 MAX_HTML_OBJECTS = 256
 """Most distinct objects (a name with a shape, size and pose) the page holds."""
+PART_RGB = (0.85, 0.55, 0.2)
+"""A part's colour when its line gives none (the world's default, ``world.parts``)."""
 _SLEEP = re.compile(rb"^sleep ([0-9.eE+-]+)\r?$", re.M)
 _OTHER = re.compile(rb"^(?!joints |sleep |#)[^\n]", re.M)
 _HEADER_ROBOT = re.compile(r"^# robot: (.*)$")
@@ -53,6 +65,16 @@ class ObjectVersion:
     shape: str
     size: tuple[float, ...]
     pose: tuple[float, float, float, float, float, float]
+
+
+@dataclass(frozen=True)
+class PartShape:
+    """A part as its first ``part`` line added it: shape (box, cylinder, sphere), size [m]
+    and colour (r, g, b in 0..1)."""
+
+    shape: str
+    size: tuple[float, ...]
+    rgb: tuple[float, float, float]
 
 
 @dataclass
@@ -71,6 +93,7 @@ class Commands:
         objects: The distinct objects, in order of first appearance.
         object_changes: (time [s], the objects there from then on, as indices into
             ``objects``), in time order.
+        parts: Each part's shape by name, from the first line that added it.
         problems: What was wrong, one sentence each.
     """
 
@@ -82,6 +105,7 @@ class Commands:
     marks: np.ndarray = field(default_factory=lambda: np.empty((0, 13)))
     objects: list[ObjectVersion] = field(default_factory=list)
     object_changes: list[tuple[float, tuple[int, ...]]] = field(default_factory=list)
+    parts: dict[str, PartShape] = field(default_factory=dict)
     problems: list[str] = field(default_factory=list)
 
 
@@ -177,6 +201,13 @@ class _Reader:
             self._mark(0.0, (*map(float, placement.translation), qw, qx, qy, qz))
         elif isinstance(command, ObjectEdit):
             self._object(command)
+        elif isinstance(command, PartEdit) and self._new_part(command):
+            rgb = command.rgb if command.rgb is not None else PART_RGB
+            self.out.parts[command.name] = PartShape(command.shape, command.size, rgb)
+
+    def _new_part(self, command: PartEdit) -> bool:
+        """Whether ``command`` adds a part not seen before."""
+        return command.shape in ("box", "cylinder", "sphere") and command.name not in self.out.parts
 
     def _header(self, text: str) -> None:
         if m := _HEADER_ROBOT.match(text):

@@ -6,8 +6,9 @@ the recording places), built in a private offline viser server and serialized
 by viser, and our player (``record_player.js`` and ``.css``, next to this
 module), which poses the arm from the recording's frames in the browser
 (``record_kinematics``: Pinocchio's numbers), shows the markers and objects at
-their times, backwards too, and gives play/pause, seek, speed (0.25x to 4x), a
-frame back and on, the time shown, a readout and plots that follow the time
+their times, backwards too, moves the parts to each frame's poses, and gives
+play/pause, seek, speed (0.25x to 4x), a frame back and on, the time shown, a readout
+and plots that follow the time
 shown.
 
 Building it streams NAME.csv and NAME.txt (``record_rows``, ``record_commands``):
@@ -42,6 +43,7 @@ from . import adapter
 from .marker_meshes import marker_mesh
 from .record_commands import Commands, read_commands
 from .record_kinematics import chain_kinematics
+from .record_parts import add_parts, placement_list
 from .record_rows import HTML_HZ, MAX_HTML_FRAMES, Frames, read_frames
 from .robot_view import RobotView, node_name
 from .workcell_layer import add_object
@@ -67,6 +69,7 @@ def write_html(recorded: Recorded, state: RobotState) -> Path:
     problems = [*frames.problems, *commands.problems]
     problems += _disagreements(recorded.name, robot, frames, commands, recorded.error)
     scene, nodes = _scene(recorded.name, state, frames, commands)
+    problems += nodes.pop("partProblems")
     end = max(frames.end_s, commands.end_s if recorded.txt is not None else 0.0)
     meta = {
         "name": recorded.name,
@@ -88,6 +91,7 @@ def write_html(recorded: Recorded, state: RobotState) -> Path:
         "problems": problems,
         "shapes": list(MARKER_SHAPES),
         "objectChanges": [[t, list(ids)] for t, ids in commands.object_changes],
+        "base": placement_list(base),
         **nodes,
     }
     blobs = {
@@ -203,6 +207,9 @@ def _scene(
             obj = WorkcellObject(version.name, version.shape, version.size, placement)
             add_object(server.scene, node, obj, robot.base_placement * placement).visible = False
             objects.append(node)
+        parts, part_problems = add_parts(
+            server.scene, name, frames, commands, robot.n, state.origin * robot.base_placement
+        )
         _aim_camera(server, view)
         html = server.get_scene_serializer().as_html()
     finally:
@@ -212,6 +219,8 @@ def _scene(
         "linkParents": parents,
         "markerNodes": markers,
         "objectNodes": objects,
+        "parts": parts,
+        "partProblems": part_problems,
     }
 
 

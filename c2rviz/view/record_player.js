@@ -4,7 +4,8 @@
  * and, in <script> elements, the recording: its description (JSON: joints, the chain's
  * kinematics from Pinocchio, the nodes, what was wrong) and its frames, marker changes and
  * times, gzipped and in base64. This player poses the arm for the time shown with the
- * chain's forward kinematics, shows the markers and objects there were at that time
+ * chain's forward kinematics, poses the parts (NAME.csv's part columns, in the base frame),
+ * shows the markers and objects there were at that time
  * (backwards too: each is computed from the time alone), and draws a readout and plots
  * that end at the time shown, with a cursor there. It drives the scene through viser's
  * own message queue (window.__viserMutable, which viser's client sets up for tests): the
@@ -26,7 +27,8 @@
 
   var meta = JSON.parse(document.getElementById("c2rviz-recording").textContent);
   var n = meta.joints.length;
-  var width = n + 6;
+  var parts = meta.parts || [];
+  var width = n + 6 + 6 * parts.length;
   var data = { times: new Float64Array(0), values: new Float32Array(0), marks: new Float64Array(0) };
   var lastClear = new Int32Array(0);
   var st = {
@@ -37,6 +39,7 @@
     refused: 0, lastTick: null
   };
   var objectVisible = meta.objectNodes.map(function () { return false; });
+  var partVisible = parts.map(function () { return null; });
 
   // ---------- small helpers
 
@@ -89,6 +92,11 @@
     var c = [a.q[0], -a.q[1], -a.q[2], -a.q[3]];
     return { p: qrot(c, [b.p[0] - a.p[0], b.p[1] - a.p[1], b.p[2] - a.p[2]]), q: qmul(c, b.q) };
   }
+  function rpyQuat(roll, pitch, yaw) {  // Rz(yaw) Ry(pitch) Rx(roll), as Pinocchio's rpy
+    var h = function (a, i) { var q = [Math.cos(a / 2), 0, 0, 0]; q[i] = Math.sin(a / 2); return q; };
+    return qmul(qmul(h(yaw, 3), h(pitch, 2)), h(roll, 1));
+  }
+  var base = meta.base ? placement(meta.base) : { p: [0, 0, 0], q: [1, 0, 0, 0] };
   function placement(x) { return { p: [x[0], x[1], x[2]], q: [x[3], x[4], x[5], x[6]] }; }
   function exp6(tw, s) {  // exp of the twist tw = (v, w) times s
     var v = [tw[0] * s, tw[1] * s, tw[2] * s], w = [tw[3] * s, tw[4] * s, tw[5] * s];
@@ -286,6 +294,7 @@
           messages.push({ type: "SetPositionMessage", name: name, position: pose.p, owner: "" });
           messages.push({ type: "SetOrientationMessage", name: name, wxyz: pose.q, owner: "" });
         });
+        drawParts(k, messages);
         readout(k);
       }
     }
@@ -325,6 +334,26 @@
       messages.push({ type: "SetSceneNodeVisibilityMessage", name: node, visible: rows.length > 0, owner: "" });
     });
     st.markersShown = shown;
+  }
+
+  function partPose(k, i) {  // part i's pose in frame k (base frame), or null: not there
+    var o = k * width + parts[i].column, x = Array.prototype.slice.call(data.values.subarray(o, o + 6));
+    return x.every(isFinite) ? x : null;
+  }
+  function drawParts(k, messages) {
+    parts.forEach(function (part, i) {
+      if (!part.node) return;
+      var x = partPose(k, i), on = x !== null;
+      if (on) {
+        var pose = compose(base, { p: [x[0], x[1], x[2]], q: rpyQuat(x[3], x[4], x[5]) });
+        messages.push({ type: "SetPositionMessage", name: part.node, position: pose.p, owner: "" });
+        messages.push({ type: "SetOrientationMessage", name: part.node, wxyz: pose.q, owner: "" });
+      }
+      if (on !== partVisible[i]) {
+        partVisible[i] = on;
+        messages.push({ type: "SetSceneNodeVisibilityMessage", name: part.node, visible: on, owner: "" });
+      }
+    });
   }
 
   function drawObjects(messages) {
@@ -498,6 +527,12 @@
     });
   }
 
+  function partPoses(k) {  // each part's pose in frame k: x, y, z [m], roll, pitch, yaw [rad]
+    var out = {};
+    parts.forEach(function (part, i) { out[part.name] = partPose(k, i); });
+    return out;
+  }
+
   var api = {
     state: function () {
       var k = st.frame;
@@ -506,6 +541,7 @@
         frameTime: k >= 0 && data.times.length ? data.times[k] : null,
         q: k >= 0 && data.times.length ? Array.prototype.slice.call(data.values.subarray(k * width, k * width + n)) : null,
         markers: st.markersShown, objects: st.objectsShown.slice(), playing: st.playing,
+        parts: k >= 0 && data.times.length ? partPoses(k) : {},
         speed: st.speed, window: st.window, plotCursor: st.plotCursor, plotRange: st.plotRange,
         plotDraws: st.plotDraws, problems: st.problems.slice(), refused: st.refused, endS: meta.endS,
         timings: st.timings
@@ -514,7 +550,7 @@
     seek: function (t) { pause(); return seek(t); },
     typeTime: typedTime,
     step: step, play: play, pause: pause, setSpeed: setSpeed, setWindow: setWindow,
-    poseLinks: poseLinks
+    poseLinks: poseLinks, rpyQuat: rpyQuat
   };
   window.__c2rvizPlayer = api;
 

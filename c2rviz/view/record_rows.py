@@ -5,7 +5,10 @@ with the recording's length: of every row it reads only the time, and it keeps
 the first row of each ``1 / HTML_HZ`` of the recording (wider for a recording
 longer than ``MAX_HTML_FRAMES`` frames at that rate), and the last row. Kept rows
 are parsed whole and checked: the header names the robot's joints, every row has
-its number of values, all finite, and time never goes back. Anything wrong ends
+its number of values, all finite, and time never goes back. After the tool pose the
+header may name parts' poses (``NAME.x`` .. ``NAME.yaw``, six columns a part: the
+recorder's ``observers.record_parts.csv_columns``); a part's empty cells (it was
+removed) are read as NaN. Anything wrong ends
 the reading there, with a sentence in ``problems`` that the page shows: the page
 opens with what was good and says what was not, never blank or frozen.
 """
@@ -40,7 +43,10 @@ class Frames:
         times: Each kept frame's time [s from the start], shape (k,).
         values: Its joints [rad or m] then the tool pose x, y, z [m], roll, pitch, yaw
             [rad], shape (k, n + 6), float32.
+            Then six per part in ``parts``: its pose x, y, z [m], roll, pitch, yaw [rad]
+            in the base frame, NaN while it is not there.
         rows: Good rows read (every one, kept or not).
+        parts: The parts whose poses follow the tool pose, in the columns' order.
         problems: What was wrong, one sentence each (empty: nothing).
     """
 
@@ -48,6 +54,7 @@ class Frames:
     values: np.ndarray
     rows: int = 0
     problems: list[str] = field(default_factory=list)
+    parts: list[str] = field(default_factory=list)
 
     @property
     def end_s(self) -> float:
@@ -69,14 +76,17 @@ def read_frames(path: Path, joint_names: Sequence[str]) -> Frames:
             if not header:
                 empty.problems.append(f"{name} is empty: nothing was recorded")
                 return empty
-            if got != expected:
+            parts = _part_names(got[len(expected) :]) if got.startswith(expected) else None
+            if parts is None:
                 empty.problems.append(
                     f"{name} is not this robot's: its columns are {_cut(got)}, "
                     f"the robot's are {_cut(expected)}"
                 )
                 return empty
             step = max(1.0 / HTML_HZ, _last_time(path) / MAX_HTML_FRAMES)
-            return _Reader(name, width, step).read(file)
+            frames = _Reader(name, width + 6 * len(parts), step, width).read(file)
+            frames.parts = parts
+            return frames
     except OSError as exc:
         empty.problems.append(f"{name} cannot be read: {exc.strerror or exc}")
         return empty
@@ -85,9 +95,10 @@ def read_frames(path: Path, joint_names: Sequence[str]) -> Frames:
 class _Reader:
     """One streaming pass over the rows after the header."""
 
-    def __init__(self, name: str, width: int, step: float) -> None:
+    def __init__(self, name: str, width: int, step: float, checked: int) -> None:
         self.name = name
         self.width = width
+        self.checked = checked  # the columns that must be finite (the parts' may be empty)
         self.step = step
         self.line = 1  # the header's
         self.rows = 0
@@ -117,7 +128,7 @@ class _Reader:
                 "ends in a partial row: the recording was cut short",
             )
         if self.last_row is not None and not self.last_kept:
-            row = np.array(self.last_row.split(b","), dtype=float)
+            row = np.array([cell or b"nan" for cell in self.last_row.split(b",")], dtype=float)
             self.kept_times.append(row[:1])
             self.kept.append(row[None, 1:].astype(np.float32))
         times = np.concatenate(self.kept_times) if self.kept else np.empty(0)
@@ -161,10 +172,13 @@ class _Reader:
         if len(keep):
             joined = b",".join([lines[i] for i in keep])
             try:
-                values = np.array(joined.split(b","), dtype=float).reshape(len(keep), -1)
+                cells = joined.split(b",")
+                if self.width > self.checked:  # a removed part's empty cells
+                    cells = [cell or b"nan" for cell in cells]
+                values = np.array(cells, dtype=float).reshape(len(keep), -1)
             except ValueError:
                 return self._one_by_one(lines)
-            if not np.isfinite(values).all():
+            if not np.isfinite(values[:, : self.checked]).all():
                 return self._one_by_one(lines)
             self.kept_times.append(values[:, 0].copy())
             self.kept.append(values[:, 1:].astype(np.float32))
@@ -179,10 +193,12 @@ class _Reader:
         """The slow way through a chunk with a bad row: take the good ones before it."""
         for k, line in enumerate(lines):
             try:
-                values = np.array(line.split(b","), dtype=float)
+                cells = line.split(b",")
+                checked, rest = cells[: self.checked], cells[self.checked :]
+                values = np.array(checked + [cell or b"nan" for cell in rest], dtype=float)
             except ValueError:
                 values = np.array([math.nan])
-            if not np.isfinite(values).all():
+            if not np.isfinite(values[: self.checked]).all():
                 self._take(lines[:k])
                 self._stop(self.line + 1, "has a value that is not a finite number")
                 return False
@@ -208,6 +224,23 @@ def _last_time(path: Path) -> float:
         except ValueError:
             continue
     return 0.0
+
+
+def _part_names(columns: str) -> list[str] | None:
+    """The parts named by the header's ``columns`` after the tool pose (``,NAME.x`` ..
+    ``,NAME.yaw`` each), or None if they are not such columns."""
+    if not columns:
+        return []
+    names = columns[1:].split(",") if columns.startswith(",") else []
+    if not names or len(names) % len(POSE_COLUMNS):
+        return None
+    parts = []
+    for k in range(0, len(names), len(POSE_COLUMNS)):
+        part = names[k].rsplit(".", 1)[0]
+        if names[k : k + len(POSE_COLUMNS)] != [f"{part}.{a}" for a in POSE_COLUMNS]:
+            return None
+        parts.append(part)
+    return parts
 
 
 def _cut(text: str, limit: int = 120) -> str:
