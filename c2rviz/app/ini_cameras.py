@@ -12,7 +12,6 @@ again when the camera is placed (a bad one is an error that names it).
 
 from __future__ import annotations
 
-import configparser
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,7 +22,7 @@ import pinocchio as pin
 from ..errors import C2rvizError, ConfigError
 from ..world.cameras import DEFAULT_FOV_RAD, DEFAULT_RANGE_M, MAX_RATE_HZ, Camera
 from ..world.world import World
-from .robot_options import pose_from
+from .robot_options import ini_entries, pose_from
 
 __all__ = ["IniCamera", "ini_cameras", "place_cameras"]
 
@@ -45,13 +44,8 @@ def ini_cameras(ini: Path | None) -> list[IniCamera]:
     """The cameras of the ini's ``[cameras]`` (none without an ini or the section)."""
     if ini is None:
         return []
-    parser = configparser.ConfigParser(interpolation=None, inline_comment_prefixes=("#", ";"))
-    parser.read(ini, encoding="utf-8")
-    if not parser.has_section("cameras"):
-        return []
     found = []
-    for name, text in parser.items("cameras"):
-        where = f"[cameras] {name}"
+    for where, name, text in ini_entries(ini, "cameras"):
         words = text.split()
         if not words:
             raise ConfigError(f"{where} needs a pose x,y,z,roll,pitch,yaw (m, deg)")

@@ -11,7 +11,6 @@
 
 from __future__ import annotations
 
-import configparser
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -20,6 +19,7 @@ from ..protocol.verbs.faults import FaultVerb
 from ..robot.model import Robot
 from ..world.faults import Fault, to_fault
 from ..world.world import World
+from .robot_options import ini_entries
 
 __all__ = ["IniFault", "ini_faults", "start_faults"]
 
@@ -33,21 +33,16 @@ def ini_faults(ini: Path, name: str, robot: Robot, first: bool) -> list[IniFault
     Raises:
         ConfigError: an entry ``fault`` would refuse, naming it and why.
     """
-    parser = configparser.ConfigParser(interpolation=None, inline_comment_prefixes=("#", ";"))
-    parser.read(ini, encoding="utf-8")
     found: list[IniFault] = []
-    for section in (["faults"] if first else []) + [f"faults:{name}"]:
-        if not parser.has_section(section):
-            continue
-        for key, text in parser.items(section):
-            try:
-                command = FaultVerb.parse("fault", text.split())
-                if command.spec is None:
-                    raise ConfigError("clear is not a fault to start")
-                fault = to_fault(name, robot.joint_names, 1.0, command.spec)
-            except C2rvizError as exc:
-                raise ConfigError(f"[{section}] {key} = {text!r}: {exc}") from None
-            found.append((command, fault))
+    for where, _, text in ini_entries(ini, "faults", name, first):
+        try:
+            command = FaultVerb.parse("fault", text.split())
+            if command.spec is None:
+                raise ConfigError("clear is not a fault to start")
+            fault = to_fault(name, robot.joint_names, 1.0, command.spec)
+        except C2rvizError as exc:
+            raise ConfigError(f"{where} = {text!r}: {exc}") from None
+        found.append((command, fault))
     return found
 
 

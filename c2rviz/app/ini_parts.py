@@ -11,14 +11,12 @@ again when it is added (a part inside an object is an error that names it).
 
 from __future__ import annotations
 
-import configparser
-import math
 from pathlib import Path
 
 import pinocchio as pin
 
 from ..errors import ConfigError
-from .robot_options import pose_from
+from .robot_options import ini_entries, ini_numbers, pose_from
 
 __all__ = ["IniPart", "ini_parts"]
 
@@ -28,37 +26,21 @@ IniPart = tuple[str, str, list[float], pin.SE3, "str | None", "tuple[float, ...]
 
 def ini_parts(ini: Path, robot: str, first: bool) -> list[IniPart]:
     """The parts the ini places around ``robot`` (``[parts]`` too when it is the first)."""
-    parser = configparser.ConfigParser(interpolation=None, inline_comment_prefixes=("#", ";"))
-    parser.read(ini, encoding="utf-8")
     found: list[IniPart] = []
-    for section in (["parts"] if first else []) + [f"parts:{robot}"]:
-        if not parser.has_section(section):
-            continue
-        for name, text in parser.items(section):
-            where = f"[{section}] {name}"
-            words = text.split()
-            if len(words) < 3:
-                raise ConfigError(f"{where} = {text!r} needs a shape, a size and a pose")
-            kind: str | None = None
-            rgba: tuple[float, ...] | None = None
-            for word in words[3:]:
-                key, _, value = word.partition("=")
-                if key == "type" and value:
-                    kind = value
-                elif key in ("color", "colour") and value:
-                    rgba = (*_numbers(where, value), 1.0)
-                else:
-                    raise ConfigError(f"{where}: {word!r} is not type=TYPE or color=r,g,b")
-            size = _numbers(where, words[1])
-            found.append((name, words[0].lower(), size, pose_from(where, words[2]), kind, rgba))
+    for where, name, text in ini_entries(ini, "parts", robot, first):
+        words = text.split()
+        if len(words) < 3:
+            raise ConfigError(f"{where} = {text!r} needs a shape, a size and a pose")
+        kind: str | None = None
+        rgba: tuple[float, ...] | None = None
+        for word in words[3:]:
+            key, _, value = word.partition("=")
+            if key == "type" and value:
+                kind = value
+            elif key in ("color", "colour") and value:
+                rgba = (*ini_numbers(where, value), 1.0)
+            else:
+                raise ConfigError(f"{where}: {word!r} is not type=TYPE or color=r,g,b")
+        size = ini_numbers(where, words[1])
+        found.append((name, words[0].lower(), size, pose_from(where, words[2]), kind, rgba))
     return found
-
-
-def _numbers(where: str, text: str) -> list[float]:
-    try:
-        values = [float(part) for part in text.split(",")]
-    except ValueError:
-        raise ConfigError(f"{where} = {text!r} is not a comma-separated list of numbers") from None
-    if not all(map(math.isfinite, values)):
-        raise ConfigError(f"{where} = {text!r} has a value that is not a finite number")
-    return values

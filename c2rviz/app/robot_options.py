@@ -34,7 +34,16 @@ from ..robot.gripper import Gripper, make_gripper
 from ..robot.model import Robot
 from ..world.grasp import make_vacuum
 
-__all__ = ["IniObject", "gripper_from", "ini_objects", "limits_from", "pose_from", "tool_from"]
+__all__ = [
+    "IniObject",
+    "gripper_from",
+    "ini_entries",
+    "ini_numbers",
+    "ini_objects",
+    "limits_from",
+    "pose_from",
+    "tool_from",
+]
 
 IniObject = tuple[str, str, list[float], pin.SE3, "tuple[float, ...] | None", "Path | None"]
 """name, shape, size, placement in the base frame, rgba (None: default), mesh file."""
@@ -42,7 +51,7 @@ IniObject = tuple[str, str, list[float], pin.SE3, "tuple[float, ...] | None", "P
 
 def pose_from(where: str, text: str) -> pin.SE3:
     """``x,y,z,roll,pitch,yaw`` (m, deg) as an SE3."""
-    values = _numbers(where, text)
+    values = ini_numbers(where, text)
     if len(values) != 6:
         raise ConfigError(f"{where} = {text!r} must be 6 numbers: x,y,z (m),roll,pitch,yaw (deg)")
     x, y, z, roll, pitch, yaw = values
@@ -73,7 +82,7 @@ def gripper_from(section: str, extras: Mapping[str, str], robot: Robot) -> Gripp
     joints: list[tuple[str, float, float]] = []
     for entry in text.split():
         name, _, values = entry.partition(":")
-        numbers = _numbers(where, values.replace(":", ",")) if values else []
+        numbers = ini_numbers(where, values.replace(":", ",")) if values else []
         if not name or len(numbers) != 2:
             raise ConfigError(
                 f"{where} = {text!r}: {entry!r} must be JOINT:CLOSED:OPEN (m, or deg for a "
@@ -102,7 +111,7 @@ def limits_from(section: str, extras: Mapping[str, str], robot: Robot) -> Motion
     given: dict[str, float | Sequence[float]] = {}
     for key in ("max_velocity", "max_acceleration", "max_jerk"):
         if key in extras:
-            values = _numbers(f"[{section}] {key}", extras[key])
+            values = ini_numbers(f"[{section}] {key}", extras[key])
             given[key] = values[0] if len(values) == 1 else values
     try:
         return motion_limits(robot, **given)  # type: ignore[arg-type]
@@ -115,33 +124,45 @@ def ini_objects(
 ) -> list[tuple[str, str, list[float], pin.SE3, tuple[float, ...] | None, Path | None]]:
     """The objects the ini places around ``robot`` (``[objects]`` too when it is the first
     robot): name, shape, size, placement, rgba, mesh path. Checked again when set."""
-    parser = configparser.ConfigParser(interpolation=None, inline_comment_prefixes=("#", ";"))
-    parser.read(ini, encoding="utf-8")
     found: list[IniObject] = []
-    for section in (["objects"] if first else []) + [f"objects:{robot}"]:
-        if not parser.has_section(section):
-            continue
-        for name, text in parser.items(section):
-            where = f"[{section}] {name}"
-            words = text.split()
-            if len(words) < 3:
-                raise ConfigError(f"{where} = {text!r} needs a shape, a size and a pose")
-            shape = words[0].lower()
-            rgba: tuple[float, ...] | None = None
-            mesh: Path | None = None
-            if shape == "mesh":
-                mesh = (ini.parent / words[1]).resolve()
-                placement = pose_from(where, words[2])
-                size = _numbers(where, words[3]) if len(words) > 3 else [1.0, 1.0, 1.0]
-            else:
-                size = _numbers(where, words[1])
-                placement = pose_from(where, words[2])
-                rgba = tuple(_numbers(where, words[3])) if len(words) > 3 else None
-            found.append((name, shape, size, placement, rgba, mesh))
+    for where, name, text in ini_entries(ini, "objects", robot, first):
+        words = text.split()
+        if len(words) < 3:
+            raise ConfigError(f"{where} = {text!r} needs a shape, a size and a pose")
+        shape = words[0].lower()
+        rgba: tuple[float, ...] | None = None
+        mesh: Path | None = None
+        if shape == "mesh":
+            mesh = (ini.parent / words[1]).resolve()
+            placement = pose_from(where, words[2])
+            size = ini_numbers(where, words[3]) if len(words) > 3 else [1.0, 1.0, 1.0]
+        else:
+            size = ini_numbers(where, words[1])
+            placement = pose_from(where, words[2])
+            rgba = tuple(ini_numbers(where, words[3])) if len(words) > 3 else None
+        found.append((name, shape, size, placement, rgba, mesh))
     return found
 
 
-def _numbers(where: str, text: str) -> list[float]:
+def ini_entries(
+    ini: Path, kind: str, robot: str | None = None, first: bool = True
+) -> list[tuple[str, str, str]]:
+    """Each ``name = text`` of the ini's ``[KIND]`` (with ``first``: the first robot's, or a
+    world's when ``robot`` is None) and ``[KIND:ROBOT]``, with where it stands
+    (``[KIND] name``, for errors), in the file's order."""
+    parser = configparser.ConfigParser(interpolation=None, inline_comment_prefixes=("#", ";"))
+    parser.read(ini, encoding="utf-8")
+    sections = ([kind] if first else []) + ([f"{kind}:{robot}"] if robot is not None else [])
+    return [
+        (f"[{section}] {name}", name, text)
+        for section in sections
+        if parser.has_section(section)
+        for name, text in parser.items(section)
+    ]
+
+
+def ini_numbers(where: str, text: str) -> list[float]:
+    """``text`` (``a,b,c``) as finite numbers, or a ``ConfigError`` saying ``where``."""
     try:
         values = [float(part) for part in text.split(",")]
     except ValueError:
