@@ -7,13 +7,12 @@ Usage: ``python scripts/cameras_screenshot.py [--out DIR]`` (under a minute).
 
 from __future__ import annotations
 
-import argparse
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from page_screenshot import ARGS, ROOT, Program  # noqa: E402
+from page_screenshot import scene_picture  # noqa: E402
 
 SCENE = [
     "degrees",
@@ -29,33 +28,7 @@ SCENE = [
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--out", type=Path, default=ROOT / "docs", help="where the picture goes")
-    args = parser.parse_args(argv)
-    from playwright.sync_api import sync_playwright
-
-    program = Program("--robot", "fanuc_lrmate200id", "--hz", "10", "--no-crcl", "--no-rosbridge")
-    try:
-        with sync_playwright() as pw:
-            browser = pw.chromium.launch(executable_path="/usr/bin/chromium", args=ARGS)
-            try:
-                page = browser.new_page(viewport={"width": 1200, "height": 800})
-                page.goto(program.url + "/?fixedDpr=1")
-                page.wait_for_function(
-                    "() => window.__viserSceneTree && Object.keys("
-                    "window.__viserSceneTree.getState()).some((n) => n.endsWith('/link_6'))",
-                    timeout=120_000,
-                )
-                for line in SCENE:
-                    print(line, "->", program.ask(line))
-                page.wait_for_timeout(4000)
-                page.screenshot(path=str(args.out / "cameras.png"))
-                print(f"wrote {args.out / 'cameras.png'}")
-            finally:
-                browser.close()
-    finally:
-        program.stop()
-    return 0
+    return scene_picture("cameras.png", SCENE, argv)
 
 
 if __name__ == "__main__":

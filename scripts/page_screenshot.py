@@ -130,6 +130,38 @@ def recorded_page(browser: object, out: Path, record_dir: Path) -> None:
     print(f"wrote {out / 'page-recorded.png'}")
 
 
+def scene_picture(name: str, scene: Sequence[str], argv: Sequence[str] | None) -> int:
+    """docs/NAME (or ``--out DIR``/NAME): the fanuc's live page after ``scene``'s lines, as
+    the parts' and cameras' scripts take them."""
+    parser = argparse.ArgumentParser(description=f"Take docs/{name} from the real program.")
+    parser.add_argument("--out", type=Path, default=ROOT / "docs", help="where the picture goes")
+    args = parser.parse_args(argv)
+    from playwright.sync_api import sync_playwright
+
+    program = Program("--robot", "fanuc_lrmate200id", "--hz", "10", "--no-crcl", "--no-rosbridge")
+    try:
+        with sync_playwright() as pw:
+            browser = pw.chromium.launch(executable_path="/usr/bin/chromium", args=ARGS)
+            try:
+                page = browser.new_page(viewport={"width": 1200, "height": 800})
+                page.goto(program.url + "/?fixedDpr=1")
+                page.wait_for_function(
+                    "() => window.__viserSceneTree && Object.keys("
+                    "window.__viserSceneTree.getState()).some((n) => n.endsWith('/link_6'))",
+                    timeout=120_000,
+                )
+                for line in scene:
+                    print(line, "->", program.ask(line))
+                page.wait_for_timeout(4000)
+                page.screenshot(path=str(args.out / name))
+                print(f"wrote {args.out / name}")
+            finally:
+                browser.close()
+    finally:
+        program.stop()
+    return 0
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--out", type=Path, default=ROOT / "docs", help="where the pictures go")
