@@ -1,4 +1,9 @@
-"""``c2rviz``: the flags, the settings, and then the program (``program.serve``)."""
+"""``c2rviz``: the flags, the settings, and then the program (``program.serve``).
+
+Only the standard library loads before ``main`` runs: a page process that the arguments
+or the ini ask for (``view.page_start.early``) starts first, and loads viser beside the
+program's own imports (Pinocchio, the session, the doors), which ``main`` makes next.
+"""
 
 from __future__ import annotations
 
@@ -9,12 +14,8 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from ..collision.geometry import read_srdf
 from ..errors import C2rvizError
-from ..robot.catalogue import catalogue, listing
-from .config import MOTION_FLAGS, find_ini, load_settings, read_robots
-from .members import members
-from .program import serve
+from ..view.page_start import Spawned, close, early
 
 __all__ = ["build_parser", "main"]
 
@@ -194,9 +195,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add(
         "--page-process",
-        action="store_true",
+        action="store_const",
+        const=True,
         help="serve the page from a process of its own, so drawing never delays a command "
-        "(docs/page.md)",
+        "(ini: page_process = on; docs/page.md)",
     )
     add("--max-clients", type=int, metavar="N", help="clients at once (default 64)")
     add("--max-line", type=int, metavar="BYTES", help="longest line (default 8192)")
@@ -245,6 +247,21 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``c2rviz`` command; returns the exit status."""
+    spawned = early(sys.argv[1:] if argv is None else argv)  # first: it loads meanwhile
+    try:
+        return _main(argv, spawned)
+    finally:
+        if spawned is not None:
+            close(spawned)  # if it never got its hello (the settings, or a door, said no)
+
+
+def _main(argv: Sequence[str] | None, spawned: Spawned | None) -> int:
+    from ..collision.geometry import read_srdf
+    from ..robot.catalogue import catalogue, listing
+    from .config import MOTION_FLAGS, find_ini, load_settings, read_robots
+    from .members import members
+    from .program import serve
+
     args = build_parser().parse_args(argv)
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,
@@ -253,7 +270,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     overrides = {
         k: v
         for k, v in vars(args).items()
-        if k not in ("config", "verbose", "list_robots", "page_process", *MOTION_FLAGS)
+        if k not in ("config", "verbose", "list_robots", *MOTION_FLAGS)
     }
     overrides["motion_flags"] = tuple(
         (k, getattr(args, k)) for k in MOTION_FLAGS if getattr(args, k) is not None
@@ -274,7 +291,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"c2rviz: {exc}", file=sys.stderr)
         return 2
     try:
-        return asyncio.run(serve(settings, robots, cell, page_process=args.page_process))
+        page = settings.page_process and settings.viewer
+        return asyncio.run(
+            serve(
+                settings,
+                robots,
+                cell,
+                page_process=settings.page_process,
+                spawned=spawned if page else None,
+            )
+        )
     except KeyboardInterrupt:  # a second Ctrl-C while stopping
         return 130
 

@@ -57,8 +57,11 @@ def spawn() -> Spawned:
 
 
 def close(spawned: Spawned) -> None:
-    """End a page process that got no ``hello``: it sees its channel close and exits."""
+    """End a page process that got no ``hello``: it sees its channel close and exits. One
+    handed to a ``PageLink`` (its channel taken, then closed by it) is left alone."""
     process, ours = spawned
+    if ours.fileno() == -1:
+        return
     ours.close()
     try:
         process.wait(timeout=2.0)

@@ -255,3 +255,63 @@ def test_the_program_side_never_loads_viser() -> None:
         "import sys, c2rviz.app.program, c2rviz.view.page_link; sys.exit('viser' in sys.modules)"
     )
     assert subprocess.run([sys.executable, "-c", check], timeout=DEADLINE_S).returncode == 0
+
+
+# the ini key and the early start
+
+
+def test_the_ini_key_serves_the_page_from_its_own_process(
+    c2rviz_process: Callable[..., Any], tmp_path: Path
+) -> None:
+    ini = tmp_path / "cmdinterpreter.ini"
+    ini.write_text("[options]\npage_process = on\n")
+    proc = c2rviz_process("--config", str(ini), "--viser-port", "0")
+    assert page_process(proc.popen.pid)
+    assert "joint_s" in gui_values(scene(proc.viewer_url))
+    ini.write_text("[options]\npage_process = off\n")
+    proc = c2rviz_process("--config", str(ini), "--viser-port", "0")
+    assert children(proc.popen.pid) == []  # the page in the program's own process
+
+
+def test_a_bad_ini_value_names_the_choices(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from c2rviz.app.cli import main
+
+    ini = tmp_path / "cmdinterpreter.ini"
+    ini.write_text("[options]\npage_process = yes\n")
+    assert main(["--config", str(ini), "--port", "0"]) == 2
+    said = capsys.readouterr().err
+    assert "[options] page_process = 'yes' is not one" in said and "off, on" in said, said
+    assert not [c for c in children(os.getpid()) if is_page_process(c)]
+
+
+def test_a_page_process_started_early_ends_when_the_program_does_not_start(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--page-process`` starts the page process first thing (it loads beside the
+    program); a program that then stops on a bad flag leaves none behind."""
+    from c2rviz.app.cli import main
+    from c2rviz.view import page_start
+
+    started: list[page_start.Spawned] = []
+    spawn = page_start.spawn
+
+    def counted() -> page_start.Spawned:
+        started.append(spawn())
+        return started[-1]
+
+    monkeypatch.setattr(page_start, "spawn", counted)
+    assert main(["--page-process", "--robot", "no_such_robot", "--port", "0"]) == 2
+    assert "no_such_robot" in capsys.readouterr().err
+    assert len(started) == 1
+    assert started[0][0].poll() is not None  # it ended: no page process left
+    assert page_start.early(["--page-process", "--no-viewer"]) is None
+    assert page_start.early(["--help"]) is None
+
+
+def is_page_process(pid: int) -> bool:
+    try:
+        return b"c2rviz.view.page_process" in Path(f"/proc/{pid}/cmdline").read_bytes()
+    except OSError:
+        return False
