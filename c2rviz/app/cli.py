@@ -1,8 +1,7 @@
 """``c2rviz``: the flags, the settings, and then the program (``program.serve``).
 
-Only the standard library loads before ``main`` runs: a page process that the arguments
-or the ini ask for (``view.page_start.early``) starts first, and loads viser beside the
-program's own imports (Pinocchio, the session, the doors), which ``main`` makes next.
+A page process the flags or the ini ask for is forked once the settings are read and the
+robots loaded, before the program starts its loop (``view.page_start.fork``).
 """
 
 from __future__ import annotations
@@ -14,8 +13,13 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from ..collision.geometry import read_srdf
 from ..errors import C2rvizError
-from ..view.page_start import Spawned, close, early
+from ..robot.catalogue import catalogue, listing
+from ..view.page_start import close, fork
+from .config import MOTION_FLAGS, find_ini, load_settings, read_robots
+from .members import members
+from .program import serve
 
 __all__ = ["build_parser", "main"]
 
@@ -247,21 +251,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``c2rviz`` command; returns the exit status."""
-    spawned = early(sys.argv[1:] if argv is None else argv)  # first: it loads meanwhile
-    try:
-        return _main(argv, spawned)
-    finally:
-        if spawned is not None:
-            close(spawned)  # if it never got its hello (the settings, or a door, said no)
-
-
-def _main(argv: Sequence[str] | None, spawned: Spawned | None) -> int:
-    from ..collision.geometry import read_srdf
-    from ..robot.catalogue import catalogue, listing
-    from .config import MOTION_FLAGS, find_ini, load_settings, read_robots
-    from .members import members
-    from .program import serve
-
     args = build_parser().parse_args(argv)
     logging.basicConfig(
         level=logging.INFO if args.verbose else logging.WARNING,
@@ -290,19 +279,17 @@ def _main(argv: Sequence[str] | None, spawned: Spawned | None) -> int:
     except C2rvizError as exc:
         print(f"c2rviz: {exc}", file=sys.stderr)
         return 2
+    # What both processes need is loaded: the page process starts from it (before the loop).
+    spawned = fork() if settings.page_process and settings.viewer else None
     try:
-        page = settings.page_process and settings.viewer
         return asyncio.run(
-            serve(
-                settings,
-                robots,
-                cell,
-                page_process=settings.page_process,
-                spawned=spawned if page else None,
-            )
+            serve(settings, robots, cell, page_process=settings.page_process, spawned=spawned)
         )
     except KeyboardInterrupt:  # a second Ctrl-C while stopping
         return 130
+    finally:
+        if spawned is not None:
+            close(spawned)  # if it never got its hello (a door could not open)
 
 
 if __name__ == "__main__":

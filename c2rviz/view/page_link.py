@@ -40,7 +40,7 @@ from ..session.session import Session
 from .page_channel import ChannelError, FrameReader, encode
 from .page_frame import SAMPLES_KEPT, FrameNotes
 from .page_snapshot import Hello, PageConfig, snapshot
-from .page_start import Spawned, spawn
+from .page_start import PageProcessHandle, Spawned, spawn
 from .ratelog import RateLimitedLog
 
 __all__ = ["BACKLOG", "SAMPLES_KEPT", "PageLink"]
@@ -80,7 +80,7 @@ class PageLink(FrameNotes):
         self.port: int | None = None
         self.starts = 0
         self.frames = 0
-        self.process: subprocess.Popen[bytes] | None = None
+        self.process: PageProcessHandle | None = None
         sessions: dict[str, Session] = {}
         for name in world.robots:
             session = Session(services, source="page", robot=name)

@@ -304,7 +304,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("usage: python -m c2rviz.view.page_process FD (started by c2rviz)", file=sys.stderr)
         return 2
     logging.basicConfig(level=logging.WARNING, format="c2rviz: %(levelname)s: %(message)s")
-    sock = socket.socket(fileno=int(args[0]))
+    return run(socket.socket(fileno=int(args[0])))
+
+
+def run(sock: socket.socket) -> int:
+    """Serve the page over channel ``sock`` until told to stop or it ends; the exit status
+    (``main``'s, or that of the page process the program forked, ``page_start.fork``)."""
     try:
         return asyncio.run(serve(sock))
     except KeyboardInterrupt:

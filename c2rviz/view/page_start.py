@@ -1,40 +1,118 @@
-"""Starting the page process (``--page-process``) as early as the program can.
+"""Starting the page process (``--page-process``): forked at start, spawned on a restart.
 
-The page process spends most of its start loading Python (viser, Pinocchio, numpy,
-the session: some 0.5 s here), and so does the program. ``spawn`` starts it; the
-program calls ``early`` first thing, before its own heavy imports, so both load side by
-side on two cores and the banner waits only for the page's own set-up (docs/page.md).
+At start the program forks the page process (``fork``) once it has loaded what both need
+(Pinocchio, numpy, the session, the world's modules: some 0.45 s of a start) and before
+it starts its loop, any thread of its own or any door: the child begins with all of it
+loaded and only loads viser (``page_process``, ~0.15 s) while the program builds its
+world and opens its doors, so the banner does not wait for a second load of the rest
+(docs/page.md, "Start"). The fork takes nothing the page must not have: no loop, no
+socket but its channel, its own session (a Ctrl-C is the program's to act on), stdin and
+stdout on /dev/null.
 
-``early`` only peeks: ``--page-process`` among the arguments, or ``page_process = on``
-in ``[options]`` of the ini (``--config`` or the usual one), and no ``--no-viewer``,
-``--help`` or ``--list-robots``. The settings decide (``app.config``): a page process
-started early that the settings do not want is closed, and one they want that was not
-started early is started then. This module loads the standard library alone (and
-``c2rviz.ini``, which does too).
+A page process started again after a crash is ``spawn``ed fresh (``python -m
+c2rviz.view.page_process FD``): by then the program has a running loop and threads, which
+a fork would copy in whatever state they are.
+
+This module loads the standard library alone.
 """
 
 from __future__ import annotations
 
-import configparser
+import os
+import signal
 import socket
 import subprocess
 import sys
-from collections.abc import Sequence
+import time
+import traceback
+from typing import Protocol
 
-from ..errors import ConfigError
-from ..ini import find_ini, read_ini
+__all__ = ["Forked", "PageProcessHandle", "Spawned", "close", "fork", "spawn"]
 
-__all__ = ["Spawned", "close", "early", "spawn"]
 
-Spawned = tuple[subprocess.Popen[bytes], socket.socket]
+class PageProcessHandle(Protocol):
+    """What the program does with a page process: a ``subprocess.Popen`` or ``Forked``."""
+
+    @property
+    def pid(self) -> int: ...
+
+    def poll(self) -> int | None: ...
+
+    def wait(self, timeout: float | None = None) -> int: ...
+
+    def kill(self) -> None: ...
+
+
+Spawned = tuple[PageProcessHandle, socket.socket]
 """A page process and the program's end of its channel."""
 
-_NOT_NOW = ("--no-viewer", "--help", "-h", "--list-robots")
+
+class Forked:
+    """A forked page process, handled as a ``subprocess.Popen`` is (``returncode``: its exit
+    status, or minus the signal that ended it)."""
+
+    def __init__(self, pid: int) -> None:
+        self.pid = pid
+        self.returncode: int | None = None
+
+    def poll(self) -> int | None:
+        if self.returncode is None:
+            pid, status = os.waitpid(self.pid, os.WNOHANG)
+            if pid == self.pid:
+                self.returncode = os.waitstatus_to_exitcode(status)
+        return self.returncode
+
+    def wait(self, timeout: float | None = None) -> int:
+        """Its exit status, once it ended (``subprocess.TimeoutExpired`` after ``timeout``)."""
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while (code := self.poll()) is None:
+            if deadline is not None and time.monotonic() > deadline:
+                raise subprocess.TimeoutExpired(f"page process {self.pid}", timeout or 0.0)
+            time.sleep(0.01)
+        return code
+
+    def kill(self) -> None:
+        if self.poll() is None:
+            os.kill(self.pid, signal.SIGKILL)
+
+
+def fork() -> Spawned | None:
+    """Fork a page process now (see the module docstring); None if it cannot be (the
+    program spawns one when the page opens, and says why if that fails too)."""
+    try:
+        ours, theirs = socket.socketpair()
+    except OSError:
+        return None
+    sys.stdout.flush()
+    sys.stderr.flush()
+    try:
+        pid = os.fork()
+    except OSError:
+        ours.close()
+        theirs.close()
+        return None
+    if pid == 0:  # the page process: it never returns into the program
+        code = 1
+        try:
+            ours.close()
+            os.setsid()
+            null = os.open(os.devnull, os.O_RDWR)
+            os.dup2(null, 0)
+            os.dup2(null, 1)
+            from .page_process import run
+
+            code = run(theirs)
+        except BaseException:
+            traceback.print_exc()
+        finally:
+            os._exit(code)
+    theirs.close()
+    return Forked(pid), ours
 
 
 def spawn() -> Spawned:
-    """Start a page process; it and our end of its channel. It loads viser and waits for
-    its ``hello`` meanwhile.
+    """Start a fresh page process; it and our end of its channel. It loads viser and waits
+    for its ``hello`` meanwhile.
 
     Raises:
         OSError: it cannot be started.
@@ -68,35 +146,3 @@ def close(spawned: Spawned) -> None:
     except subprocess.TimeoutExpired:
         process.kill()
         process.wait()
-
-
-def early(argv: Sequence[str]) -> Spawned | None:
-    """A page process started now if ``argv`` (the program's arguments) or the ini ask for
-    one; None otherwise, or if it cannot start (the program tries again and says why)."""
-    args = list(argv)
-    if any(a in _NOT_NOW for a in args):
-        return None
-    if "--page-process" not in args and not _ini_wants(args):
-        return None
-    try:
-        return spawn()
-    except OSError:
-        return None
-
-
-def _ini_wants(args: list[str]) -> bool:
-    """``[options] page_process = on`` in the ini the program will read (a guess: an ini
-    that cannot be read says no here; ``app.config`` says why later)."""
-    explicit: str | None = None
-    for k, arg in enumerate(args):
-        if arg == "--config" and k + 1 < len(args):
-            explicit = args[k + 1]
-        elif arg.startswith("--config="):
-            explicit = arg.partition("=")[2]
-    try:
-        ini = find_ini(explicit)
-        if ini is None:
-            return False
-        return read_ini(ini).get("options", "page_process", fallback="off") == "on"
-    except (ConfigError, configparser.Error):
-        return False

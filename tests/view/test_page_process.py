@@ -76,16 +76,18 @@ def children(pid: int) -> list[int]:
     return out
 
 
-def page_process(pid: int) -> int:
-    """The page process of the program ``pid``, once it runs."""
+def page_process(pid: int, but: int | None = None) -> int:
+    """The page process of the program ``pid`` (other than ``but``), once it runs: its one
+    child (forked at start, so named as the program is; spawned on a restart)."""
     deadline = time.monotonic() + DEADLINE_S
     while time.monotonic() < deadline:
         for child in children(pid):
             try:
-                if b"c2rviz.view.page_process" in Path(f"/proc/{child}/cmdline").read_bytes():
-                    return child
+                state = Path(f"/proc/{child}/stat").read_text().rsplit(")", 1)[1].split()[0]
             except OSError:
                 continue
+            if child != but and state != "Z":
+                return child
         time.sleep(0.05)
     raise AssertionError("no page process")
 
@@ -150,8 +152,8 @@ def test_a_killed_page_process_comes_back_and_commands_go_on(
         assert mover.ask("where") == "ok 90,0,0,0,0,0,0"
         said = "".join(read_until(proc, "starting it again"))
         assert "the page process stopped (status -9)" in said
-        second = page_process(proc.popen.pid)
-        assert second != first
+        second = page_process(proc.popen.pid, but=first)
+        assert b"c2rviz.view.page_process" in Path(f"/proc/{second}/cmdline").read_bytes()
         assert bystander.ask("mark") == "ok"
         # A tab opened now, on the same URL, gets the whole scene: the robot where it
         # is, both markers, the last commands. (A tab that came before the new page
@@ -286,28 +288,31 @@ def test_a_bad_ini_value_names_the_choices(
     assert not [c for c in children(os.getpid()) if is_page_process(c)]
 
 
-def test_a_page_process_started_early_ends_when_the_program_does_not_start(
+def test_a_forked_page_process_ends_when_the_program_does_not_start(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """``--page-process`` starts the page process first thing (it loads beside the
-    program); a program that then stops on a bad flag leaves none behind."""
-    from c2rviz.app.cli import main
+    """The page process is forked before the loop starts; a program that then cannot open
+    a door (its command port taken) closes it: none is left behind."""
+    from c2rviz.app import cli
     from c2rviz.view import page_start
 
-    started: list[page_start.Spawned] = []
-    spawn = page_start.spawn
+    started: list[page_start.Spawned | None] = []
 
-    def counted() -> page_start.Spawned:
-        started.append(spawn())
+    def counted() -> page_start.Spawned | None:
+        started.append(page_start.fork())
         return started[-1]
 
-    monkeypatch.setattr(page_start, "spawn", counted)
-    assert main(["--page-process", "--robot", "no_such_robot", "--port", "0"]) == 2
-    assert "no_such_robot" in capsys.readouterr().err
-    assert len(started) == 1
-    assert started[0][0].poll() is not None  # it ended: no page process left
-    assert page_start.early(["--page-process", "--no-viewer"]) is None
-    assert page_start.early(["--help"]) is None
+    monkeypatch.setattr(cli, "fork", counted)
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = str(taken.getsockname()[1])
+        assert cli.main(["--page-process", "--port", port, "--no-crcl", "--no-rosbridge"]) == 2
+    assert "the port is in use" in capsys.readouterr().err
+    assert len(started) == 1 and started[0] is not None
+    process, _ = started[0]
+    assert process.poll() is not None  # it ended: no page process left
+    assert process.pid not in children(os.getpid())
 
 
 def is_page_process(pid: int) -> bool:
