@@ -16,7 +16,6 @@ from pathlib import Path
 from ..collision.geometry import read_srdf
 from ..errors import C2rvizError
 from ..robot.catalogue import catalogue, listing
-from ..view.page_start import close, fork
 from .config import MOTION_FLAGS, find_ini, load_settings, read_robots
 from .members import members
 from .program import serve
@@ -279,8 +278,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except C2rvizError as exc:
         print(f"c2rviz: {exc}", file=sys.stderr)
         return 2
-    # What both processes need is loaded: the page process starts from it (before the loop).
-    spawned = fork() if settings.page_process and settings.viewer else None
+    spawned = None
+    if settings.page_process and settings.viewer:
+        from ..view import page_start  # (a program without a viewer loads no view module)
+
+        # What both processes need is loaded: the page process starts from it.
+        spawned = page_start.fork()
     try:
         return asyncio.run(
             serve(settings, robots, cell, page_process=settings.page_process, spawned=spawned)
@@ -289,7 +292,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
     finally:
         if spawned is not None:
-            close(spawned)  # if it never got its hello (a door could not open)
+            page_start.close(spawned)  # if it never got its hello (a door could not open)
 
 
 if __name__ == "__main__":

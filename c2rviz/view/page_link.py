@@ -1,24 +1,24 @@
 """The page in a process of its own (``--page-process``): the command process's side.
 
-``PageLink`` is the scene the world tells its effects to. It draws nothing: it
-notes what changed (every joint sample of every robot, markers, objects,
-collisions, the tool, the ghost, refusals, the clients and the last commands)
-and, at most once per frame (``1/hz``), publishes one ``frame`` message on the
-channel (``page_channel``) to the page process (``page_process``), which owns
-viser, builds the scene and serves the tabs. So the command loop does only I/O
-and bookkeeping: a frame costs it one msgpack encoding and one socket write,
-whatever the number of tabs.
+``PageLink`` is the scene the world tells its effects to. It draws nothing: it notes
+what changed (``page_frame.FrameNotes``: every joint sample of every robot, markers,
+objects, collisions, the tool, the ghost, refusals, the clients and the last commands,
+the parts, goals, cameras and fault banners) and, at most once per frame (``1/hz``),
+publishes one ``frame`` message on the channel (``page_channel``) to the page process
+(``page_process``), which owns viser, builds the scene and serves the tabs. So the
+command loop does only I/O and bookkeeping: a frame costs it one msgpack encoding and
+one socket write, whatever the number of tabs.
 
-The page process is started fresh (``python -m c2rviz.view.page_process``, so it
-inherits neither the loop nor its threads) and is handed a ``hello``: how to
-serve the page (host, port, hz, the door's policy) and a snapshot of the world
-(``page_snapshot``). Input from the page (sliders, handles, buttons) comes back
-as ``line`` messages and runs on the page's ``Session`` of that robot, like any
-other door's lines. When the page process exits or crashes, the link logs it
-and starts another on the same port (tabs reconnect by themselves) with a fresh
-snapshot; commands go on meanwhile. While the page falls behind (its socket's
-buffer past ``BACKLOG``) frames are dropped and a snapshot follows once it
-catches up.
+The first page process is the one the program forked at start (``page_start.fork``);
+a later one is spawned fresh (``python -m c2rviz.view.page_process``, so it inherits
+neither the loop nor its threads). Each is handed a ``hello``: how to serve the page
+(host, port, hz, the door's policy) and a snapshot of the world (``page_snapshot``).
+Input from the page (sliders, handles, buttons) comes back as ``line`` messages and
+runs on the page's ``Session`` of that robot, like any other door's lines. When the
+page process exits or crashes, the link logs it and starts another on the same port
+(tabs reconnect by themselves) with a fresh snapshot; commands go on meanwhile. While
+the page falls behind (its socket's buffer past ``BACKLOG``) frames are dropped and a
+snapshot follows once it catches up.
 """
 
 from __future__ import annotations

@@ -1,7 +1,8 @@
 """The page process (``--page-process``): viser, the scene and the tabs, off the command loop.
 
-Started by ``page_link.PageLink`` as ``python -m c2rviz.view.page_process FD``, FD being
-its end of the channel (``page_channel``). It reads a ``Hello`` (``page_snapshot``),
+Forked by the program at start (``page_start.fork``, which calls ``run``), or started by
+``page_link.PageLink`` after a crash as ``python -m c2rviz.view.page_process FD``, FD
+being its end of the channel (``page_channel``). It reads a ``Hello`` (``page_snapshot``),
 builds a mirror of the world from it (``MirrorWorld``: the same robots, placed and
 posed as they are, fed by the frames that follow, never moving on its own), and serves
 the page with the usual ``ViserScene`` over it: the same door, origin check, token and

@@ -13,10 +13,12 @@ thousands of times a second; each call only records what changed and asks
 for a send. A send, at most one per frame (``1/hz``), draws the latest state:
 each changed robot's links (Pinocchio FK), its target ghost and path while it
 moves, its panel, the markers, the workcell objects and collisions, the trails
-(``workcell_layer``), the plots and readouts when due; or, while the timeline
-looks back, every robot as it was at that time. A send of many robots comes in
-slices of ``SLICE_S`` (each an atomic batch), the loop taking a turn between
-them, and the scheduler paces sends by their cost (docs/page.md, "Many robots").
+(``workcell_layer``), the parts, goals and cameras (``parts_layer``,
+``camera_layer``), the plots and readouts when due; or, while the timeline looks
+back, every robot as it was at that time (``scene_send``, which holds the sends). A
+send of many robots comes in slices of ``scene_send.SLICE_S`` (each an atomic batch),
+the loop taking a turn between them, and the scheduler paces sends by their cost
+(docs/page.md, "Many robots").
 """
 
 from __future__ import annotations

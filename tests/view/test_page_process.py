@@ -297,12 +297,13 @@ def test_a_forked_page_process_ends_when_the_program_does_not_start(
     from c2rviz.view import page_start
 
     started: list[page_start.Spawned | None] = []
+    fork = page_start.fork
 
     def counted() -> page_start.Spawned | None:
-        started.append(page_start.fork())
+        started.append(fork())
         return started[-1]
 
-    monkeypatch.setattr(cli, "fork", counted)
+    monkeypatch.setattr(page_start, "fork", counted)
     with socket.socket() as taken:
         taken.bind(("127.0.0.1", 0))
         taken.listen()
