@@ -145,13 +145,13 @@ def drive(port: int, names: Sequence[str], until: float) -> int:
 
 
 def page_process(pid: int) -> int | None:
-    """The page process of the program ``pid`` (``--page-process``), if it runs one."""
+    """The page process of the program ``pid`` (``--page-process``), if it runs one: its
+    one child (forked at start, so its command line is the program's)."""
     for entry in Path("/proc").iterdir():
         with contextlib.suppress(OSError, ValueError, IndexError):
             if (
                 entry.name.isdigit()
                 and int((entry / "stat").read_text().rsplit(")", 1)[1].split()[1]) == pid
-                and b"page_process" in (entry / "cmdline").read_bytes()
             ):
                 return int(entry.name)
     return None

@@ -1,4 +1,8 @@
-"""``c2rviz``: the flags, the settings, and then the program (``program.serve``)."""
+"""``c2rviz``: the flags, the settings, and then the program (``program.serve``).
+
+A page process the flags or the ini ask for is forked once the settings are read and the
+robots loaded, before the program starts its loop (``view.page_start.fork``).
+"""
 
 from __future__ import annotations
 
@@ -194,9 +198,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add(
         "--page-process",
-        action="store_true",
+        action="store_const",
+        const=True,
         help="serve the page from a process of its own, so drawing never delays a command "
-        "(docs/page.md)",
+        "(ini: page_process = on; docs/page.md)",
     )
     add("--max-clients", type=int, metavar="N", help="clients at once (default 64)")
     add("--max-line", type=int, metavar="BYTES", help="longest line (default 8192)")
@@ -253,7 +258,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     overrides = {
         k: v
         for k, v in vars(args).items()
-        if k not in ("config", "verbose", "list_robots", "page_process", *MOTION_FLAGS)
+        if k not in ("config", "verbose", "list_robots", *MOTION_FLAGS)
     }
     overrides["motion_flags"] = tuple(
         (k, getattr(args, k)) for k in MOTION_FLAGS if getattr(args, k) is not None
@@ -273,10 +278,21 @@ def main(argv: Sequence[str] | None = None) -> int:
     except C2rvizError as exc:
         print(f"c2rviz: {exc}", file=sys.stderr)
         return 2
+    spawned = None
+    if settings.page_process and settings.viewer:
+        from ..view import page_start  # (a program without a viewer loads no view module)
+
+        # What both processes need is loaded: the page process starts from it.
+        spawned = page_start.fork()
     try:
-        return asyncio.run(serve(settings, robots, cell, page_process=args.page_process))
+        return asyncio.run(
+            serve(settings, robots, cell, page_process=settings.page_process, spawned=spawned)
+        )
     except KeyboardInterrupt:  # a second Ctrl-C while stopping
         return 130
+    finally:
+        if spawned is not None:
+            page_start.close(spawned)  # if it never got its hello (a door could not open)
 
 
 if __name__ == "__main__":

@@ -98,6 +98,9 @@ class Settings:
     """The token the page needs (``?token=``); None: none, unless bound beyond loopback."""
     max_viewers: int = 16
     """Viewer tabs connected at once."""
+    page_process: bool = False
+    """Serve the page from a process of its own (``--page-process``, ini ``page_process =
+    on``; docs/page.md)."""
     rosbridge: bool = True
     """Serve rosbridge (``--no-rosbridge``: not)."""
     rosbridge_port: int | None = None
@@ -183,8 +186,13 @@ _TEXT_OPTIONS = (
     "viewer_token",
     "viewer_origins",
     "clock",
+    "page_process",
 )
-_CHOICES = {"motion": ("off", "on", "follow"), "guard": ("off", "on", "plan")}
+_CHOICES = {
+    "motion": ("off", "on", "follow"),
+    "guard": ("off", "on", "plan"),
+    "page_process": ("off", "on"),
+}
 MOTION_FLAGS = ("max_velocity", "max_acceleration", "max_jerk")
 """Motion limits a flag may give every robot (over the ini's)."""
 _EXTRA_KEYS = ["tool", "gripper", *MOTION_FLAGS]
@@ -211,6 +219,8 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
                     values[key] = path.parent / text
                 elif key == "viewer_origins":
                     values[key] = tuple(text.split())
+                elif key == "page_process":
+                    values[key] = text == "on"
                 else:
                     values[key] = text
             else:

@@ -131,11 +131,12 @@ async def serve(
     cell: str | None = None,
     clock: Clock | None = None,
     page_process: bool = False,
+    spawned: Any = None,
 ) -> int:
     """Run the viewer and a command server per robot until ``quit``, SIGINT or SIGTERM.
 
     ``page_process``: the page runs in a process of its own (``--page-process``,
-    docs/page.md), started here and stopped last.
+    docs/page.md), started here unless ``spawned`` (``page_start.early``), stopped last.
 
     ``members`` are the robots, each by the name the user chose (``--robot kuka_lwr``,
     or a cell's member name), which the banner and ``names`` say. Every command port
@@ -144,7 +145,8 @@ async def serve(
     """
     loop = asyncio.get_running_loop()
     stop = asyncio.Event()
-    spawned = _spawn_page() if page_process and settings.viewer else None
+    if spawned is None and page_process and settings.viewer:
+        spawned = _spawn_page()
     srdf = read_srdf(settings.srdf) if settings.srdf is not None else None
     if clock is None:
         clock = parse_clock(settings.clock)
@@ -276,7 +278,7 @@ async def serve(
 def _spawn_page() -> Any:
     """The page process, started first: it loads viser while we set up (it then waits for
     the world); None if it cannot be started now (the scene tries again, and says why)."""
-    from ..view.page_link import spawn
+    from ..view.page_start import spawn
 
     try:
         return spawn()

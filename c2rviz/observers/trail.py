@@ -47,6 +47,9 @@ class RobotTrail:
         self._count = 0
         self._due = -np.inf  # clock time [s] when the next point may be added
         self._pending: Sequence[float] | None = None  # the latest state not yet added
+        self.clears = 0
+        """Times it was emptied (``trail clear``): a copy of it elsewhere (the page
+        process's) clears its own when this moves."""
 
     def __len__(self) -> int:
         self._take_pending()
@@ -67,6 +70,7 @@ class RobotTrail:
         return self._points[: self._count].copy()
 
     def clear(self) -> None:
+        self.clears += 1
         self._count = 0
         self._pending = None
         self._due = -np.inf

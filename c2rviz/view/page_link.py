@@ -1,24 +1,24 @@
 """The page in a process of its own (``--page-process``): the command process's side.
 
-``PageLink`` is the scene the world tells its effects to. It draws nothing: it
-notes what changed (every joint sample of every robot, markers, objects,
-collisions, the tool, the ghost, refusals, the clients and the last commands)
-and, at most once per frame (``1/hz``), publishes one ``frame`` message on the
-channel (``page_channel``) to the page process (``page_process``), which owns
-viser, builds the scene and serves the tabs. So the command loop does only I/O
-and bookkeeping: a frame costs it one msgpack encoding and one socket write,
-whatever the number of tabs.
+``PageLink`` is the scene the world tells its effects to. It draws nothing: it notes
+what changed (``page_frame.FrameNotes``: every joint sample of every robot, markers,
+objects, collisions, the tool, the ghost, refusals, the clients and the last commands,
+the parts, goals, cameras and fault banners) and, at most once per frame (``1/hz``),
+publishes one ``frame`` message on the channel (``page_channel``) to the page process
+(``page_process``), which owns viser, builds the scene and serves the tabs. So the
+command loop does only I/O and bookkeeping: a frame costs it one msgpack encoding and
+one socket write, whatever the number of tabs.
 
-The page process is started fresh (``python -m c2rviz.view.page_process``, so it
-inherits neither the loop nor its threads) and is handed a ``hello``: how to
-serve the page (host, port, hz, the door's policy) and a snapshot of the world
-(``page_snapshot``). Input from the page (sliders, handles, buttons) comes back
-as ``line`` messages and runs on the page's ``Session`` of that robot, like any
-other door's lines. When the page process exits or crashes, the link logs it
-and starts another on the same port (tabs reconnect by themselves) with a fresh
-snapshot; commands go on meanwhile. While the page falls behind (its socket's
-buffer past ``BACKLOG``) frames are dropped and a snapshot follows once it
-catches up.
+The first page process is the one the program forked at start (``page_start.fork``);
+a later one is spawned fresh (``python -m c2rviz.view.page_process``, so it inherits
+neither the loop nor its threads). Each is handed a ``hello``: how to serve the page
+(host, port, hz, the door's policy) and a snapshot of the world (``page_snapshot``).
+Input from the page (sliders, handles, buttons) comes back as ``line`` messages and
+runs on the page's ``Session`` of that robot, like any other door's lines. When the
+page process exits or crashes, the link logs it and starts another on the same port
+(tabs reconnect by themselves) with a fresh snapshot; commands go on meanwhile. While
+the page falls behind (its socket's buffer past ``BACKLOG``) frames are dropped and a
+snapshot follows once it catches up.
 """
 
 from __future__ import annotations
@@ -28,24 +28,19 @@ import contextlib
 import functools
 import logging
 import pickle
-import socket
 import subprocess
-import sys
 import time
 from collections import deque
-from collections.abc import Awaitable, Sequence
+from collections.abc import Awaitable
 from typing import Any
 
-import numpy as np
-import pinocchio as pin
-
-from ..collision.workcell import WorkcellObject
-from ..errors import C2rvizError, MotionInterrupted, PathCollides
+from ..errors import C2rvizError, MotionInterrupted
 from ..session.services import Services
 from ..session.session import Session
-from ..world.effects import Marker, Scene
 from .page_channel import ChannelError, FrameReader, encode
+from .page_frame import SAMPLES_KEPT, FrameNotes
 from .page_snapshot import Hello, PageConfig, snapshot
+from .page_start import PageProcessHandle, Spawned, spawn
 from .ratelog import RateLimitedLog
 
 __all__ = ["BACKLOG", "SAMPLES_KEPT", "PageLink"]
@@ -54,12 +49,6 @@ log = logging.getLogger("c2rviz.view")
 
 BACKLOG = 8 << 20
 """Bytes waiting for the page process past which frames are dropped (then a snapshot)."""
-SAMPLES_KEPT = 256
-"""Joint samples of one robot kept for one frame (the newest; a flood of ``joints``
-lines is thinned for the page's plots, never for the robot)."""
-PATH_ROWS = 128
-"""Rows a ghost's timed path is sampled at (``ghost.PATH_POINTS // 2``, as the page does;
-not imported: ``ghost`` loads viser, which this process never needs)."""
 START_TIMEOUT_S = 60.0
 """Longest wait for the page process to serve the page [s]."""
 STOP_TIMEOUT_S = 2.0
@@ -68,7 +57,7 @@ RESTART_S = (0.2, 1.0, 5.0)
 """Pauses before starting the page process again after quick successive crashes [s]."""
 
 
-class PageLink(Scene):
+class PageLink(FrameNotes):
     """The world's scene when the page runs in its own process; see the module docstring.
 
     Attributes:
@@ -81,35 +70,25 @@ class PageLink(Scene):
     """
 
     def __init__(
-        self,
-        services: Services,
-        config: PageConfig,
-        spawned: tuple[subprocess.Popen[bytes], socket.socket] | None = None,
+        self, services: Services, config: PageConfig, spawned: Spawned | None = None
     ) -> None:
-        """Set up; ``spawned``: a page process started early (``spawn``), to use first."""
+        """Set up; ``spawned``: a page process started early (``page_start``), to use first."""
         self._spawned = spawned
-        self.services = services
-        self.world = world = services.world
+        world = services.world
         self.config = config
         self.url: str | None = None
         self.port: int | None = None
         self.starts = 0
         self.frames = 0
-        self.process: subprocess.Popen[bytes] | None = None
-        self.sessions: dict[str, Session] = {}
+        self.process: PageProcessHandle | None = None
+        sessions: dict[str, Session] = {}
         for name in world.robots:
             session = Session(services, source="page", robot=name)
             session.set_degrees(True)
             session.set_motion("off" if services.defaults.motion == "off" else "follow")
-            self.sessions[name] = session
-        self._samples: dict[str, deque[list[float]]] = {
-            name: deque(maxlen=SAMPLES_KEPT) for name in world.robots
-        }
-        self._dirty: set[str] = set()
-        self._events: list[list[Any]] = []
-        self._commands: deque[tuple[str, bool]] = deque(maxlen=config.recent_commands)
-        self._trails: list[str] = []
-        self._paths: dict[str, object] = {}  # the path each robot's ghost was last sent
+            sessions[name] = session
+        super().__init__(services, sessions, config.recent_commands)
+        self.request = self._request
         self._writer: asyncio.StreamWriter | None = None
         self._behind = False  # frames were dropped: a snapshot is due
         self._loop: asyncio.AbstractEventLoop | None = None
@@ -150,6 +129,7 @@ class PageLink(Scene):
         if self._flush is not None:
             self._flush.cancel()
         writer, self._writer = self._writer, None
+        self.on_air = False
         if writer is not None:
             with contextlib.suppress(Exception):
                 writer.write(encode(["stop"]))
@@ -208,22 +188,16 @@ class PageLink(Scene):
         except (ChannelError, ConnectionError) as exc:
             log.warning("the page process's channel: %s", exc)
         finally:
-            self._writer = None
+            self._writer, self.on_air = None, False
             writer.close()
         while process.poll() is None and not self._stopping:
             await asyncio.sleep(0.02)
         return process.poll()
 
     def _send_hello(self, writer: asyncio.StreamWriter, config: PageConfig) -> None:
-        hello = Hello(config, snapshot(self.services, self.sessions, self._commands))
+        hello = Hello(config, snapshot(self.services, self.sessions, self.commands))
         writer.write(encode(["hello", pickle.dumps(hello)]))
-        for samples in self._samples.values():
-            samples.clear()
-        self._dirty.clear()
-        self._events.clear()
-        self._trails = sorted(self.services.trails.trails)
-        self._paths.clear()
-        self._dirty.update(self.world.robots)  # the first frame says each ghost's path
+        self.fresh()
         self._behind = False
         self._writer = writer
 
@@ -274,65 +248,6 @@ class PageLink(Scene):
         elif error is not None:
             self._log.warning("failed", f"a page command failed: {line}: {error!r}")
 
-    # the Observer protocol (asyncio thread, O(1) each)
-
-    def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
-        self._samples[robot].append([t, *q])
-        self._dirty.add(robot)
-        self._request()
-
-    def on_gripper(self, robot: str, opening: float, t: float) -> None:
-        self._dirty.add(robot)
-        self._request()
-
-    def on_motion(self, robot: str, t: float) -> None:
-        self._dirty.add(robot)
-        self._request()
-
-    def on_arrived(self, robot: str) -> None:
-        self.on_motion(robot, 0.0)
-
-    def on_stopped(self, robot: str) -> None:
-        self.on_motion(robot, 0.0)
-
-    def on_marker(self, robot: str, marker: Marker) -> None:
-        self._event(["marker", robot, marker.position, marker.wxyz, marker.rgb, marker.shape])
-
-    def on_clear_markers(self, robot: str) -> None:
-        self._event(["clear", robot])
-
-    def on_clients(self, count: int) -> None:
-        self._event(["clients", count])
-
-    def on_command(self, source: str, line: str, accepted: bool) -> None:
-        self._commands.appendleft((line, accepted))
-        self._event(["command", source, line, accepted])
-
-    def on_tool(self, robot: str, tool: pin.SE3) -> None:
-        self._event(["tool", robot, tool.homogeneous.ravel().tolist()])
-
-    def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
-        self._event(["objects", robot, pickle.dumps(list(objects))])
-
-    def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
-        self._event(["collisions", robot, [list(p) for p in pairs]])
-
-    def on_refused(self, robot: str, source: str, line: str, error: C2rvizError) -> None:
-        pair: list[str] | None = None
-        target: list[float] | None = None
-        if isinstance(error, PathCollides):
-            pair = list(error.pair)
-            target = list(error.target) if error.target is not None else None
-        self._event(["refused", robot, source, line, str(error), pair, target])
-
-    def on_ghost(self, robot: str, shown: bool) -> None:
-        self._event(["ghost", robot, shown])
-
-    def _event(self, event: list[Any]) -> None:
-        if self._writer is not None:
-            self._events.append(event)
-            self._request()
-
     # publishing
 
     def _request(self) -> None:
@@ -350,48 +265,16 @@ class PageLink(Scene):
             return
         if writer.transport.get_write_buffer_size() > BACKLOG:
             self._behind = True  # the page is stuck: drop, and send it all when it is not
-            self._dirty.clear()
-            self._events.clear()
-            for samples in self._samples.values():
-                samples.clear()
+            self.drop()
             self._flush = self._loop.call_later(0.1, self._publish) if self._loop else None
             return
         if self._behind:
             self._behind = False
-            now = snapshot(self.services, self.sessions, self._commands)
+            now = snapshot(self.services, self.sessions, self.commands)
             writer.write(encode(["state", pickle.dumps(now)]))
-            self._events.clear()  # the snapshot has them: none twice (a marker)
-            for samples in self._samples.values():
-                samples.clear()
-        world = self.world
-        robots = []
-        for name in self._dirty:
-            state = world.robots[name]
-            samples = self._samples[name]
-            robots.append(
-                [
-                    name,
-                    list(samples),
-                    state.opening,
-                    state.target,
-                    world.moving(name),
-                    world.travels.seconds_left(state),
-                    self.sessions[name].speed,
-                ]
-            )
-            samples.clear()
-            path = world.travel(name).path if robots[-1][4] else None
-            if path is not self._paths.get(name):
-                self._paths[name] = path
-                self._events.append(["path", name, path_rows(path, world.clock.now())])
-        self._dirty.clear()
-        trails = sorted(self.services.trails.trails)
-        if trails != self._trails:
-            self._trails = trails
-            self._events.append(["trails", trails])
-        events, self._events = self._events, []
+            self.fresh()  # the snapshot has it all: nothing twice (a marker)
         try:
-            writer.write(encode(["frame", world.clock.now(), robots, events]))
+            writer.write(encode(self.frame()))
         except ChannelError as exc:  # a frame too big to send: the page gets a snapshot
             self._log.warning("frame", f"a page frame was dropped: {exc}")
             self._behind = True
@@ -403,40 +286,3 @@ class PageLink(Scene):
     def pid(self) -> int | None:
         """The page process's id, if one runs."""
         return self.process.pid if self.process is not None else None
-
-
-def path_rows(path: Any, now: float) -> list[list[float]] | None:
-    """The joint rows of a ghost's path (``ghost.tool_path`` draws them), or None."""
-    if path is None:
-        return None
-    rows = getattr(path, "joint_path", None)
-    if rows is None:
-        rows = getattr(path, "qs", None)
-    if rows is None or len(rows) < 2:
-        times = np.linspace(now, max(float(path.arrival), now), PATH_ROWS)
-        rows = [path.sample(float(t)) for t in times]
-    return np.asarray(rows, dtype=float).tolist()  # type: ignore[no-any-return]
-
-
-def spawn() -> tuple[subprocess.Popen[bytes], socket.socket]:
-    """Start a page process; it and our end of its channel. It loads viser and waits for
-    its ``hello`` meanwhile, so the program starts it as early as it can.
-
-    Raises:
-        OSError: it cannot be started.
-    """
-    ours, theirs = socket.socketpair()
-    try:
-        process = subprocess.Popen(
-            [sys.executable, "-m", "c2rviz.view.page_process", str(theirs.fileno())],
-            pass_fds=(theirs.fileno(),),
-            stdin=subprocess.DEVNULL,
-            stdout=subprocess.DEVNULL,
-            start_new_session=True,  # a Ctrl-C is ours to act on: we stop it in order
-        )
-    except OSError:
-        ours.close()
-        raise
-    finally:
-        theirs.close()
-    return process, ours

@@ -1,7 +1,8 @@
 """The page process (``--page-process``): viser, the scene and the tabs, off the command loop.
 
-Started by ``page_link.PageLink`` as ``python -m c2rviz.view.page_process FD``, FD being
-its end of the channel (``page_channel``). It reads a ``Hello`` (``page_snapshot``),
+Forked by the program at start (``page_start.fork``, which calls ``run``), or started by
+``page_link.PageLink`` after a crash as ``python -m c2rviz.view.page_process FD``, FD
+being its end of the channel (``page_channel``). It reads a ``Hello`` (``page_snapshot``),
 builds a mirror of the world from it (``MirrorWorld``: the same robots, placed and
 posed as they are, fed by the frames that follow, never moving on its own), and serves
 the page with the usual ``ViserScene`` over it: the same door, origin check, token and
@@ -22,26 +23,24 @@ import pickle
 import signal
 import socket
 import sys
-import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
-from ..collision.workcell import WorkcellObject
 from ..errors import C2rvizError, PathCollides
 from ..session.services import Services
 from ..session.session import Reply, Session
-from ..world.clock import Clock
-from ..world.state import Marker, RobotState
-from ..world.world import World
+from ..world.state import Marker
+from .mirror_world import MirrorClock, MirrorWorld, _Path
+from .page_cell import MirrorCell
 from .page_channel import FrameReader, encode
 from .page_snapshot import Hello, Snapshot
 from .policy import DoorPolicy
 from .viser_scene import ViserScene
 
-__all__ = ["REST_PER_WORK", "ForwardingSession", "MirrorWorld", "main"]
+__all__ = ["REST_PER_WORK", "ForwardingSession", "MirrorWorld", "PageProcess", "main"]
 
 log = logging.getLogger("c2rviz.view")
 
@@ -49,85 +48,6 @@ REST_PER_WORK = 0.25
 """The page's sends leave its loop this much time per second of work (the program's
 page leaves 1.0, ``scheduler.REST_PER_WORK``, for its clients' lines): here the loop
 serves no client, only the channel, whose frames wait in the socket meanwhile."""
-
-
-class MirrorClock(Clock):
-    """The command process's clock, as last heard of, running on at real speed."""
-
-    def __init__(self, t: float) -> None:
-        self.offset = t - time.monotonic()
-
-    def now(self) -> float:
-        return time.monotonic() + self.offset
-
-    def heard(self, t: float) -> None:
-        """The command process's clock read ``t`` just now."""
-        self.offset = t - time.monotonic()
-
-
-class _Path:
-    """A ghost's path as the command process sent it: joint rows (``ghost.tool_path``)."""
-
-    def __init__(self, rows: list[list[float]]) -> None:
-        self.joint_path = np.asarray(rows, dtype=float)
-        self.arrival = 0.0
-
-
-class _Travel:
-    """A robot's motion as the command process last said: moving or not, its path."""
-
-    def __init__(self) -> None:
-        self.active = False
-        self.path: _Path | None = None
-        self.seconds_left = 0.0
-
-
-class _Travels:
-    """Stands in for ``world.moves.Travels``: what the page reads of it."""
-
-    def __init__(self, names: Sequence[str]) -> None:
-        self.by_robot = {name: _Travel() for name in names}
-
-    def seconds_left(self, state: RobotState) -> float:
-        return self.by_robot[state.name].seconds_left
-
-    def now(self, state: RobotState) -> tuple[float, ...]:
-        return state.q
-
-    def stop_all(self) -> None:
-        pass
-
-
-class MirrorWorld(World):
-    """The world of the command process, as the frames tell it; see the module docstring.
-
-    Attributes:
-        objects: Each robot's workcell objects (there is no collision model here).
-    """
-
-    def __init__(self, snap: Snapshot, hz: float) -> None:
-        super().__init__(
-            {name: r.robot for name, r in snap.robots.items()},
-            clock=MirrorClock(snap.t),
-            hz=1.0 / snap.frame_s,
-            origins={name: r.origin for name, r in snap.robots.items()},
-            limits={name: r.limits for name, r in snap.robots.items()},
-        )
-        self.travels = _Travels(list(snap.robots))  # type: ignore[assignment]
-        self.observers = []  # no collision checks here: the scene, and a trail when on
-        self.objects: dict[str, list[WorkcellObject]] = {}
-        for name, r in snap.robots.items():
-            state = self.robots[name]
-            state.q, state.target, state.opening = r.q, r.target, r.opening
-            state.tool, state.ghost = r.tool, r.ghost
-            state.markers.extend(r.markers)
-            self.objects[name] = list(r.objects)
-            self.moved(name, r.moving, r.seconds_left)
-
-    def moved(self, name: str, moving: bool, seconds_left: float) -> None:
-        travel = self.travels.by_robot[name]
-        travel.active = moving
-        travel.seconds_left = seconds_left  # type: ignore[attr-defined]
 
 
 class ForwardingSession(Session):
@@ -167,6 +87,10 @@ class PageProcess:
         self.services = Services(world, defaults=config.defaults, trail_points=config.trail_points)
         world.observers = []  # drop what Services added (guards): the page only draws
         self.services.watch.origin = snap.watch_origin
+        self.cell = MirrorCell(world)
+        for name, r in snap.robots.items():
+            self.cell.objects(name, r.objects)
+        self._clears: dict[str, int] = {}  # each trail's clears, as last told
         policy = DoorPolicy(config.origins, config.token, config.max_viewers)
         self.scene = ViserScene(
             self.services,
@@ -218,13 +142,21 @@ class PageProcess:
             self.sessions_speed(name, r.speed)
             world._show(state, r.q, snap.t)
             world._show_opening(state, r.opening, snap.t)
-            world.objects[name] = list(r.objects)
-            scene.on_objects(name, r.objects)
+            self.objects(name, r.objects)
             scene.on_collisions(name, r.collisions)
+            scene.show_faults(name, snap.banners.get(name, ""))
         self.trails(snap.trails)
         scene.on_clients(snap.clients)
         for line, accepted in reversed(snap.commands):
             scene.on_command("", line, accepted)
+        scene.on_parts(self.cell.parts(snap.parts), snap.t)
+        scene.on_goals(self.cell.set_goals(snap.goals))
+        scene.on_cameras(self.cell.cameras(snap.cameras))
+
+    def objects(self, name: str, objects: Sequence[Any]) -> None:
+        self.world.objects[name] = list(objects)
+        self.cell.objects(name, objects)
+        self.scene.on_objects(name, objects)
 
     def sessions_speed(self, name: str, speed: float) -> None:
         session = self.scene.sessions.get(name)
@@ -270,9 +202,7 @@ class PageProcess:
             world.robots[event[1]].tool = tool
             scene.on_tool(event[1], tool)
         elif kind == "objects":
-            objects = pickle.loads(event[2])
-            world.objects[event[1]] = objects
-            scene.on_objects(event[1], objects)
+            self.objects(event[1], pickle.loads(event[2]))
         elif kind == "collisions":
             scene.on_collisions(event[1], [(a, b) for a, b in event[2]])
         elif kind == "refused":
@@ -283,18 +213,33 @@ class PageProcess:
             scene.on_ghost(event[1], event[2])
         elif kind == "trails":
             self.trails(event[1])
+        elif kind == "parts":
+            scene.on_parts(self.cell.parts(event[1]), event[2])
+        elif kind == "goals":
+            scene.on_goals(self.cell.set_goals(event[1]))
+        elif kind == "cameras":
+            scene.on_cameras(self.cell.cameras(event[1]))
+        elif kind == "fault":
+            scene.show_faults(event[1], event[2])
         elif kind == "path":
             travel = world.travels.by_robot[event[1]]
             travel.path = None if event[2] is None else _Path(event[2])  # type: ignore[assignment]
             scene.redraw(event[1])
 
-    def trails(self, on: Sequence[str]) -> None:
-        keeper = self.services.trails
-        for name in set(keeper.trails) - set(on):
+    def trails(self, on: Sequence[Sequence[Any]]) -> None:
+        """The trails on are ``on``: [name, clears] each (a trail whose clears moved
+        was cleared: the page's is cleared too, from where its arm is now)."""
+        keeper, clears = self.services.trails, dict((name, n) for name, n in on)
+        for name in set(keeper.trails) - set(clears):
             keeper.stop(name)
-        for name in on:
-            if name not in keeper.trails and name in self.world.robots:
+        for name, n in clears.items():
+            if name not in self.world.robots:
+                continue
+            if name not in keeper.trails:
                 keeper.start(name)
+            elif self._clears.get(name, n) != n:
+                keeper.clear(name)
+        self._clears = clears
 
 
 def _error(text: str, pair: list[str] | None, target: list[float] | None) -> C2rvizError:
@@ -360,7 +305,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("usage: python -m c2rviz.view.page_process FD (started by c2rviz)", file=sys.stderr)
         return 2
     logging.basicConfig(level=logging.WARNING, format="c2rviz: %(levelname)s: %(message)s")
-    sock = socket.socket(fileno=int(args[0]))
+    return run(socket.socket(fileno=int(args[0])))
+
+
+def run(sock: socket.socket) -> int:
+    """Serve the page over channel ``sock`` until told to stop or it ends; the exit status
+    (``main``'s, or that of the page process the program forked, ``page_start.fork``)."""
     try:
         return asyncio.run(serve(sock))
     except KeyboardInterrupt:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import pinocchio as pin
 
@@ -22,6 +23,8 @@ from ..session.services import Services
 from ..session.session import Session
 from ..session.settings import SessionDefaults
 from ..world.state import Marker
+from .page_cell import camera_rows, fault_banners, goal_rows, part_rows
+from .page_frame import trail_state
 
 __all__ = ["RECENT_COMMANDS", "Hello", "PageConfig", "RobotSnapshot", "Snapshot", "snapshot"]
 
@@ -96,18 +99,24 @@ class Snapshot:
         watch_origin: The time the page's times count from [s of the clock].
         frame_s: The world's time between two samples of a moving arm [s].
         robots: Each robot, by name, the default first.
-        trails: The robots whose trail is on.
+        trails: The robots whose trail is on, each with how often it was cleared.
         clients: Clients connected through every door.
         commands: The last commands, newest first, and whether each was accepted.
+        parts, goals, cameras: Their rows (``page_cell``).
+        banners: Each robot's fault banner that is not empty, by name.
     """
 
     t: float
     watch_origin: float
     frame_s: float
     robots: dict[str, RobotSnapshot]
-    trails: list[str]
+    trails: list[list[Any]]
     clients: int
     commands: list[tuple[str, bool]]
+    parts: list[list[Any]]
+    goals: list[list[Any]]
+    cameras: list[list[Any]]
+    banners: dict[str, str]
 
 
 @dataclass(frozen=True)
@@ -147,7 +156,11 @@ def snapshot(
         watch_origin=services.watch.origin,
         frame_s=world.frame_s,
         robots=robots,
-        trails=sorted(services.trails.trails),
+        trails=trail_state(services),
         clients=services.client_count,
         commands=list(commands),
+        parts=part_rows(world.parts.parts.all()),
+        goals=goal_rows(world.parts.goals.all()),
+        cameras=camera_rows(world.cameras.all()),
+        banners=fault_banners(world),
     )

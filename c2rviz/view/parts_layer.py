@@ -64,8 +64,8 @@ class PartsLayer:
             drawn = self.nodes.get(part.name)
             if drawn is None or drawn[2] != key:
                 if drawn is not None:
+                    drawn[1].remove()  # first: removing the node takes its label with it
                     drawn[0].remove()
-                    drawn[1].remove()
                 path = f"/parts/{node_name(part.name)}"
                 node = _shape_node(
                     self._scene, path, part.obj.shape, part.obj.size, part.obj.rgba[:3]
@@ -80,8 +80,8 @@ class PartsLayer:
             label.text = f"{part.name} (held by {part.holder})" if held else part.name
         for name in [n for n in self.nodes if n not in seen]:
             node, label, _ = self.nodes.pop(name)
+            label.remove()  # first: removing the node takes its label with it
             node.remove()
-            label.remove()
 
     def show_goals(self, goals: Sequence[Goal], parts: Sequence[Part]) -> None:
         """Replace the drawn goals by ``goals`` (outlines of their parts' shapes)."""

@@ -13,10 +13,12 @@ thousands of times a second; each call only records what changed and asks
 for a send. A send, at most one per frame (``1/hz``), draws the latest state:
 each changed robot's links (Pinocchio FK), its target ghost and path while it
 moves, its panel, the markers, the workcell objects and collisions, the trails
-(``workcell_layer``), the plots and readouts when due; or, while the timeline
-looks back, every robot as it was at that time. A send of many robots comes in
-slices of ``SLICE_S`` (each an atomic batch), the loop taking a turn between
-them, and the scheduler paces sends by their cost (docs/page.md, "Many robots").
+(``workcell_layer``), the parts, goals and cameras (``parts_layer``,
+``camera_layer``), the plots and readouts when due; or, while the timeline looks
+back, every robot as it was at that time (``scene_send``, which holds the sends). A
+send of many robots comes in slices of ``scene_send.SLICE_S`` (each an atomic batch),
+the loop taking a turn between them, and the scheduler paces sends by their cost
+(docs/page.md, "Many robots").
 """
 
 from __future__ import annotations
@@ -25,7 +27,6 @@ import asyncio
 import errno
 import logging
 import socket
-import time
 from collections import deque
 from collections.abc import Callable, Sequence
 
@@ -33,26 +34,26 @@ import numpy as np
 import pinocchio as pin
 
 from ..collision.workcell import WorkcellObject
-from ..errors import C2rvizError, EmergencyStop
+from ..errors import C2rvizError
 from ..robot.visuals import LinkGeometry, load_link_geometry
 from ..session.services import Services
 from ..session.session import Session
-from ..world.camera_sight import sight
 from ..world.cameras import Camera
 from ..world.effects import Marker, Scene
 from ..world.goals import Goal
 from ..world.parts import Part
-from ..world.world import World
 from . import adapter
 from .camera_layer import CameraLayer
 from .handle import ToolHandles
 from .instruments import Instruments
 from .markers import MarkerLayer
+from .page_cell import fault_banner
 from .page_input import PageInput
 from .panel import RECENT_COMMANDS, RobotPanel, StatePanel
 from .parts_layer import PartsLayer
 from .policy import DoorPolicy
 from .robot_view import RobotView, node_name
+from .scene_send import SceneSends
 from .scheduler import SendScheduler
 from .timeline import Timeline
 from .workcell_layer import TrailLayer, WorkcellLayer
@@ -62,12 +63,9 @@ __all__ = ["RECENT_COMMANDS", "STOP_TIMEOUT_S", "ViserScene"]
 log = logging.getLogger("c2rviz.view")
 
 STOP_TIMEOUT_S = 0.5  # longest wait for viser to stop [s]; it goes on stopping after
-SLICE_S = 0.002
-"""Longest run of drawing robots before the loop gets a turn [s] (a send of many robots
-comes in slices, so a client's line never waits behind a whole frame)."""
 
 
-class ViserScene(Scene):
+class ViserScene(SceneSends, Scene):
     """The viser implementation of ``scene.Scene``; see the module docstring.
 
     Attributes:
@@ -288,9 +286,14 @@ class ViserScene(Scene):
         self.scheduler.request()
 
     def on_fault(self, robot: str, text: str) -> None:
+        self.show_faults(robot, fault_banner(self.world, robot))
+
+    def show_faults(self, robot: str, banner: str) -> None:
+        """Show ``banner`` (markdown, "" for none) as ``robot``'s fault banner (the page
+        process is told the command process's, ``page_cell.fault_banner``)."""
         panel = self.panels.get(robot)
         if panel is not None:
-            panel.show_faults(fault_banner(self.world, robot))
+            panel.show_faults(banner)
             self.scheduler.request()
 
     def on_parts(self, parts: Sequence[Part], t: float) -> None:
@@ -361,126 +364,10 @@ class ViserScene(Scene):
         """Markers held for every robot (drawn at the next send)."""
         return self.markers.count()
 
-    # sending
-
-    def _send(self) -> bool:
-        """Draw whatever changed since the last send, in one atomic batch per slice.
-
-        A send draws each robot changed at its start once; after ``SLICE_S`` of drawing
-        robots it returns True, the robots left for its next slice (the scheduler runs
-        it at the loop's next turn). The last slice draws the rest: markers, workcells,
-        instruments, the state panel.
-        """
-        if self._stopped:
-            return False
-        world, instruments = self.world, self.instruments
-        began = time.perf_counter()
-        with self.server.atomic():
-            shown = instruments.shown()  # None: now; else the time the page looks back at
-            if shown is None:
-                if self._drawing is None:  # a new send: the robots changed by now
-                    objects_now = instruments.back_to_live()
-                    if objects_now is not None:  # back from looking back: all, as it is now
-                        self._objects.update(objects_now)
-                        self._dirty.update(world.robots)
-                    self._drawing, self._dirty = list(self._dirty), set()
-                drew = bool(self._drawing)
-                if self._draw_robots(began + SLICE_S):
-                    return True  # robots left for the next slice
-                if drew and time.perf_counter() > began + SLICE_S / 2:
-                    self._drawing = []  # all drawn: the rest gets a slice of its own
-                    return True
-                self.markers.draw()
-            else:
-                if self._drawing:  # looked back mid-send: those robots wait for live
-                    self._dirty.update(self._drawing)
-                instruments.draw_past(shown)
-            self._drawing = None
-            for name in self.handles.due():
-                if name in world.robots:
-                    self.handles.draw(world.robots[name])
-            self._draw_workcells(shown is None)
-            instruments.draw(shown, time.perf_counter() + SLICE_S)
-            if self._state_dirty:
-                self._state_dirty = False
-                self.state_panel.show(self._client_count, self._commands)
-        self.server.flush()
-        return False
-
-    def _draw_robots(self, deadline: float) -> bool:
-        """Draw the robots of this send until ``deadline`` [s of ``time.perf_counter``],
-        at least one.
-
-        Returns:
-            Whether robots are left for the next slice.
-        """
-        drawing = self._drawing
-        assert drawing is not None
-        world, busy, instruments = self.world, self.page_input.busy, self.instruments
-        while drawing:
-            state = world.robots.get(drawing.pop())
-            if state is None:
-                continue
-            name = state.name
-            view, panel = self.views[name], self.panels[name]
-            ee = view.draw(state.q, state.opening)
-            instruments.draw_live(name)
-            panel.show_joints(state.target, busy)
-            panel.show_motion(world.moving(name), world.travels.seconds_left(state))
-            self.handles.draw(state, ee)
-            if drawing and time.perf_counter() >= deadline:
-                return True
-        return False
-
-    def _draw_workcells(self, live: bool) -> None:
-        """The objects (``live``: looking back draws its own) and collisions that changed,
-        and the trails if they moved."""
-        if live:
-            for name, objects in self._objects.items():
-                if name in self.workcells:
-                    self.workcells[name].show_objects(objects)
-            self._objects.clear()
-            if self._parts is not None:
-                self.parts.show_parts(self._parts)
-                self._parts = None
-            if self._goals is not None:
-                self.parts.show_goals(self._goals, self.world.parts.parts.all())
-                self._goals = None
-            if self._cameras is not None:
-                seen = {
-                    c.name: [s.name for s in sight(self.world, c.name, noisy=False)]
-                    for c in self._cameras
-                }
-                self.cameras.show(self._cameras, self.world.clock.now(), seen)
-                self._cameras = None
-        for name, pairs in self._collisions.items():
-            if name in self.workcells:
-                self.workcells[name].show_collisions(pairs)
-                self.panels[name].show_collisions(pairs)
-        self._collisions.clear()
-        keeper = self.services.trails
-        if keeper.changed != self.trails.drawn:
-            for name, panel in self.panels.items():
-                panel.show_trail(name in keeper.trails)
-            self.trails.draw(keeper)
-
     def _show_collision(self, shown: bool) -> None:
         for view in self.views.values():
             view.show_collision(shown)
         self.server.flush()
-
-
-def fault_banner(world: World, robot: str) -> str:
-    """The page's banner for ``robot``'s faults (markdown; "" without any)."""
-    rules = world.faults
-    faults = rules.of(robot)
-    stop = faults.refusal(rules.origin)
-    if isinstance(stop, EmergencyStop):
-        return f"**EMERGENCY STOP** — `{stop}`"  # (no emoji: a page may have no font for it)
-    if stop is not None:
-        return f"**PROTECTIVE STOP** — `{stop}`"
-    active = [fault.text(faults.joint_names) for fault, _ in faults.active.values()]
-    return "**Faults:** " + ", ".join(f"`{text}`" for text in active) if active else ""
 
 
 def _page_session(services: Services, robot: str) -> Session:

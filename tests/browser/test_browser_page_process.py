@@ -16,6 +16,14 @@ import test_browser_cartesian
 import test_browser_instruments
 import test_browser_motion
 import test_browser_trail
+from browser_support import (
+    DEADLINE_S,
+    changed,
+    program_page,
+    scene_pixels,
+    settle,
+    wait_for,
+)
 from test_browser import other_origin  # noqa: F401 (a fixture a test below asks for)
 
 pytestmark = pytest.mark.browser
@@ -61,3 +69,33 @@ def test_the_same_with_the_page_in_its_own_process(
         if arg not in ("browser", "c2rviz_process")
     }
     test(browser=browser, c2rviz_process=in_its_own_process, **more)
+
+
+def scene_nodes(page: Any) -> list[str]:
+    return page.evaluate("() => Object.keys(window.__viserSceneTree.getState())")  # type: ignore[no-any-return]
+
+
+def test_parts_goals_cameras_and_the_fault_banner_come_from_the_page_process(
+    browser: Any, c2rviz_process: Callable[..., Any]
+) -> None:
+    """What the in-process page draws of the cell (tests/view/test_view_parts.py,
+    test_view_cameras.py, the banner in test_view_instruments.py), drawn by the page
+    process from the rows the channel carries, in real Chromium."""
+    with program_page(browser, c2rviz_process, "--page-process") as (_, page, tcp):
+        home = settle(page, "page-process-cell-1-home")
+        assert tcp.ask("part p1 box 0.1,0.1,0.1 0.6,0.3,0.05,0,0,0") == "ok"
+        assert tcp.ask("goal p1 0.6,-0.3,0.05,0,0,0") == "ok"
+        assert tcp.ask("camera top 0.6,0,1.2,0,1.5707963267948966,0") == "ok"
+        wanted = ("/parts/p1", "/parts/p1/label", "/goals/p1", "/cameras/top/label")
+        wait_for(lambda: all(n in scene_nodes(page) for n in wanted), "the part, goal and camera")
+        wait_for(lambda: changed(home, scene_pixels(page)) > 200, "the cell drawn")
+        settle(page, "page-process-cell-2-drawn")
+        assert tcp.ask("fault stall joint_l") == "ok"
+        banner = page.locator("code", has_text="stall joint_l")  # the banner's markdown
+        banner.first.wait_for(state="visible", timeout=DEADLINE_S * 1000)
+        assert page.get_by_text("Faults:").first.is_visible()
+        assert tcp.ask("fault clear") == "ok"
+        wait_for(lambda: not banner.first.is_visible(), "the banner gone")
+        for line in ("part p1 remove", "goal all remove", "camera top remove"):
+            assert tcp.ask(line) == "ok", line
+        wait_for(lambda: not any(n in scene_nodes(page) for n in wanted), "the cell's things gone")

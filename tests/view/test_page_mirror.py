@@ -4,10 +4,13 @@ effect the scene is told arrives, and the page's lines go back to the page's ses
 
 from __future__ import annotations
 
+import math
 import pickle
 from collections.abc import Iterator
 from typing import Any
 
+import numpy as np
+import pinocchio as pin
 import pytest
 from support import load_robot
 
@@ -58,6 +61,7 @@ class Both:
         hello = Hello(config, snapshot(self.services, self.link.sessions, []))
         self.page = PageProcess(pickle.loads(pickle.dumps(hello)), self.to_program)  # type: ignore[arg-type]
         self.link._writer = self.to_page  # type: ignore[assignment]
+        self.link.fresh()  # as the hello does: the link notes what follows
         self.session = Session(self.services, robot=ROBOT)
         self.session.set_degrees(True)
 
@@ -142,3 +146,89 @@ def test_a_page_that_fell_behind_gets_the_whole_world_again(both: Both) -> None:
     both.frame()
     assert len(both.mirror.markers) == 2
     assert both.mirror.q == pytest.approx(both.world.robots[ROBOT].q)
+
+
+def drawn(both: Both) -> Any:
+    """A frame applied, then the page's scene's send run to its end; the scene."""
+    both.frame()
+    scene = both.page.scene
+    while scene._send():  # slices
+        pass
+    return scene
+
+
+def test_parts_goals_cameras_and_the_fault_banner_reach_the_page(both: Both) -> None:
+    run = both.session.run
+    assert run("part p1 box 0.03,0.03,0.05 0.5,0,0.025,0,0,0") == "ok"
+    assert run("goal p1 0.5,0.2,0.025,0,0,0") == "ok"
+    assert run("camera top 0.5,0,1,0,90,0") == "ok"
+    assert run("fault stall joint_l") == "ok"
+    scene = drawn(both)
+    node, label, _ = scene.parts.nodes["p1"]
+    np.testing.assert_allclose(node.position, [0.5, 0, 0.025], atol=1e-9)
+    assert label.text == "p1" and node.opacity is None
+    goal = scene.parts.goals["p1"]
+    assert goal.wireframe and tuple(goal.dimensions) == pytest.approx((0.03, 0.03, 0.05))
+    np.testing.assert_allclose(goal.position, [0.5, 0.2, 0.025], atol=1e-9)
+    camera, seen, _ = scene.cameras.nodes["top"]
+    np.testing.assert_allclose(camera.position, [0.5, 0, 1], atol=1e-9)
+    assert seen.text == "top: p1"
+    banner = scene.panels[ROBOT].banner
+    assert banner.visible and banner.content == "**Faults:** `stall joint_l`"
+    # An object over the part hides it from the camera, in the page as in the program.
+    assert run("object lid box 0.3,0.3,0.01 0.5,0,0.5,0,0,0") == "ok"
+    drawn(both)
+    assert seen.text == "top: none"
+    both.world.cameras.blackout("top", math.inf)
+    assert drawn(both).cameras.nodes["top"][1].text == "top: dark"
+    for line in ("part p1 remove", "goal all remove", "camera top remove", "fault clear"):
+        assert run(line) == "ok", line
+    scene = drawn(both)
+    assert scene.parts.nodes == {} and scene.parts.goals == {} and scene.cameras.nodes == {}
+    assert not banner.visible
+
+
+def test_a_held_part_follows_the_mirrors_arm(both: Both) -> None:
+    """A held part's row says its link and offset: the mirror moves it with its own joint
+    samples, as the world does, and the page labels it held."""
+    world = both.world
+    assert both.session.run("part p1 box 0.03,0.03,0.03 0.5,0,0.015,0,0,0") == "ok"
+    part = world.parts.parts.get("p1")
+    link = world.robots[ROBOT].robot.eelink
+    part.holder, part.link, part.offset = ROBOT, link, pin.SE3.Identity()
+    assert both.session.run("move 0 30") == "ok"  # the world moves p1 with the arm
+    scene = drawn(both)
+    mirrored = both.page.world.parts.parts.get("p1")
+    assert mirrored.holder == ROBOT and mirrored.link == link
+    assert mirrored.pose.isApprox(part.pose, 1e-9)
+    node, label, _ = scene.parts.nodes["p1"]
+    assert label.text == f"p1 (held by {ROBOT})" and node.opacity is not None
+    np.testing.assert_allclose(node.position, part.pose.translation, atol=1e-9)
+
+
+def test_a_page_that_fell_behind_gets_the_parts_cameras_and_banner_again(both: Both) -> None:
+    for line in ("part p1 box 0.03,0.03,0.03 0.5,0,0.015,0,0,0", "camera top 0.5,0,1,0,90,0"):
+        assert both.session.run(line) == "ok", line
+    assert both.session.run("fault estop") == "ok"
+    both.link._behind = True
+    both.to_page.data.clear()  # as if those frames were dropped
+    scene = drawn(both)
+    assert list(scene.parts.nodes) == ["p1"] and list(scene.cameras.nodes) == ["top"]
+    assert "EMERGENCY STOP" in scene.panels[ROBOT].banner.content
+
+
+def test_a_trail_clear_clears_the_pages_trail(both: Both) -> None:
+    run = both.session.run
+    assert run("trail on") == "ok"
+    both.frame()
+    keeper, kept = both.page.services.trails, both.services.trails
+    for k in range(1, 100_000):  # a point per frame of the clock: move until there are 4
+        assert run(f"move 0 {k % 90}") == "ok"
+        both.frame()
+        if len(kept.points(ROBOT)) >= 4:
+            break
+    np.testing.assert_allclose(keeper.points(ROBOT), kept.points(ROBOT))
+    assert run("trail clear") == "ok"
+    both.frame()
+    assert len(keeper.points(ROBOT)) == 1  # from where the arm is now
+    np.testing.assert_allclose(keeper.points(ROBOT), kept.points(ROBOT))

@@ -76,16 +76,18 @@ def children(pid: int) -> list[int]:
     return out
 
 
-def page_process(pid: int) -> int:
-    """The page process of the program ``pid``, once it runs."""
+def page_process(pid: int, but: int | None = None) -> int:
+    """The page process of the program ``pid`` (other than ``but``), once it runs: its one
+    child (forked at start, so named as the program is; spawned on a restart)."""
     deadline = time.monotonic() + DEADLINE_S
     while time.monotonic() < deadline:
         for child in children(pid):
             try:
-                if b"c2rviz.view.page_process" in Path(f"/proc/{child}/cmdline").read_bytes():
-                    return child
+                state = Path(f"/proc/{child}/stat").read_text().rsplit(")", 1)[1].split()[0]
             except OSError:
                 continue
+            if child != but and state != "Z":
+                return child
         time.sleep(0.05)
     raise AssertionError("no page process")
 
@@ -150,8 +152,8 @@ def test_a_killed_page_process_comes_back_and_commands_go_on(
         assert mover.ask("where") == "ok 90,0,0,0,0,0,0"
         said = "".join(read_until(proc, "starting it again"))
         assert "the page process stopped (status -9)" in said
-        second = page_process(proc.popen.pid)
-        assert second != first
+        second = page_process(proc.popen.pid, but=first)
+        assert b"c2rviz.view.page_process" in Path(f"/proc/{second}/cmdline").read_bytes()
         assert bystander.ask("mark") == "ok"
         # A tab opened now, on the same URL, gets the whole scene: the robot where it
         # is, both markers, the last commands. (A tab that came before the new page
@@ -255,3 +257,67 @@ def test_the_program_side_never_loads_viser() -> None:
         "import sys, c2rviz.app.program, c2rviz.view.page_link; sys.exit('viser' in sys.modules)"
     )
     assert subprocess.run([sys.executable, "-c", check], timeout=DEADLINE_S).returncode == 0
+
+
+# the ini key and the early start
+
+
+def test_the_ini_key_serves_the_page_from_its_own_process(
+    c2rviz_process: Callable[..., Any], tmp_path: Path
+) -> None:
+    ini = tmp_path / "cmdinterpreter.ini"
+    ini.write_text("[options]\npage_process = on\n")
+    proc = c2rviz_process("--config", str(ini), "--viser-port", "0")
+    assert page_process(proc.popen.pid)
+    assert "joint_s" in gui_values(scene(proc.viewer_url))
+    ini.write_text("[options]\npage_process = off\n")
+    proc = c2rviz_process("--config", str(ini), "--viser-port", "0")
+    assert children(proc.popen.pid) == []  # the page in the program's own process
+
+
+def test_a_bad_ini_value_names_the_choices(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from c2rviz.app.cli import main
+
+    ini = tmp_path / "cmdinterpreter.ini"
+    ini.write_text("[options]\npage_process = yes\n")
+    assert main(["--config", str(ini), "--port", "0"]) == 2
+    said = capsys.readouterr().err
+    assert "[options] page_process = 'yes' is not one" in said and "off, on" in said, said
+    assert not [c for c in children(os.getpid()) if is_page_process(c)]
+
+
+def test_a_forked_page_process_ends_when_the_program_does_not_start(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The page process is forked before the loop starts; a program that then cannot open
+    a door (its command port taken) closes it: none is left behind."""
+    from c2rviz.app import cli
+    from c2rviz.view import page_start
+
+    started: list[page_start.Spawned | None] = []
+    fork = page_start.fork
+
+    def counted() -> page_start.Spawned | None:
+        started.append(fork())
+        return started[-1]
+
+    monkeypatch.setattr(page_start, "fork", counted)
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = str(taken.getsockname()[1])
+        assert cli.main(["--page-process", "--port", port, "--no-crcl", "--no-rosbridge"]) == 2
+    assert "the port is in use" in capsys.readouterr().err
+    assert len(started) == 1 and started[0] is not None
+    process, _ = started[0]
+    assert process.poll() is not None  # it ended: no page process left
+    assert process.pid not in children(os.getpid())
+
+
+def is_page_process(pid: int) -> bool:
+    try:
+        return b"c2rviz.view.page_process" in Path(f"/proc/{pid}/cmdline").read_bytes()
+    except OSError:
+        return False

@@ -1,6 +1,6 @@
 """Many robots on one page: sends in slices, paced by their cost, and nothing dropped.
 
-A send of a big cell comes in slices (``viser_scene.SLICE_S``) and link poses go out
+A send of a big cell comes in slices (``scene_send.SLICE_S``) and link poses go out
 only where they changed (``adapter.PoseBatch``); these tests check that no pose is
 lost on the way: a real ``ViserScene`` and a real websocket tab (``viewer_tabs``), the
 tab's view of every link compared with Pinocchio's FK.
@@ -19,7 +19,7 @@ import pytest
 from support import load_robot
 from viewer_tabs import Harness, Tab
 
-from c2rviz.view import adapter, viser_scene
+from c2rviz.view import adapter, scene_send, viser_scene
 from c2rviz.view.plots import PLOT_HZ, PLOTS_PER_S
 from c2rviz.view.readout import READOUT_HZ, READOUTS_PER_S
 from c2rviz.view.scheduler import REST_PER_WORK, SendScheduler
@@ -91,7 +91,7 @@ def page_shows(h: Harness, tab: Tab, qs: dict[str, Any], tol: float = 1e-9) -> b
 def test_a_cell_sent_in_slices_reaches_the_page_at_every_robots_last_pose(
     cell: Callable[..., Harness], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setattr(viser_scene, "SLICE_S", 0.0)  # one robot a slice
+    monkeypatch.setattr(scene_send, "SLICE_S", 0.0)  # one robot a slice
     slices: list[bool] = []
     draw = viser_scene.ViserScene._draw_robots
 

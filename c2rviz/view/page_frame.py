@@ -1,0 +1,225 @@
+"""What one frame to the page process carries: the notes the world's effects leave, and
+the ``frame`` message made of them (``--page-process``; ``page_link`` sends it).
+
+``FrameNotes`` is the scene the world tells (``Scene``): each effect is noted in O(1)
+(a joint sample, a robot changed, an event in order, parts, goals or cameras changed, a
+robot's faults changed) and asks for a frame (``request``). ``frame`` then makes one
+message: each changed robot's samples and state, then the events, then the parts, goals,
+cameras and fault banners as rows (``page_cell``) when they changed, the ghost's path
+when it changed, and the trails when one was turned on or off or cleared.
+"""
+
+from __future__ import annotations
+
+import pickle
+from collections import deque
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from ..collision.workcell import WorkcellObject
+from ..errors import C2rvizError, PathCollides
+from ..session.services import Services
+from ..session.session import Session
+from ..world.cameras import Camera
+from ..world.effects import Marker, Scene
+from ..world.goals import Goal
+from ..world.parts import Part
+from .page_cell import camera_rows, fault_banner, goal_rows, part_rows
+
+__all__ = ["PATH_ROWS", "SAMPLES_KEPT", "FrameNotes", "path_rows", "trail_state"]
+
+SAMPLES_KEPT = 256
+"""Joint samples of one robot kept for one frame (the newest; a flood of ``joints``
+lines is thinned for the page's plots, never for the robot)."""
+PATH_ROWS = 128
+"""Rows a ghost's timed path is sampled at (``ghost.PATH_POINTS // 2``, as the page does;
+not imported: ``ghost`` loads viser, which this process never needs)."""
+
+
+class FrameNotes(Scene):
+    """What changed since the last frame; see the module docstring.
+
+    Attributes:
+        sessions: The page's ``Session`` per robot (source ``page``).
+        on_air: Whether a page process listens (effects are noted only then).
+    """
+
+    def __init__(self, services: Services, sessions: dict[str, Session], keep: int) -> None:
+        """Notes for the robots of ``services``' world; ``keep``: last commands kept."""
+        self.services = services
+        self.world = world = services.world
+        self.sessions = sessions
+        self.on_air = False
+        self.request: Callable[[], None] = lambda: None
+        """Asks for a frame soon (``page_link`` sets it)."""
+        self._samples: dict[str, deque[list[float]]] = {
+            name: deque(maxlen=SAMPLES_KEPT) for name in world.robots
+        }
+        self._dirty: set[str] = set()
+        self._events: list[list[Any]] = []
+        self.commands: deque[tuple[str, bool]] = deque(maxlen=keep)
+        self._trails: list[list[Any]] = []
+        self._paths: dict[str, object] = {}  # the path each robot's ghost was last sent
+        self._parts = self._goals = self._cameras = False  # changed since the last frame
+        self._faults: set[str] = set()
+
+    def fresh(self) -> None:
+        """A new page process has the world as it is now: note only what follows."""
+        self.drop()
+        self._trails = trail_state(self.services)
+        self._paths.clear()
+        self._dirty.update(self.world.robots)  # the first frame says each ghost's path
+        self.on_air = True
+
+    def drop(self) -> None:
+        """Forget what was noted (the page falls behind: a snapshot will say it all)."""
+        for samples in self._samples.values():
+            samples.clear()
+        self._dirty.clear()
+        self._events.clear()
+        self._parts = self._goals = self._cameras = False
+        self._faults.clear()
+
+    # the Observer protocol (asyncio thread, O(1) each)
+
+    def on_joints(self, robot: str, q: Sequence[float], t: float) -> None:
+        self._samples[robot].append([t, *q])
+        self._dirty.add(robot)
+        self.request()
+
+    def on_gripper(self, robot: str, opening: float, t: float) -> None:
+        self._dirty.add(robot)
+        self.request()
+
+    def on_motion(self, robot: str, t: float) -> None:
+        self._dirty.add(robot)
+        self.request()
+
+    def on_arrived(self, robot: str) -> None:
+        self.on_motion(robot, 0.0)
+
+    def on_stopped(self, robot: str) -> None:
+        self.on_motion(robot, 0.0)
+
+    def on_marker(self, robot: str, marker: Marker) -> None:
+        self._event(["marker", robot, marker.position, marker.wxyz, marker.rgb, marker.shape])
+
+    def on_clear_markers(self, robot: str) -> None:
+        self._event(["clear", robot])
+
+    def on_clients(self, count: int) -> None:
+        self._event(["clients", count])
+
+    def on_command(self, source: str, line: str, accepted: bool) -> None:
+        self.commands.appendleft((line, accepted))
+        self._event(["command", source, line, accepted])
+
+    def on_tool(self, robot: str, tool: pin.SE3) -> None:
+        self._event(["tool", robot, tool.homogeneous.ravel().tolist()])
+
+    def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
+        self._event(["objects", robot, pickle.dumps(list(objects))])
+
+    def on_collisions(self, robot: str, pairs: Sequence[tuple[str, str]]) -> None:
+        self._event(["collisions", robot, [list(p) for p in pairs]])
+
+    def on_refused(self, robot: str, source: str, line: str, error: C2rvizError) -> None:
+        pair: list[str] | None = None
+        target: list[float] | None = None
+        if isinstance(error, PathCollides):
+            pair = list(error.pair)
+            target = list(error.target) if error.target is not None else None
+        self._event(["refused", robot, source, line, str(error), pair, target])
+
+    def on_ghost(self, robot: str, shown: bool) -> None:
+        self._event(["ghost", robot, shown])
+
+    def on_fault(self, robot: str, text: str) -> None:
+        if self.on_air:
+            self._faults.add(robot)
+            self.request()
+
+    def on_parts(self, parts: Sequence[Part], t: float) -> None:
+        if self.on_air:
+            self._parts = True  # rows made once per frame, however many moves came
+            self.request()
+
+    def on_goals(self, goals: Sequence[Goal]) -> None:
+        if self.on_air:
+            self._goals = True
+            self.request()
+
+    def on_cameras(self, cameras: Sequence[Camera]) -> None:
+        if self.on_air:
+            self._cameras = True
+            self.request()
+
+    def _event(self, event: list[Any]) -> None:
+        if self.on_air:
+            self._events.append(event)
+            self.request()
+
+    # the frame
+
+    def frame(self) -> list[Any]:
+        """The ``frame`` message of what changed since the last; the notes start again."""
+        world = self.world
+        robots = []
+        for name in self._dirty:
+            state = world.robots[name]
+            samples = self._samples[name]
+            moving = world.moving(name)
+            robots.append(
+                [
+                    name,
+                    list(samples),
+                    state.opening,
+                    state.target,
+                    moving,
+                    world.travels.seconds_left(state),
+                    self.sessions[name].speed,
+                ]
+            )
+            samples.clear()
+            path = world.travel(name).path if moving else None
+            if path is not self._paths.get(name):
+                self._paths[name] = path
+                self._events.append(["path", name, path_rows(path, world.clock.now())])
+        self._dirty.clear()
+        events, self._events = self._events, []
+        if self._parts:
+            events.append(["parts", part_rows(world.parts.parts.all()), world.clock.now()])
+        if self._goals:
+            events.append(["goals", goal_rows(world.parts.goals.all())])
+        if self._cameras:
+            events.append(["cameras", camera_rows(world.cameras.all())])
+        for name in sorted(self._faults):
+            events.append(["fault", name, fault_banner(world, name)])
+        self._parts = self._goals = self._cameras = False
+        self._faults.clear()
+        trails = trail_state(self.services)
+        if trails != self._trails:
+            self._trails = trails
+            events.append(["trails", trails])
+        return ["frame", world.clock.now(), robots, events]
+
+
+def trail_state(services: Services) -> list[list[Any]]:
+    """The robots whose trail is on, each with how often it was cleared: [name, clears]."""
+    return [[name, trail.clears] for name, trail in sorted(services.trails.trails.items())]
+
+
+def path_rows(path: Any, now: float) -> list[list[float]] | None:
+    """The joint rows of a ghost's path (``ghost.tool_path`` draws them), or None."""
+    if path is None:
+        return None
+    rows = getattr(path, "joint_path", None)
+    if rows is None:
+        rows = getattr(path, "qs", None)
+    if rows is None or len(rows) < 2:
+        times = np.linspace(now, max(float(path.arrival), now), PATH_ROWS)
+        rows = [path.sample(float(t)) for t in times]
+    return np.asarray(rows, dtype=float).tolist()  # type: ignore[no-any-return]
