@@ -16,8 +16,6 @@ if TYPE_CHECKING:
     from ...world.parts import Part
     from ..session import Session
 
-__all__: list[str] = []
-
 
 def _where(session: Session, part: Part) -> str:
     """The part's pose in the session robot's base frame, in its units."""
