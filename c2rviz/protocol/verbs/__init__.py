@@ -5,7 +5,7 @@ Importing this package registers every verb in ``registry.VERBS``, in the order
 """
 
 # isort: off
-from . import joints, markers, queries, connection  # the seed's verbs
+from . import joints, markers, queries  # the seed's verbs (queries: then sleep, bye, quit)
 from . import cartesian, cell, motion, observe, record, workcell
 from . import planning
 from . import gripper
@@ -18,7 +18,6 @@ __all__ = [
     "cameras",
     "cartesian",
     "cell",
-    "connection",
     "faults",
     "gripper",
     "joints",

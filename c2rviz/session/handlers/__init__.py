@@ -11,7 +11,7 @@ module                    verb families (``protocol.verbs``)
 ``parts``                 ``parts``: parts, goals, the score
 ``cameras``               ``cameras``
 ``faults``                ``faults``
-``queries``               ``queries``, ``connection``: questions, ``sleep``, ``bye``
+``queries``               ``queries``: questions, and ``sleep``, ``bye``, ``quit``
 ``observation``           ``observe``, ``record``: watch, trail, ghost, record
 ========================  ==============================================================
 

@@ -1,6 +1,6 @@
 """What the connection asks and says of itself: the questions ``where``, ``pose``,
-``limits``, ``names``, ``version``, ``help`` (``protocol.verbs.queries``), and ``sleep``,
-``bye``, ``quit`` (``protocol.verbs.connection``)."""
+``limits``, ``names``, ``version``, ``help``, and ``sleep``, ``bye``, ``quit`` (all
+``protocol.verbs.queries``)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,7 @@ from typing import TYPE_CHECKING
 from ...errors import BadArguments
 from ...protocol import replies
 from ...protocol.registry import Reply, handler, usage
-from ...protocol.verbs.connection import Bye, Quit, Sleep
-from ...protocol.verbs.queries import Help, Limits, Names, Pose, Version, Where
+from ...protocol.verbs.queries import Bye, Help, Limits, Names, Pose, Quit, Sleep, Version, Where
 from ...version import __version__
 
 if TYPE_CHECKING:
