@@ -20,7 +20,7 @@ import numpy as np
 from ..collision.geometry import read_srdf
 from ..errors import C2rvizError, ConfigError
 from ..observers.recorder import Recorded
-from ..protocol.verbs.record import Record
+from ..protocol.verbs.observe import Record
 from ..session.services import Services
 from ..transports.tcp_server import CommandServer
 from ..world.clock import Clock

@@ -21,7 +21,7 @@ from c2rviz.protocol.verbs.gripper import Grip
 from c2rviz.protocol.verbs.joints import Home, Joints, Move, Rand, Units
 from c2rviz.protocol.verbs.markers import Clear, Color, Mark, MarkerShape
 from c2rviz.protocol.verbs.motion import MotionMode, Speed, Status, Stop, Target, Wait
-from c2rviz.protocol.verbs.observe import Ghost, Trail, Unwatch, Watch
+from c2rviz.protocol.verbs.observe import Ghost, Record, Trail, Unwatch, Watch
 from c2rviz.protocol.verbs.parts import GoalEdit, PartEdit, PartsQuery, Score
 from c2rviz.protocol.verbs.planning import Plan
 from c2rviz.protocol.verbs.queries import (
@@ -35,7 +35,6 @@ from c2rviz.protocol.verbs.queries import (
     Version,
     Where,
 )
-from c2rviz.protocol.verbs.record import Record
 from c2rviz.protocol.verbs.workcell import Collisions, Guard, ObjectEdit, Objects
 
 GOOD = [

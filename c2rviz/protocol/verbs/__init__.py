@@ -6,7 +6,7 @@ Importing this package registers every verb in ``registry.VERBS``, in the order
 
 # isort: off
 from . import joints, markers, queries  # the seed's verbs (queries: then sleep, bye, quit)
-from . import cartesian, cell, motion, observe, record, workcell
+from . import cartesian, cell, motion, observe, workcell  # observe: then record
 from . import planning
 from . import gripper
 from . import parts
@@ -27,6 +27,5 @@ __all__ = [
     "parts",
     "planning",
     "queries",
-    "record",
     "workcell",
 ]

@@ -12,7 +12,7 @@ module                    verb families (``protocol.verbs``)
 ``cameras``               ``cameras``
 ``faults``                ``faults``
 ``queries``               ``queries``: questions, and ``sleep``, ``bye``, ``quit``
-``observation``           ``observe``, ``record``: watch, trail, ghost, record
+``observe``               ``observe``: watch, trail, ghost, and record
 ========================  ==============================================================
 
 The import below is the whole list: importing this package registers every handler in
@@ -20,14 +20,14 @@ The import below is the whole list: importing this package registers every handl
 ``tests/protocol/test_registry.py`` checks that every verb has exactly one).
 """
 
-from . import arm, cameras, cartesian, faults, observation, parts, planning, queries, scene
+from . import arm, cameras, cartesian, faults, observe, parts, planning, queries, scene
 
 __all__ = [
     "arm",
     "cameras",
     "cartesian",
     "faults",
-    "observation",
+    "observe",
     "parts",
     "planning",
     "queries",

@@ -1,6 +1,6 @@
 """What the verbs that show and keep what happens do: ``watch``, ``unwatch``, ``trail``,
-``ghost`` (``protocol.verbs.observe``), and ``record``: start, stop and ask about this
-connection's robot's recording (``protocol.verbs.record``)."""
+``ghost`` and ``record``: start, stop and ask about this connection's robot's recording (all
+``protocol.verbs.observe``)."""
 
 from __future__ import annotations
 
@@ -10,8 +10,7 @@ from typing import TYPE_CHECKING
 from ...observers.recorded import Recorded
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
-from ...protocol.verbs.observe import Ghost, Trail, Unwatch, Watch
-from ...protocol.verbs.record import Record
+from ...protocol.verbs.observe import Ghost, Record, Trail, Unwatch, Watch
 
 if TYPE_CHECKING:
     from ..session import Session
