@@ -74,12 +74,11 @@ DOCS_PAGES = {
     "joints": "docs/commands.md",
     "markers": "docs/commands.md",
     "queries": "docs/commands.md",
-    "connection": "docs/commands.md",
     "cartesian": "docs/cartesian.md",
     "cell": "docs/cells.md",
     "motion": "docs/motion.md",
     "observe": "docs/watch.md",
-    "record": "docs/recording.md",
+    "record": "docs/recording.md",  # a verb of observe.py, by name
     "workcell": "docs/workcell.md",
     "planning": "docs/planning.md",
     "gripper": "docs/commands.md",
