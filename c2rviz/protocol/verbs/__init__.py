@@ -8,8 +8,7 @@ Importing this package registers every verb in ``registry.VERBS``, in the order
 from . import joints, markers, queries  # the seed's verbs (queries: then sleep, bye, quit)
 from . import cartesian, cell, motion, observe, workcell  # observe: then record
 from . import planning
-from . import gripper
-from . import parts
+from . import parts  # grip first, then the part verbs
 from . import cameras
 from . import faults
 # isort: on
@@ -19,7 +18,6 @@ __all__ = [
     "cartesian",
     "cell",
     "faults",
-    "gripper",
     "joints",
     "markers",
     "motion",

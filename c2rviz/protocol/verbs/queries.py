@@ -81,7 +81,6 @@ DOCS_PAGES = {
     "record": "docs/recording.md",  # a verb of observe.py, by name
     "workcell": "docs/workcell.md",
     "planning": "docs/planning.md",
-    "gripper": "docs/commands.md",
     "ghost": "docs/page.md",
     "objects": "docs/commands.md",  # workcell.md shows objects, not this question
 }

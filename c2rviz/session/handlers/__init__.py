@@ -4,11 +4,11 @@
 ========================  ==============================================================
 module                    verb families (``protocol.verbs``)
 ========================  ==============================================================
-``arm``                   ``joints``, ``motion``, ``gripper``: the arm moved by its joints
+``arm``                   ``joints``, ``motion``: the arm moved by its joints
 ``cartesian``             ``cartesian``: the tool, IK, moves to a tool pose
 ``planning``              ``planning``: ``plan``, a path around obstacles
 ``scene``                 ``markers``, ``workcell``, ``cell``: what the scene holds
-``parts``                 ``parts``: parts, goals, the score
+``parts``                 ``parts``: the gripper, parts, goals, the score
 ``cameras``               ``cameras``
 ``faults``                ``faults``
 ``queries``               ``queries``: questions, and ``sleep``, ``bye``, ``quit``

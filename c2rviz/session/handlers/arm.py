@@ -1,19 +1,16 @@
 """What the verbs that move the arm by its joints do: ``rand``, ``home``, ``joints``,
 ``move`` and ``degrees``/``radians`` (``protocol.verbs.joints``); this connection's
 ``motion`` mode and ``speed``, ``stop``, ``wait``, ``target``, ``status``
-(``protocol.verbs.motion``); and ``grip``, the fingers to an opening, travelling as
-``motion`` says, by the grasp rule for parts (``protocol.verbs.gripper``;
-``Session.grip``, every door's grip).
+(``protocol.verbs.motion``).
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ...errors import JointCountError, JointIndexError, NoGripper
+from ...errors import JointCountError, JointIndexError
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
-from ...protocol.verbs.gripper import Grip
 from ...protocol.verbs.joints import Home, Joints, Move, Rand, Units
 from ...protocol.verbs.motion import MotionMode, Speed, Status, Stop, Target, Wait
 from ..guarded import guarded_rand
@@ -100,13 +97,3 @@ def target(session: Session, command: Target) -> str:
 def status(session: Session, command: Status) -> str:
     left = session.world.travels.seconds_left(session.state)
     return replies.ok(f"moving {left:.3f}" if session.travel.active else "idle")
-
-
-@handler(Grip)
-def grip(session: Session, command: Grip) -> Reply:
-    state, grips = session.state, session.world.grips
-    if state.robot.gripper is None:
-        raise NoGripper(state.name)
-    if command.opening is None:
-        return replies.ok(replies.numbers([grips.now(state)]))
-    return session.grip(command.opening)
