@@ -20,7 +20,7 @@ import numpy as np
 from ..collision.geometry import read_srdf
 from ..errors import C2rvizError, ConfigError
 from ..observers.recorder import Recorded
-from ..protocol.verbs.record import Record
+from ..protocol.verbs.observe import Record
 from ..session.services import Services
 from ..transports.tcp_server import CommandServer
 from ..world.clock import Clock
@@ -31,7 +31,7 @@ from ..world.world import World
 from . import crcl_door  # noqa: F401 (its opener joins doors.OPENERS)
 from .config import Settings, replaced_bundled
 from .doors import close_doors, open_doors
-from .ini_cameras import ini_cameras, place_cameras
+from .ini_world import ini_cameras, place_cameras
 from .members import Member, furnish
 from .rosbridge_door import open_rosbridge  # noqa: F401 (importing it adds it to OPENERS)
 

@@ -16,9 +16,9 @@ from typing import TextIO
 
 from ..errors import BadArguments, C2rvizError
 from ..protocol.grammar import parse_line
-from ..protocol.verbs.connection import Sleep
 from ..protocol.verbs.joints import Joints
 from ..protocol.verbs.observe import Watch
+from ..protocol.verbs.queries import Sleep
 from .bag_play import is_bag, play_in_repl
 from .client import Client, ConnectionLost, find_script
 from .goto import motion_of, step, target_problem, travel

@@ -21,10 +21,10 @@ from pathlib import Path
 from ..errors import C2rvizError, JointCountError, JointIndexError
 from ..protocol.grammar import Command, parse_line
 from ..protocol.verbs.cartesian import MoveL, MoveTo
-from ..protocol.verbs.connection import Bye, Quit
 from ..protocol.verbs.joints import Home, Joints, Move, Rand
 from ..protocol.verbs.markers import Clear
 from ..protocol.verbs.motion import MotionMode, Stop, Wait
+from ..protocol.verbs.queries import Bye, Quit
 
 __all__ = [
     "MAX_LINE_BYTES",

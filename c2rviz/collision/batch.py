@@ -30,8 +30,6 @@ import pinocchio as pin
 from ..robot.model import Robot
 from .geometry import Pair
 
-__all__ = ["CHUNK", "BatchCheck", "CheckGeometry", "PlacedShape", "may_touch"]
-
 CHUNK = 8  # configurations per Pinocchio call (the event loop's longest wait, see the module)
 
 PlacedShape = tuple[str, Any, pin.SE3]

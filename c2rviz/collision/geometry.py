@@ -24,23 +24,6 @@ from ..errors import C2rvizError
 from ..robot.model import Robot
 from ..robot.sources import MissingMesh, RobotSource
 
-__all__ = [
-    "CollisionError",
-    "CollisionModelError",
-    "Pair",
-    "SelfPairs",
-    "SrdfError",
-    "adjacent_links",
-    "coal_message",
-    "collision_xml",
-    "configure_requests",
-    "moving_joints",
-    "ordered_pair",
-    "parse_srdf",
-    "read_srdf",
-    "robot_geometry",
-]
-
 Pair = tuple[str, str]
 
 

@@ -7,8 +7,8 @@ never links joined by a joint (a link without geometry passes its neighbours
 on), pairs an SRDF disables, pairs that cannot move relative to each other,
 pairs that touch at home (each chain joint at 0, or its nearest limit), and
 pairs that touch in nearly every one of ``samples`` random configurations (a
-fixed seed, so the choice is reproducible). Pairs that never touched in the
-samples are still checked. Workcell objects (``workcell.py``) are checked
+fixed seed, so the choice is reproducible): ``checks.choose_pairs``. Pairs that never
+touched in the samples are still checked. Workcell objects (``workcell.py``) are checked
 against every link the chain moves; a link that never moves relative to the
 base (the pedestal a table touches) never collides with them.
 
@@ -18,57 +18,22 @@ A pair is ``(link, link)`` in alphabetical order, or ``(link, object)``.
 from __future__ import annotations
 
 import math
-from collections import Counter
 from collections.abc import Iterable, Sequence
-from itertools import combinations
 from pathlib import Path
 from typing import Any
 
-import coal
 import numpy as np
 import pinocchio as pin
 
 from ..robot.model import Robot
 from .batch import BatchCheck, CheckGeometry, PlacedShape
-from .geometry import (
-    CollisionError,
-    CollisionModelError,
-    Pair,
-    SelfPairs,
-    SrdfError,
-    adjacent_links,
-    configure_requests,
-    moving_joints,
-    ordered_pair,
-    parse_srdf,
-    read_srdf,
-    robot_geometry,
-)
-from .part_checks import PartShape, add_parts, held_as_links, held_shapes
+from .checks import DEFAULT_SAMPLES, build_checks, choose_pairs, hits
+from .geometry import CollisionError, Pair, moving_joints, ordered_pair, robot_geometry
+from .part_checks import PartShape, held_as_links, held_shapes
 from .workcell import MAX_OBJECTS, Workcell, WorkcellObject
 
-__all__ = [
-    "ALWAYS_FRACTION",
-    "DEFAULT_SAMPLES",
-    "MAX_STEP_M",
-    "MAX_STEP_RAD",
-    "CollisionError",
-    "CollisionModel",
-    "CollisionModelError",
-    "NoFreeConfiguration",
-    "Pair",
-    "SelfPairs",
-    "SrdfError",
-    "parse_srdf",
-    "read_srdf",
-    "segment",
-]
-
-DEFAULT_SAMPLES = 2000
-ALWAYS_FRACTION = 0.95  # touching in at least this share of the samples: "always touching"
 MAX_STEP_RAD = math.radians(1.0)  # guarded paths: most a revolute joint moves between checks
 MAX_STEP_M = 0.005  # and a prismatic one
-_Checks = tuple[pin.GeometryModel, pin.GeometryData, list[Pair]]
 
 
 class NoFreeConfiguration(CollisionError):
@@ -163,7 +128,7 @@ class CollisionModel:
         if unknown:
             notes.append(f"disabled pairs name links {robot.name} lacks: {', '.join(unknown)}")
         self.warnings = tuple(notes)
-        self.self_pairs = self._choose_pairs(skip, moving, samples, seed)
+        self.self_pairs = choose_pairs(robot, geometry, self._link_of, skip, moving, samples, seed)
         self.workcell = Workcell(known, max_objects)
         self._parts: tuple[PartShape, ...] = ()
         self._touching: tuple[frozenset[str], frozenset[str], frozenset[str]] = (
@@ -174,107 +139,15 @@ class CollisionModel:
         self._revision = 0
         self._rebuild()
 
-    def _choose_pairs(
-        self, disabled: set[Pair], moving: set[int], samples: int, seed: int
-    ) -> SelfPairs:
-        joint_of = {
-            link: g.parentJoint for link, g in zip(self._link_of, self._geometry.geometryObjects)
-        }
-        adjacent = adjacent_links(self.model, set(self._links))
-        srdf, rigid, candidates = set(), set(), set()
-        for pair in combinations(sorted(self._links), 2):
-            a, b = (joint_of[link] for link in pair)
-            if pair in adjacent:
-                continue
-            if pair in disabled:
-                srdf.add(pair)
-            elif a == b or (a not in moving and b not in moving):
-                rigid.add(pair)
-            else:
-                candidates.add(pair)
-        robot = self.robot
-        home = [min(max(0.0, joint.lower), joint.upper) for joint in robot.joints]
-        at_home = self._hits(*self._build(candidates, []), robot.configuration(home))
-        always = self._always_touching(candidates - at_home, samples, seed)
-        checked = candidates - at_home - always
-        return SelfPairs(
-            checked=frozenset(checked),
-            adjacent=frozenset(adjacent),
-            srdf=frozenset(srdf),
-            rigid=frozenset(rigid),
-            at_home=frozenset(at_home),
-            always=frozenset(always),
-            samples=samples,
-        )
-
-    def _always_touching(self, candidates: set[Pair], samples: int, seed: int) -> set[Pair]:
-        """The pairs touching in at least ``ALWAYS_FRACTION`` of ``samples`` random draws.
-
-        A pair is dropped once it has missed too often to get there, and the
-        draws stop when none is left: the answer is the one all the draws
-        would give, usually after about ``(1 - ALWAYS_FRACTION) * samples``.
-        """
-        if samples <= 0:
-            return set()
-        allowed = samples - math.ceil(ALWAYS_FRACTION * samples)  # misses a pair may have
-        misses: Counter[Pair] = Counter()
-        active = set(candidates)
-        # the counts need no micrometres, and exact checks cost most on touching pairs
-        checks = self._build(active, [], exact=False)
-        rng = np.random.default_rng(seed)
-        robot = self.robot
-        for _ in range(samples):
-            if not active:
-                break
-            hits = self._hits(*checks, robot.configuration(robot.random(rng)))
-            misses.update(active - hits)
-            dropped = {pair for pair in active if misses[pair] > allowed}
-            if dropped:
-                active -= dropped
-                checks = self._build(active, [], exact=False)
-        return active
-
-    def _build(
-        self,
-        link_pairs: set[Pair],
-        objects: list[tuple[WorkcellObject, coal.CollisionGeometry]],
-        exact: bool = True,
-        parts: Sequence[PartShape] = (),
-    ) -> _Checks:
-        """A geometry model checking ``link_pairs`` and the objects against moving links
-        (and ``parts``: see ``part_checks.add_parts``)."""
-        geometry = pin.GeometryModel()
-        names = []
-        for obj in self._geometry.geometryObjects:
-            geometry.addGeometryObject(obj)
-        for i, j in combinations(range(len(self._link_of)), 2):
-            pair = ordered_pair(self._link_of[i], self._link_of[j])
-            if pair in link_pairs:
-                geometry.addCollisionPair(pin.CollisionPair(i, j))
-                names.append(pair)
-        base = self.model.frames[self.robot.base_frame]
-        for obj, shape in objects:
-            k = geometry.addGeometryObject(
-                pin.GeometryObject(
-                    f"workcell/{obj.name}",
-                    base.parentJoint,
-                    self.robot.base_frame,
-                    base.placement * obj.placement,
-                    shape,
-                )
-            )
-            for i in self._moving_geoms:
-                geometry.addCollisionPair(pin.CollisionPair(i, k))
-                names.append((self._link_of[i], obj.name))
-        if parts:
-            add_parts(self.model, geometry, names, self._link_of, self._moving_geoms, parts)
-        data = geometry.createData()
-        configure_requests(data, exact)
-        return geometry, data, names
-
     def _rebuild(self) -> None:
-        self._checks = geometry, data, names = self._build(
-            set(self.self_pairs.checked), self.workcell.items(), parts=self._parts
+        self._checks = geometry, data, names = build_checks(
+            self.robot,
+            self._geometry,
+            self._link_of,
+            self._moving_geoms,
+            set(self.self_pairs.checked),
+            self.workcell.items(),
+            parts=self._parts,
         )
         self._revision += 1
         moving, link_of = held_as_links(geometry, self._moving_geoms, self._link_of)
@@ -320,17 +193,6 @@ class CollisionModel:
             without=frozenset(without),
             only=None if only is None else frozenset(only),
         )
-
-    def _hits(
-        self,
-        geometry: pin.GeometryModel,
-        data: pin.GeometryData,
-        names: list[Pair],
-        q: np.ndarray,
-    ) -> set[Pair]:
-        if not pin.computeCollisions(self.model, self.data, geometry, data, q, False):
-            return set()
-        return {names[k] for k, result in enumerate(data.collisionResults) if result.isCollision()}
 
     # --- the workcell -----------------------------------------------------------
 
@@ -392,7 +254,7 @@ class CollisionModel:
 
     def colliding(self, q: Sequence[float]) -> list[Pair]:
         """The pairs in collision at chain values ``q`` [rad or m], sorted."""
-        return sorted(self._hits(*self._checks, self.robot.configuration(q)))
+        return sorted(hits(self.model, self.data, *self._checks, self.robot.configuration(q)))
 
     def is_free(self, q: Sequence[float]) -> bool:
         """True when no checked pair collides at ``q`` (stops at the first hit)."""

@@ -25,8 +25,6 @@ from .batch import PlacedShape, may_touch
 from .geometry import Pair
 from .model import CollisionModel
 
-__all__ = ["OtherRobot", "first_hit_between", "pairs_between", "placed_shapes"]
-
 OtherRobot = tuple[str, CollisionModel, Sequence[float], pin.SE3]
 """Another robot of the cell as it stands: name, collision model, joints [rad or m], origin."""
 

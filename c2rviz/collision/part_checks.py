@@ -18,8 +18,6 @@ from typing import Any
 
 import pinocchio as pin
 
-__all__ = ["PART_PREFIX", "PartShape", "add_parts", "held_as_links", "held_shapes"]
-
 PART_PREFIX = "part/"
 _OBJECT_PREFIX = "workcell/"
 

@@ -15,14 +15,6 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-__all__ = [
-    "Obstacle",
-    "contains",
-    "drop",
-    "extent",
-    "signed_distance",
-]
-
 Obstacle = tuple[str, coal.CollisionGeometry, pin.SE3]
 """Something a part may rest on: its name, its shape, its placement in the world."""
 

@@ -27,26 +27,6 @@ import pinocchio as pin
 from ..errors import C2rvizError, shown
 from .geometry import coal_message
 
-__all__ = [
-    "DEFAULT_RGBA",
-    "MAX_NAME_LENGTH",
-    "MAX_OBJECTS",
-    "SHAPES",
-    "SIZE_NAMES",
-    "BadColour",
-    "BadMesh",
-    "BadObjectName",
-    "BadPlacement",
-    "BadShape",
-    "BadSize",
-    "TooManyObjects",
-    "UnknownObject",
-    "Workcell",
-    "WorkcellError",
-    "WorkcellObject",
-    "collision_geometry",
-]
-
 SHAPES = ("box", "cylinder", "mesh", "sphere")
 SIZE_NAMES: dict[str, tuple[str, ...]] = {
     "box": ("x", "y", "z"),

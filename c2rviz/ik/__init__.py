@@ -1,6 +1,6 @@
 """Inverse kinematics: a damped Newton descent over Pinocchio (``newton``) from ranked seeds
 (``seeds``), refused early beyond the arm's reach (``reach``), pink and daqp only to find
-a refused target's closest pose (``closest``, ``tool_task``); targets with or without an
+a refused target's closest pose (``closest``); targets with or without an
 orientation (``target``); and the straight tool line (``line``). Pure: no asyncio, no clock.
 """
 

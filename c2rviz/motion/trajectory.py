@@ -20,7 +20,7 @@ limits, and its velocity and acceleration within the robot's motion limits at
 full speed (``MotionLimits``; ``LIMIT_SLACK`` over them is let through), each
 sampled ``SAMPLES_PER_SEGMENT`` times per segment and at every knot. A point at
 time 0 must be where the arm is (within ``START_TOLERANCE``): it is the start.
-``trajectory_play.TrajectoryPlay`` plays the result. Pure: numpy only.
+``path_play.TrajectoryPlay`` plays the result. Pure: numpy only.
 """
 
 from __future__ import annotations

@@ -19,8 +19,8 @@ import numpy as np
 from ..collision.model import segment
 from ..errors import ArmMoved, C2rvizError, NoGripper, PathCollides
 from ..ik.target import Target
+from ..motion.path_play import TrajectoryPlay
 from ..motion.trajectory import PlannedTrajectory
-from ..motion.trajectory_play import TrajectoryPlay
 from ..planning import MoveChecker, MoveRequest, first_blocked, path_points
 from ..planning.cancel import STOPPED
 from ..protocol import replies

@@ -33,9 +33,9 @@ from ..world.moves import Travel
 from ..world.state import RobotState
 from . import calls
 from .guarded import guarded_go
-from .modes import Modes
 from .notes import Said, recorded, taken, taken_all
 from .services import Services
+from .settings import Modes
 from .units import UnitEdge, UnitTable
 
 __all__ = ["BATCHED", "Session", "UnitTable"]

@@ -1,7 +1,8 @@
-"""Every use of viser's private internals, in one place; written for viser 1.1.x.
+"""Every use of viser's private internals, reached through this one module; written for
+viser 1.1.x.
 
-viser's public API lacks four things the viewer needs, so this module reaches
-inside viser, and no other module does:
+viser's public API lacks four things the viewer needs, so this module (with the two
+beside it that it re-exports) reaches inside viser, and no other module does:
 
 * a door on the websocket (``start``): viser builds its websockets server on
   its own thread with fixed settings (50 MiB frames, no origin check, every
@@ -9,50 +10,47 @@ inside viser, and no other module does:
   ``websockets.asyncio.server.serve`` through with a ``door.Door`` in front:
   origin and token checks, a frame and a client limit, a screen on every frame
   (``accept_input`` registers the inputs the page may set).
-* fast sends (``queue_pose``, ``PoseBatch``, ``set_gui_value``, ``set_chart_data``): a pose, a
-  slider value or a chart's data without viser's ``np.allclose`` per setter,
-  without its per-array casts through typing hints and without calling the
-  input's own update callbacks (~0.23 ms a send instead of 1-1.9 ms; a chart's
-  data in ~0.05 ms instead of ~0.4 ms).
+* fast sends (``queue_pose``, ``PoseBatch``, ``set_gui_value``, ``set_chart_data``,
+  in ``viser_sends.py``): a pose, a slider value or a chart's data, cheaply.
 * a purge of removal records (``purge_removed``): viser keeps a record of each
   removed scene node until a new tab connects.
 * a stop in bounded time (``stop``), even with a tab that never reads.
 
-``check()`` looks for every private name listed in ``INTERNALS`` (a test
-checks that the list names every private attribute used here) and raises
-``ViserInternalsError`` if one is gone, so a viser upgrade fails loudly at
-start instead of freezing the page. Functions run on the caller's thread
-unless they say otherwise.
+``check()`` (``viser_internals.py``) looks for every private name listed in
+``INTERNALS`` (a test checks that the list names every private attribute used here and
+in ``viser_sends.py``) and raises ``ViserInternalsError`` if one is gone, so a viser
+upgrade fails loudly at start instead of freezing the page. Functions run on the
+caller's thread unless they say otherwise.
 """
 
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import functools
-import importlib
 import io
 import logging
 import socket
 import struct
 import threading
-import time
 import weakref
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
-import numpy as np
 import viser
 import websockets.asyncio.server
-from viser import _messages
-from viser.infra import ClientId
 
-from ..errors import C2rvizError
-from .page_messages import CAMERA_FIELDS, Click
 from .policy import DoorPolicy
+from .viser_internals import (
+    INTERNALS,
+    WRITTEN_FOR,
+    ViserInternalsError,
+    check,
+    missing_internals,
+)
+from .viser_sends import PoseBatch, queue_pose, set_chart_data, set_gui_value
 from .ws_guard import Door, GrabCallback, GuardedConnection, HandleCallback, InputCallback
 
-__all__ = [
+__all__ = [  # the view's one way to viser's internals
     "INTERNALS",
     "PoseBatch",
     "WRITTEN_FOR",
@@ -74,82 +72,10 @@ __all__ = [
 
 log = logging.getLogger("c2rviz.view")
 
-WRITTEN_FOR = "1.1"  # viser versions 1.1.x
-# Every private name of viser used here: (where, names). check() looks in viser's
-# modules and classes; start() looks at the running server ("server...").
-INTERNALS: tuple[tuple[str, tuple[str, ...]], ...] = (
-    ("viser._messages", ("SetPositionMessage", "SetOrientationMessage", "GuiUpdateMessage")),
-    ("viser._messages", ("ViewerCameraMessage", "TransformControlsUpdateMessage")),
-    ("viser._messages.Message", ("excluded_self_client",)),
-    ("viser._messages.SetPositionMessage", ("name", "position")),
-    ("viser._messages.SetOrientationMessage", ("name", "wxyz")),
-    ("viser._messages.GuiUpdateMessage", ("uuid", "updates")),
-    ("viser._assignable_props_api.AssignablePropsBase", ("_impl",)),
-    ("viser._scene_handles._SceneNodeHandleState", ("name", "api", "position", "wxyz")),
-    ("viser._scene_api.SceneApi", ("_queue_scene_message",)),
-    ("viser._gui_handles._GuiHandleState", ("uuid", "gui_api", "value", "update_timestamp")),
-    ("viser._gui_handles._GuiHandleState", ("props", "removed")),
-    ("viser._messages.GuiUplotProps", ("data",)),
-    ("viser.infra._async_message_buffer.AsyncMessageBuffer", ("message_from_id",)),
-    ("viser.infra._async_message_buffer.AsyncMessageBuffer", ("message_counter",)),
-    ("viser.infra._async_message_buffer.AsyncMessageBuffer", ("generator_cursors",)),
-    ("viser.ViserServer", ("_run_garbage_collector",)),
-    ("viser.infra._infra", ("websockets",)),  # it starts its server with ...serve()
-    ("server", ("_websock_server",)),
-    ("server._websock_server", ("_broadcast_buffer", "_live_connections")),
-    ("server._websock_server", ("_background_event_loop",)),
-    ("server.gui", ("_websock_interface",)),
-)
 _VISER_SERVE_MODULE = "viser.infra._infra"  # where viser's websocket handler is defined
 
 _doors: weakref.WeakKeyDictionary[Any, Door] = weakref.WeakKeyDictionary()
 _start_lock = threading.Lock()
-
-
-class ViserInternalsError(C2rvizError):
-    """The installed viser lacks an internal the viewer uses (viser was upgraded)."""
-
-    def __init__(self, missing: Sequence[str]) -> None:
-        self.missing = tuple(missing)
-        super().__init__(
-            f"viser {viser.__version__} lacks what c2rviz's viewer uses: {', '.join(missing)}; "
-            f"c2rviz/view/adapter.py is written for viser {WRITTEN_FOR}.x "
-            f"(pip install 'viser>={WRITTEN_FOR},<1.{int(WRITTEN_FOR.split('.')[1]) + 1}')"
-        )
-
-
-def check() -> None:
-    """Raise ``ViserInternalsError`` if a private name the adapter uses is gone."""
-    missing = missing_internals()
-    if missing:
-        raise ViserInternalsError(missing)
-    if not viser.__version__.startswith(WRITTEN_FOR + "."):
-        log.warning(
-            "viser %s: the view adapter is written for %s.x", viser.__version__, WRITTEN_FOR
-        )
-
-
-def missing_internals(server: viser.ViserServer | None = None) -> list[str]:
-    """The entries of ``INTERNALS`` the installed viser lacks, as ``where.name``.
-
-    Without ``server``, those in viser's modules and classes; with a running
-    ``server``, those on it too.
-    """
-    missing = [
-        f"{where}.{name}"
-        for where, names in INTERNALS
-        if server is not None or not where.startswith("server")
-        for name in names
-        if not _has(_resolve(where, server), name)
-    ]
-    read = {"ViewerCameraMessage": CAMERA_FIELDS, "SceneNodeClickMessage": Click.__struct_fields__}
-    for name, fields in read.items():
-        message, expected = _resolve(f"viser._messages.{name}"), set(fields) - {"type"}
-        if dataclasses.is_dataclass(message) and expected != {
-            f.name for f in dataclasses.fields(message) if f.init
-        }:
-            missing.append(f"viser._messages.{name} fields {sorted(expected)}")
-    return missing
 
 
 def start(
@@ -243,132 +169,6 @@ def accept_click(
     """
     door(server).accept_click(node._impl.name)
     node.on_click(lambda event: callback(int(event.client_id), event.instance_index))
-
-
-def queue_pose(handle: Any, position: np.ndarray, wxyz: np.ndarray, force: bool = False) -> None:
-    """``handle.position = position; handle.wxyz = wxyz`` for a scene node, cheaply.
-
-    Sends only a part that changed, without viser's ``np.allclose`` per setter.
-
-    Args:
-        handle: A viser scene node handle.
-        position: Its new position in its parent's frame [m], shape (3,).
-        wxyz: Its new orientation, a unit quaternion (w, x, y, z), shape (4,).
-        force: Send both even if unchanged (a tab shows another pose: a drag
-            the server refused).
-    """
-    state = handle._impl
-    if force or (state.position != position).any():
-        state.position[:] = position
-        state.api._queue_scene_message(
-            _messages.SetPositionMessage(state.name, tuple(state.position.tolist()))
-        )
-    if force or (state.wxyz != wxyz).any():
-        state.wxyz[:] = wxyz
-        state.api._queue_scene_message(
-            _messages.SetOrientationMessage(state.name, tuple(state.wxyz.tolist()))
-        )
-
-
-class PoseBatch:
-    """Scene nodes posed together (a robot's link frames): ``queue_pose`` for all of them
-    at once, comparing every pose with the one last sent in one array operation and
-    sending only the positions and orientations that changed (exactly; a pose that
-    moves by any amount is sent, so the last pose of a stopped robot always is).
-
-    Only this batch may pose its nodes (it keeps what it sent).
-
-    Attributes:
-        handles: The nodes, in row order.
-        states: Their viser states (what ``handle.position``/``wxyz`` read).
-        sent: The poses last sent, one row per node (position, then w x y z).
-    """
-
-    def __init__(self, handles: Sequence[Any]) -> None:
-        """``handles``: viser scene node handles, in the order of ``queue``'s rows."""
-        self.handles = list(handles)
-        self.states = [handle._impl for handle in self.handles]
-        self.sent = np.array(
-            [[*state.position, *state.wxyz] for state in self.states], dtype=float
-        ).reshape(len(self.states), 7)
-
-    def queue(self, poses: np.ndarray) -> int:
-        """Pose node ``k`` at ``poses[k]``: its position [m] (3 values) then its unit
-        quaternion (w, x, y, z), in its parent's frame.
-
-        Returns:
-            How many messages were queued.
-        """
-        changed = poses != self.sent
-        sent = 0
-        for k in np.flatnonzero(changed[:, :3].any(axis=1)).tolist():
-            state = self.states[k]
-            position = poses[k, :3]
-            state.position[:] = position
-            state.api._queue_scene_message(
-                _messages.SetPositionMessage(state.name, tuple(position.tolist()))
-            )
-            sent += 1
-        for k in np.flatnonzero(changed[:, 3:].any(axis=1)).tolist():
-            state = self.states[k]
-            wxyz = poses[k, 3:]
-            state.wxyz[:] = wxyz
-            state.api._queue_scene_message(
-                _messages.SetOrientationMessage(state.name, tuple(wxyz.tolist()))
-            )
-            sent += 1
-        self.sent[:] = poses
-        return sent
-
-
-def set_gui_value(
-    handle: Any, value: float | bool | str, exclude_client: int | None = None, force: bool = False
-) -> bool:
-    """``handle.value = value`` without calling the handle's own update callbacks.
-
-    Args:
-        handle: A viser GUI input handle on the server's panel.
-        value: Its new value (cast to the handle's type).
-        exclude_client: A viser client id not to send it to (the tab that set it).
-        force: Send it even if it is the value held: a tab shows another one (a
-            page value that was refused, which the server never applied).
-
-    Returns:
-        Whether the value was sent.
-    """
-    state = handle._impl
-    value = type(state.value)(value)
-    if state.value == value and not force:
-        return False
-    message = _messages.GuiUpdateMessage(state.uuid, {"value": value})
-    if exclude_client is not None:
-        message.excluded_self_client = ClientId(exclude_client)
-    state.gui_api._websock_interface.queue_message(message)
-    state.value = value
-    state.update_timestamp = time.time()
-    return True
-
-
-def set_chart_data(handle: Any, data: Sequence[np.ndarray]) -> None:
-    """``handle.data = data`` for a uPlot chart (``gui.add_uplot``), cheaply.
-
-    viser's setter casts each array through the prop's typing hints (some 20 µs an
-    array) and compares it with the one held; this sends the arrays as they are,
-    once cast to float64. The arrays are the chart's from now on: the caller
-    must not change them afterwards (a new array for each update).
-
-    Args:
-        handle: A viser uPlot handle.
-        data: The x values, then one array per series, all of one length.
-    """
-    state = handle._impl
-    if state.removed:
-        raise RuntimeError(f"Cannot assign to 'data' on a removed {type(handle).__name__}.")
-    arrays = tuple(np.asarray(column, dtype=np.float64) for column in data)
-    state.props.data = arrays
-    state.gui_api._websock_interface.queue_message(
-        _messages.GuiUpdateMessage(state.uuid, {"data": arrays})
-    )
 
 
 def buffered_messages(server: viser.ViserServer) -> int:
@@ -504,33 +304,3 @@ def _quiet() -> Iterator[None]:
         yield
     if out.getvalue().strip():
         log.debug("viser: %s", out.getvalue().strip())
-
-
-def _resolve(where: str, server: Any = None) -> Any:
-    """The object named ``where`` (``viser.x.Y`` or ``server.a.b``), or None."""
-    parts = where.split(".")
-    if parts[0] == "server":
-        found = server
-        for name in parts[1:]:
-            found = getattr(found, name, None)
-        return found
-    for cut in range(len(parts), 0, -1):
-        try:
-            found = importlib.import_module(".".join(parts[:cut]))
-        except ImportError:
-            continue
-        for name in parts[cut:]:
-            found = getattr(found, name, None)
-        return found
-    return None
-
-
-def _has(owner: Any, name: str) -> bool:
-    """Whether ``owner`` has ``name``: an attribute, a dataclass field or an annotation."""
-    if owner is None:
-        return False
-    if hasattr(owner, name):
-        return True
-    if dataclasses.is_dataclass(owner) and name in {f.name for f in dataclasses.fields(owner)}:
-        return True
-    return any(name in getattr(k, "__annotations__", {}) for k in getattr(owner, "__mro__", ()))

@@ -27,10 +27,10 @@ import pinocchio as pin
 
 from ..errors import C2rvizError
 from ..protocol.grammar import MARKER_SHAPES, parse_line
-from ..protocol.verbs.connection import Sleep
 from ..protocol.verbs.joints import Units
 from ..protocol.verbs.markers import Clear, Color, Mark, MarkerShape
 from ..protocol.verbs.parts import PartEdit
+from ..protocol.verbs.queries import Sleep
 from ..protocol.verbs.workcell import ObjectEdit
 from .record_rows import CHUNK_BYTES
 

@@ -11,14 +11,8 @@ import pinocchio as pin
 import pytest
 from support import ROOT, load_robot
 
-from c2rviz.collision.model import (
-    CollisionModel,
-    NoFreeConfiguration,
-    SrdfError,
-    parse_srdf,
-    read_srdf,
-    segment,
-)
+from c2rviz.collision.geometry import SrdfError, parse_srdf, read_srdf
+from c2rviz.collision.model import CollisionModel, NoFreeConfiguration, segment
 from c2rviz.collision.workcell import (
     DEFAULT_RGBA,
     BadColour,

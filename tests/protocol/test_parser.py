@@ -16,17 +16,24 @@ from c2rviz.protocol.grammar import ForeignProtocol, parse_line
 from c2rviz.protocol.verbs.cameras import CameraEdit, CamerasQuery
 from c2rviz.protocol.verbs.cartesian import Ik, LinearSpeed, MoveL, MoveTo, Tool
 from c2rviz.protocol.verbs.cell import RobotChoice, RobotsList
-from c2rviz.protocol.verbs.connection import Bye, Quit, Sleep
 from c2rviz.protocol.verbs.faults import Faults, FaultSpec, FaultVerb, Reset
-from c2rviz.protocol.verbs.gripper import Grip
 from c2rviz.protocol.verbs.joints import Home, Joints, Move, Rand, Units
 from c2rviz.protocol.verbs.markers import Clear, Color, Mark, MarkerShape
 from c2rviz.protocol.verbs.motion import MotionMode, Speed, Status, Stop, Target, Wait
-from c2rviz.protocol.verbs.observe import Ghost, Trail, Unwatch, Watch
-from c2rviz.protocol.verbs.parts import GoalEdit, PartEdit, PartsQuery, Score
+from c2rviz.protocol.verbs.observe import Ghost, Record, Trail, Unwatch, Watch
+from c2rviz.protocol.verbs.parts import GoalEdit, Grip, PartEdit, PartsQuery, Score
 from c2rviz.protocol.verbs.planning import Plan
-from c2rviz.protocol.verbs.queries import Help, Limits, Names, Pose, Version, Where
-from c2rviz.protocol.verbs.record import Record
+from c2rviz.protocol.verbs.queries import (
+    Bye,
+    Help,
+    Limits,
+    Names,
+    Pose,
+    Quit,
+    Sleep,
+    Version,
+    Where,
+)
 from c2rviz.protocol.verbs.workcell import Collisions, Guard, ObjectEdit, Objects
 
 GOOD = [

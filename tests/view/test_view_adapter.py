@@ -34,7 +34,11 @@ from c2rviz.view.policy import DoorPolicy, DoorPolicyError, normalize_origin
 from c2rviz.view.ratelog import RateLimitedLog
 
 VERSION = f"viser-v{viser.__version__}"
-ADAPTER_SOURCE = Path(adapter.__file__)
+# the modules that reach inside viser: the adapter and the two it re-exports
+ADAPTER_SOURCES = [
+    Path(adapter.__file__).with_name(name)
+    for name in ("adapter.py", "viser_sends.py", "viser_internals.py")
+]
 
 
 def encode(message: dict[str, Any]) -> bytes:
@@ -594,17 +598,19 @@ def test_set_gui_value_sends_without_calling_back(served: Callable[..., Served])
 
 
 def private_attributes_used_by_the_adapter() -> set[str]:
-    tree = ast.parse(ADAPTER_SOURCE.read_text())
-    used = {
-        node.attr
-        for node in ast.walk(tree)
-        if isinstance(node, ast.Attribute)
-        and node.attr.startswith("_")
-        and not node.attr.startswith("__")
-    }
-    for node in ast.walk(tree):
-        if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("viser"):
-            used |= {a.name for a in node.names if a.name.startswith("_")}
+    used: set[str] = set()
+    for source in ADAPTER_SOURCES:
+        tree = ast.parse(source.read_text())
+        used |= {
+            node.attr
+            for node in ast.walk(tree)
+            if isinstance(node, ast.Attribute)
+            and node.attr.startswith("_")
+            and not node.attr.startswith("__")
+        }
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("viser"):
+                used |= {a.name for a in node.names if a.name.startswith("_")}
     return used
 
 

@@ -5,11 +5,10 @@ Importing this package registers every verb in ``registry.VERBS``, in the order
 """
 
 # isort: off
-from . import joints, markers, queries, connection  # the seed's verbs
-from . import cartesian, cell, motion, observe, record, workcell
+from . import joints, markers, queries  # the seed's verbs (queries: then sleep, bye, quit)
+from . import cartesian, cell, motion, observe, workcell  # observe: then record
 from . import planning
-from . import gripper
-from . import parts
+from . import parts  # grip first, then the part verbs
 from . import cameras
 from . import faults
 # isort: on
@@ -18,9 +17,7 @@ __all__ = [
     "cameras",
     "cartesian",
     "cell",
-    "connection",
     "faults",
-    "gripper",
     "joints",
     "markers",
     "motion",
@@ -28,6 +25,5 @@ __all__ = [
     "parts",
     "planning",
     "queries",
-    "record",
     "workcell",
 ]

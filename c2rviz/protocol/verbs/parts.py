@@ -1,4 +1,5 @@
-"""Part verbs: parts a gripper picks and places, goals for them, and a score."""
+"""Part verbs: the gripper (``grip``, registered first), parts it picks and places, goals
+for them, and a score."""
 
 from __future__ import annotations
 
@@ -6,11 +7,33 @@ import re
 from dataclasses import dataclass
 
 from ...errors import BadArguments, shown
-from ..grammar import count, numbers
+from ..grammar import count, numbers, numbers_arg
 from ..ranges import ANGLE_LIMIT, check_pose
 from ..registry import usage, verb
 
-__all__ = ["GoalEdit", "PartEdit", "PartsQuery", "Score"]
+
+@verb(
+    "grip",
+    "[S]",
+    "the gripper to S, 0 closed .. 1 open, travelling as `motion` says (a robot with no "
+    "gripper gets an error); closing on a part grasps it and replies the opening where the "
+    "fingers stop, opening releases it (docs/parts.md); alone, reply its opening",
+)
+@dataclass(frozen=True, slots=True)
+class Grip:
+    """Move (or, with None, ask) the gripper's opening, 0 closed .. 1 open."""
+
+    opening: float | None
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> Grip:
+        if not words:
+            return Grip(None)
+        (opening,) = numbers_arg(verb, words, 1)
+        if not 0.0 <= opening <= 1.0:
+            raise BadArguments(verb, f"{opening:g} is outside 0..1", usage(verb))
+        return Grip(opening)
+
 
 _NAME = re.compile(r"[A-Za-z0-9_.-]{1,64}")
 # shape -> (how many size values, whether the pose has an orientation)

@@ -1,4 +1,5 @@
-"""Questions: where, pose, limits, names, version, help."""
+"""Questions (``where``, ``pose``, ``limits``, ``names``, ``version``, ``help``) and the
+connection itself (``sleep``, ``bye``, ``quit``), registered in that order."""
 
 from __future__ import annotations
 
@@ -6,10 +7,8 @@ import difflib
 from dataclasses import dataclass
 
 from ...errors import BadArguments, shown
-from ..grammar import one_word
+from ..grammar import numbers_arg, one_word
 from ..registry import LOOKUP, Verb, usage, verb
-
-__all__ = ["DOCS_PAGES", "Help", "Limits", "Names", "Pose", "Version", "Where", "docs_page"]
 
 
 @verb("where", "", "reply the chain's joint values")
@@ -75,15 +74,13 @@ DOCS_PAGES = {
     "joints": "docs/commands.md",
     "markers": "docs/commands.md",
     "queries": "docs/commands.md",
-    "connection": "docs/commands.md",
     "cartesian": "docs/cartesian.md",
     "cell": "docs/cells.md",
     "motion": "docs/motion.md",
     "observe": "docs/watch.md",
-    "record": "docs/recording.md",
+    "record": "docs/recording.md",  # a verb of observe.py, by name
     "workcell": "docs/workcell.md",
     "planning": "docs/planning.md",
-    "gripper": "docs/commands.md",
     "ghost": "docs/page.md",
     "objects": "docs/commands.md",  # workcell.md shows objects, not this question
 }
@@ -131,3 +128,34 @@ class Help:
         names = "|".join((entry.name, *entry.aliases))
         line = f"{names} {entry.args}" if entry.args else names
         return f"{line}: {entry.summary}; see {docs_page(entry)}"
+
+
+@verb(
+    "sleep",
+    "seconds",
+    "pause this connection for that long (others go on); the reply comes when it ends",
+)
+@dataclass(frozen=True, slots=True)
+class Sleep:
+    """Pause this connection for ``seconds`` [s]."""
+
+    seconds: float
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> Sleep:
+        (seconds,) = numbers_arg(verb, words, 1)
+        if seconds < 0:
+            raise BadArguments(verb, f"seconds must be >= 0, got {seconds:g}", usage(verb))
+        return Sleep(seconds)
+
+
+@verb("bye", "", "close this connection")
+@dataclass(frozen=True, slots=True)
+class Bye:
+    """Close this connection."""
+
+
+@verb("quit", "", "reply, then stop the whole program (command server and viewer), status 0")
+@dataclass(frozen=True, slots=True)
+class Quit:
+    """Stop the whole program."""

@@ -1,42 +1,35 @@
-"""What every verb does: one module of ``@handler`` functions per family of verbs, each
-mirroring its ``protocol.verbs`` module.
+"""What every verb does: ``@handler`` functions, grouped by what they act on. Each
+``protocol.verbs`` family's handlers live together in one module:
 
-Importing this package registers every handler in ``registry.HANDLERS`` (the
-``session`` package does, so a session can run every verb).
+========================  ==============================================================
+module                    verb families (``protocol.verbs``)
+========================  ==============================================================
+``arm``                   ``joints``, ``motion``: the arm moved by its joints
+``cartesian``             ``cartesian``: the tool, IK, moves to a tool pose
+``planning``              ``planning``: ``plan``, a path around obstacles
+``scene``                 ``markers``, ``workcell``, ``cell``: what the scene holds
+``parts``                 ``parts``: the gripper, parts, goals, the score
+``cameras``               ``cameras``
+``faults``                ``faults``
+``queries``               ``queries``: questions, and ``sleep``, ``bye``, ``quit``
+``observe``               ``observe``: watch, trail, ghost, and record
+========================  ==============================================================
+
+The import below is the whole list: importing this package registers every handler in
+``registry.HANDLERS`` (the ``session`` package does, so a session can run every verb;
+``tests/protocol/test_registry.py`` checks that every verb has exactly one).
 """
 
-from . import (
-    cameras,
-    cartesian,
-    cell,
-    connection,
-    faults,
-    gripper,
-    joints,
-    markers,
-    motion,
-    observe,
-    parts,
-    planning,
-    queries,
-    record,
-    workcell,
-)
+from . import arm, cameras, cartesian, faults, observe, parts, planning, queries, scene
 
 __all__ = [
+    "arm",
     "cameras",
     "cartesian",
-    "cell",
-    "connection",
     "faults",
-    "gripper",
-    "joints",
-    "markers",
-    "motion",
     "observe",
     "parts",
     "planning",
     "queries",
-    "record",
-    "workcell",
+    "scene",
 ]

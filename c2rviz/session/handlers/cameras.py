@@ -16,8 +16,6 @@ from ...world.cameras import DEFAULT_FOV_RAD, DEFAULT_RANGE_M, Camera, CameraErr
 if TYPE_CHECKING:
     from ..session import Session
 
-__all__: list[str] = []
-
 
 @handler(CameraEdit)
 def camera(session: Session, command: CameraEdit) -> str:

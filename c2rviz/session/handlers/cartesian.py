@@ -26,8 +26,6 @@ from ..guarded import checked_move
 if TYPE_CHECKING:
     from ..session import Session
 
-__all__ = ["StraightPlan", "play_straight", "plan_straight", "solve"]
-
 
 @handler(Tool)
 def tool(session: Session, command: Tool) -> str:

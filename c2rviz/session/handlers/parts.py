@@ -1,13 +1,16 @@
-"""What the part verbs do: parts added, removed and asked about, goals and the score."""
+"""What the part verbs do: the gripper's fingers to an opening, travelling as ``motion``
+says, by the grasp rule for parts (``Session.grip``, every door's grip); parts added,
+removed and asked about, goals and the score."""
 
 from __future__ import annotations
 
 import math
 from typing import TYPE_CHECKING
 
+from ...errors import NoGripper
 from ...protocol import replies
-from ...protocol.registry import handler
-from ...protocol.verbs.parts import GoalEdit, PartEdit, PartsQuery, Score
+from ...protocol.registry import Reply, handler
+from ...protocol.verbs.parts import GoalEdit, Grip, PartEdit, PartsQuery, Score
 from ...world.goals import DEFAULT_TOL_M, DEFAULT_TOL_RAD, Goal
 
 if TYPE_CHECKING:
@@ -16,7 +19,15 @@ if TYPE_CHECKING:
     from ...world.parts import Part
     from ..session import Session
 
-__all__: list[str] = []
+
+@handler(Grip)
+def grip(session: Session, command: Grip) -> Reply:
+    state, grips = session.state, session.world.grips
+    if state.robot.gripper is None:
+        raise NoGripper(state.name)
+    if command.opening is None:
+        return replies.ok(replies.numbers([grips.now(state)]))
+    return session.grip(command.opening)
 
 
 def _where(session: Session, part: Part) -> str:

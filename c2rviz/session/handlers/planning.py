@@ -26,8 +26,6 @@ from ..guarded import checked_move, play_checked
 if TYPE_CHECKING:
     from ..session import Session
 
-__all__: list[str] = []
-
 MIN_TIMEOUT_S = 0.001  # [s] shortest search a connection may set
 
 

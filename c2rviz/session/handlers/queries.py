@@ -1,19 +1,20 @@
-"""What the question verbs do: where, pose, limits, names, version, help."""
+"""What the connection asks and says of itself: the questions ``where``, ``pose``,
+``limits``, ``names``, ``version``, ``help``, and ``sleep``, ``bye``, ``quit`` (all
+``protocol.verbs.queries``)."""
 
 from __future__ import annotations
 
 import hashlib
 from typing import TYPE_CHECKING
 
+from ...errors import BadArguments
 from ...protocol import replies
-from ...protocol.registry import handler
-from ...protocol.verbs.queries import Help, Limits, Names, Pose, Version, Where
+from ...protocol.registry import Reply, handler, usage
+from ...protocol.verbs.queries import Bye, Help, Limits, Names, Pose, Quit, Sleep, Version, Where
 from ...version import __version__
 
 if TYPE_CHECKING:
     from ..session import Session
-
-__all__: list[str] = []
 
 
 @handler(Where)
@@ -65,3 +66,25 @@ def help_(session: Session, command: Help) -> str:
     if command.verb is None:
         return replies.help_reply()
     return replies.ok(command.reply_text())
+
+
+@handler(Sleep)
+def sleep(session: Session, command: Sleep) -> Reply:
+    longest = session.limits.max_sleep_s
+    if command.seconds > longest:
+        raise BadArguments(
+            "sleep", f"{command.seconds:g} s is over the limit of {longest:g} s", usage("sleep")
+        )
+    return session.after(command.seconds, replies.OK)
+
+
+@handler(Bye)
+def bye(session: Session, command: Bye) -> str:
+    session.hangup = "bye"
+    return replies.BYE
+
+
+@handler(Quit)
+def quit_(session: Session, command: Quit) -> str:
+    session.hangup = "quit"
+    return replies.OK

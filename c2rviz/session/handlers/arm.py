@@ -1,4 +1,8 @@
-"""What the joint verbs do: rand, home, degrees/radians, joints, move."""
+"""What the verbs that move the arm by its joints do: ``rand``, ``home``, ``joints``,
+``move`` and ``degrees``/``radians`` (``protocol.verbs.joints``); this connection's
+``motion`` mode and ``speed``, ``stop``, ``wait``, ``target``, ``status``
+(``protocol.verbs.motion``).
+"""
 
 from __future__ import annotations
 
@@ -8,12 +12,11 @@ from ...errors import JointCountError, JointIndexError
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
 from ...protocol.verbs.joints import Home, Joints, Move, Rand, Units
+from ...protocol.verbs.motion import MotionMode, Speed, Status, Stop, Target, Wait
 from ..guarded import guarded_rand
 
 if TYPE_CHECKING:
     from ..session import Session
-
-__all__: list[str] = []
 
 
 @handler(Rand)
@@ -56,3 +59,41 @@ def move(session: Session, command: Move) -> Reply:
     for index, value in zip(command.indices, session.to_si(command.indices, command.values)):
         q[index] = value
     return session.go(q)
+
+
+@handler(MotionMode)
+def motion_mode(session: Session, command: MotionMode) -> str:
+    if command.mode is None:
+        return replies.ok(session.motion)
+    session.motion = command.mode
+    return replies.OK
+
+
+@handler(Speed)
+def speed(session: Session, command: Speed) -> str:
+    if command.percent is None:
+        return replies.ok(replies.numbers([session.speed]))
+    session.speed = command.percent
+    return replies.OK
+
+
+@handler(Stop)
+def stop(session: Session, command: Stop) -> Reply:
+    return session.stop()
+
+
+@handler(Wait)
+def wait(session: Session, command: Wait) -> Reply:
+    at_rest = session.world.travels.rest(session.state)
+    return replies.OK if at_rest is None else at_rest
+
+
+@handler(Target)
+def target(session: Session, command: Target) -> str:
+    return replies.ok(replies.numbers(session.from_si(session.state.target)))
+
+
+@handler(Status)
+def status(session: Session, command: Status) -> str:
+    left = session.world.travels.seconds_left(session.state)
+    return replies.ok(f"moving {left:.3f}" if session.travel.active else "idle")
