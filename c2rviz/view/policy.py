@@ -11,12 +11,11 @@ reverse proxy's origin is added by the user. A host name that resolves to
 
 from __future__ import annotations
 
-import hmac
 from dataclasses import dataclass
-from urllib.parse import parse_qs, quote, urlsplit
+from urllib.parse import quote
 
 from ..errors import C2rvizError, shown
-from ..origins import LOOPBACK_HOSTS, normalize_origin
+from ..origins import LOOPBACK_HOSTS, normalize_origin, token_ok
 
 __all__ = ["LOOPBACK_HOSTS", "DoorPolicy", "DoorPolicyError", "normalize_origin"]
 
@@ -79,10 +78,7 @@ class DoorPolicy:
 
     def token_ok(self, path: str) -> bool:
         """Whether the request target ``path`` carries the token (or none is needed)."""
-        if self.token is None:
-            return True
-        given = parse_qs(urlsplit(path).query, keep_blank_values=True).get("token", [])
-        return any(hmac.compare_digest(g.encode(), self.token.encode()) for g in given)
+        return token_ok(self.token, path)
 
     def page_url(self, base_url: str) -> str:
         """The URL to print for the page at ``base_url`` (``http://host:port``).

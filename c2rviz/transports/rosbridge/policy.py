@@ -13,12 +13,10 @@ connection needs ``?token=<token>`` in its URL. A host name that resolves to
 
 from __future__ import annotations
 
-import hmac
 from dataclasses import dataclass
-from urllib.parse import parse_qs, urlsplit
 
 from ...errors import C2rvizError
-from ...origins import LOOPBACK_HOSTS, normalize_origin
+from ...origins import LOOPBACK_HOSTS, normalize_origin, token_ok
 
 __all__ = ["LOOPBACK_HOSTS", "PolicyError", "RosbridgePolicy", "normalize_origin"]
 
@@ -104,7 +102,4 @@ class RosbridgePolicy:
 
     def token_ok(self, path: str) -> bool:
         """Whether the request target ``path`` carries the token (or none is needed)."""
-        if self.token is None:
-            return True
-        given = parse_qs(urlsplit(path).query, keep_blank_values=True).get("token", [])
-        return any(hmac.compare_digest(g.encode(), self.token.encode()) for g in given)
+        return token_ok(self.token, path)
