@@ -18,11 +18,11 @@ status whose ``StateDescription`` says what was wrong):
 - what the stream cannot be re-synchronised after (a document over
   ``max_document_bytes``, binary bytes, a ``<!DOCTYPE`` or other markup declaration):
   that error, then the documented close (the server ends its side, reads and drops
-  what the client still sends for up to ``LINGER_S``, then closes);
+  what the client still sends for up to ``tcp_rules.LINGER_S``, then closes);
 - one connection over ``max_connections``: an error status, then the close;
 - statuses left unread past ``max_unread``: the connection is reset.
 
-A long run of documents in one read is worked through ``TURN_S`` at a time, so one
+A long run of documents in one read is worked through ``tcp_rules.TURN_S`` at a time, so one
 client's flood delays the others by no more than that; a document too large to parse
 in that time (over ``PARSE_ON_LOOP_BYTES``) is parsed on the door's one parsing
 thread (lxml lets go of the interpreter's lock while it parses), big documents of
@@ -40,6 +40,7 @@ from typing import Final
 
 from ...session.services import Services
 from ...session.session import Session
+from ..tcp_rules import TURN_S, close_lingering
 from .actions import ACTIONS
 from .controller import Controller
 from .documents import CommandInstance, parse_instance
@@ -49,12 +50,10 @@ from .hardened import MAX_DOCUMENT_BYTES
 
 __all__ = [
     "DEFAULT_PORT",
-    "LINGER_S",
     "PARSE_ON_LOOP_BYTES",
     "READ_BYTES",
     "REFUSALS_SUMMED_S",
     "SPLIT_BYTES",
-    "TURN_S",
     "CrclLimits",
     "CrclServer",
 ]
@@ -65,10 +64,6 @@ DEFAULT_PORT: Final = 64444
 """NIST's Java tools' port."""
 READ_BYTES: Final = 65536
 """Most bytes read at once from a client."""
-TURN_S: Final = 0.002
-"""Work per client per event-loop turn [s]: then the other clients go first."""
-LINGER_S: Final = 2.0
-"""After the close is decided, how long a client's input is read and dropped [s]."""
 REFUSALS_SUMMED_S: Final = 60.0
 """Refused connections after the first are logged as one count per this interval [s]."""
 SPLIT_BYTES: Final = 16384
@@ -375,22 +370,21 @@ class _Connection:
         self.writer.transport.abort()  # the reads end (EOF): run and close return
 
     async def close(self) -> None:
-        """The documented close: statuses out, our side ended, the client's rest read and
-        dropped for up to ``LINGER_S`` (a reset would lose the last status), then closed."""
+        """The documented close (``tcp_rules.close_lingering``): statuses out, our side
+        ended, the client's rest read and dropped until it closes or the linger ends (a
+        reset would lose the last status), then closed."""
         self.controller.close()
         self.closing = True
-        writer = self.writer
-        if writer.transport.is_closing():
+        transport = self.writer.transport
+        assert isinstance(transport, asyncio.Transport)  # a TCP stream: it reads too
+        linger = close_lingering(transport, eof=False)
+        if linger is None:
             return
-        deadline = asyncio.get_running_loop().time() + LINGER_S
         try:
-            if writer.can_write_eof():
-                writer.write_eof()
-            while True:
-                left = deadline - asyncio.get_running_loop().time()
-                if left <= 0 or not await asyncio.wait_for(self.reader.read(READ_BYTES), left):
-                    break
-        except (asyncio.TimeoutError, ConnectionError, OSError):
+            while await self.reader.read(READ_BYTES):
+                pass  # dropped; the linger's end aborts the transport, and the read ends
+        except (ConnectionError, OSError):
             pass
         finally:
-            writer.close()
+            linger.cancel()
+            self.writer.close()
