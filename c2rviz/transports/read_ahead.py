@@ -5,22 +5,35 @@ reads on, up to ``LOOK_AHEAD_BYTES`` buffered, to see two things at once: a ``st
 line cancels the connection's plans (``stop_plans``; the ``stop`` itself still runs in
 its turn), and the end of the stream cancels them all. ``StopScan`` remembers how far
 the buffer was looked at, so each byte is decoded once; ``is_command`` tells which
-lines still owe a reply when the connection closes early.
+lines still owe a reply when the connection closes early, and ``waited_reply`` what the
+client is told when the reply it waited for comes.
 """
 
 from __future__ import annotations
 
 import asyncio
+import logging
 from typing import Final
 
 from ..errors import C2rvizError
 from ..planning.cancel import STOPPED
+from ..protocol import replies
 from ..protocol.framing import Line, LineFramer
 from ..protocol.grammar import parse_line
 from ..protocol.verbs.motion import Stop
 from ..session.session import Session
 
-__all__ = ["LOOK_AHEAD_BYTES", "StopScan", "is_command", "is_stop", "pace_reading", "stop_plans"]
+__all__ = [
+    "LOOK_AHEAD_BYTES",
+    "StopScan",
+    "is_command",
+    "is_stop",
+    "pace_reading",
+    "stop_plans",
+    "waited_reply",
+]
+
+log = logging.getLogger("c2rviz.server")
 
 LOOK_AHEAD_BYTES: Final = 16384
 """Read behind a reply that waits at most [bytes], then reading pauses."""
@@ -93,3 +106,17 @@ def _quiet(future: asyncio.Future[str]) -> None:
     """A reply nobody awaits: read its outcome (asyncio logs one never read)."""
     if not future.cancelled():
         future.exception()
+
+
+def waited_reply(pending: asyncio.Future[str], peer: str) -> str:
+    """The line for a reply that waited: its text, its error, or ``SHUTTING_DOWN`` if it
+    was cancelled (a bug is logged with ``peer`` and costs one error line)."""
+    if pending.cancelled():
+        return replies.SHUTTING_DOWN
+    error = pending.exception()
+    if isinstance(error, C2rvizError):
+        return replies.error(error)
+    if error is not None:
+        log.error("internal error from %s", peer, exc_info=error)
+        return replies.error("internal error (see the server log)")
+    return pending.result()

@@ -30,7 +30,7 @@ from ..protocol.grammar import ForeignProtocol
 from ..session.services import Services
 from ..session.session import BATCHED, Session
 from ..session.settings import ServerLimits
-from .read_ahead import StopScan, is_command, is_stop, pace_reading, stop_plans
+from .read_ahead import StopScan, is_command, is_stop, pace_reading, stop_plans, waited_reply
 from .tcp_rules import TURN_S, close_lingering
 
 __all__ = ["Connection", "Host"]
@@ -289,19 +289,9 @@ class Connection(asyncio.Protocol):
         if pending is not self.pending:
             return
         self.pending = None
-        if self.closing:
-            return
-        if pending.cancelled():
-            text = replies.SHUTTING_DOWN
-        elif isinstance(pending.exception(), C2rvizError):
-            text = replies.error(pending.exception())
-        elif pending.exception() is not None:
-            log.error("internal error from %s", self.peer, exc_info=pending.exception())
-            text = replies.error("internal error (see the server log)")
-        else:
-            text = pending.result()
-        self._write([text])
-        self._go_on()
+        if not self.closing:
+            self._write([waited_reply(pending, self.peer)])
+            self._go_on()
 
     def _yield(self, rest: Sequence[Line]) -> None:
         """Stop reading for a loop turn, so the other clients go first; then run ``rest``."""
