@@ -16,6 +16,7 @@ from urllib.parse import quote
 
 from ..errors import C2rvizError, shown
 from ..origins import LOOPBACK_HOSTS, normalize_origin, token_ok
+from ..protocol.limits import below_floor, default, default_s
 
 __all__ = ["LOOPBACK_HOSTS", "DoorPolicy", "DoorPolicyError", "normalize_origin"]
 
@@ -47,10 +48,10 @@ class DoorPolicy:
 
     extra_origins: tuple[str, ...] = ()
     token: str | None = None
-    max_clients: int = 16
-    max_frame_bytes: int = 64 * 1024
-    max_queued_frames: int = 8
-    log_interval_s: float = 60.0
+    max_clients: int = default("page", "max_clients")
+    max_frame_bytes: int = default("page", "max_frame_bytes")
+    max_queued_frames: int = default("page", "max_queued_frames")
+    log_interval_s: float = default_s("page", "log_interval_s")
 
     def __post_init__(self) -> None:
         for origin in self.extra_origins:
@@ -58,9 +59,10 @@ class DoorPolicy:
                 raise DoorPolicyError("origin", origin, "scheme://host[:port] (http or https)")
         if self.token is not None and not (self.token.isascii() and self.token.isprintable()):
             raise DoorPolicyError("token", self.token, "printable ASCII")
-        for name in ("max_clients", "max_frame_bytes", "max_queued_frames"):
-            if getattr(self, name) < 1:
-                raise DoorPolicyError(name.replace("_", " "), getattr(self, name), "at least 1")
+        low = below_floor("page", self)
+        if low is not None:
+            name, value, floor = low
+            raise DoorPolicyError(name.replace("_", " "), value, f"at least {floor}")
 
     def origins(self, host: str, port: int) -> list[str]:
         """The origins allowed for a viewer served on ``host`` reached at ``port``."""

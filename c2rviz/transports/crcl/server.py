@@ -38,6 +38,7 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Final
 
+from ...protocol.limits import default, default_s
 from ...session.services import Services
 from ...session.session import Session
 from ..tcp_rules import TURN_S, close_lingering
@@ -46,7 +47,6 @@ from .controller import Controller
 from .documents import CommandInstance, parse_instance
 from .errors import CrclError, CrclFramingError
 from .framing import DocumentSplitter
-from .hardened import MAX_DOCUMENT_BYTES
 
 __all__ = [
     "DEFAULT_PORT",
@@ -80,7 +80,8 @@ INTERNAL_ERROR: Final = "internal error reading the document (see the server log
 
 @dataclass(frozen=True)
 class CrclLimits:
-    """What one CRCL client may cost (docs/limits.md).
+    """What one CRCL client may cost (docs/limits.md; the ``crcl`` rows of
+    ``session.limits.LIMITS``).
 
     Attributes:
         max_document_bytes: The largest document [bytes]; larger closes the connection.
@@ -89,10 +90,10 @@ class CrclLimits:
         max_unread: Statuses a client has not read [bytes]; more resets the connection.
     """
 
-    max_document_bytes: int = MAX_DOCUMENT_BYTES
-    stall_timeout_s: float = 10.0
-    max_connections: int = 16
-    max_unread: int = 1 << 20
+    max_document_bytes: int = default("crcl", "max_document_bytes")
+    stall_timeout_s: float = default_s("crcl", "stall_timeout_s")
+    max_connections: int = default("crcl", "max_connections")
+    max_unread: int = default("crcl", "max_unread")
 
 
 class CrclServer:
