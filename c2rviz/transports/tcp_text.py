@@ -45,11 +45,10 @@ class Host(Protocol):
     limits: ServerLimits
     robot: str | None
     viewer_url: str | None
-    stopping: bool
-    connections: set[Connection]
-    open: set[Connection]
 
-    def count_clients(self) -> None: ...
+    def admit(self, connection: Connection) -> str | None: ...
+
+    def release(self, connection: Connection) -> None: ...
 
     def request_quit(self) -> None: ...
 
@@ -99,19 +98,10 @@ class Connection(asyncio.Protocol):
         peer = transport.get_extra_info("peername")
         self.peer = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
         self.session.set_source(f"tcp {self.peer}")
-        server = self.server
-        server.open.add(self)
-        if server.stopping:
+        refusal = self.server.admit(self)
+        if refusal is not None:
             self.hold.close()
-            self._close_with(replies.SHUTTING_DOWN)
-        elif len(server.connections) >= self.limits.max_clients:
-            log.warning("refused %s: %d clients already", self.peer, len(server.connections))
-            self.hold.close()
-            self._close_with(replies.too_many_clients(self.limits.max_clients))
-        else:
-            server.connections.add(self)
-            server.count_clients()
-            log.info("client %s connected", self.peer)
+            self._close_with(refusal)
 
     def connection_lost(self, exc: Exception | None) -> None:
         self._cancel_timers()
@@ -121,12 +111,7 @@ class Connection(asyncio.Protocol):
         if self.pending is not None:
             self.pending.cancel()
         self.server.services.worker.go_on(self.session)
-        server = self.server
-        server.open.discard(self)
-        if self in server.connections:
-            server.connections.discard(self)
-            server.count_clients()
-            log.info("client %s left", self.peer)
+        self.server.release(self)
         if not self.closed.done():
             self.closed.set_result(None)
 
