@@ -20,6 +20,7 @@ from typing import Any
 
 from ..errors import ConfigError
 from ..ini import INI_NAME, PROJECT_DIR, find_ini, number, read_ini
+from ..protocol.limits import bounds, default
 from ..robot.catalogue import catalogue, find_robot
 from ..robot.sources import split_package_path
 from ..session.settings import ServerLimits, SessionDefaults
@@ -96,7 +97,7 @@ class Settings:
     """Origins allowed to open the viewer's websocket besides its own (a reverse proxy)."""
     viewer_token: str | None = None
     """The token the page needs (``?token=``); None: none, unless bound beyond loopback."""
-    max_viewers: int = 16
+    max_viewers: int = default("page", "max_clients")
     """Viewer tabs connected at once."""
     page_process: bool = False
     """Serve the page from a process of its own (``--page-process``, ini ``page_process =
@@ -155,16 +156,16 @@ _OPTIONS: dict[str, tuple[str, type, float, float]] = {
     "port": ("port", int, 0, 65535),
     "hz": ("hz", float, 1, 1000),
     "viewer_port": ("viewer_port", int, 0, 65535),
-    "max_line": ("max_line", int, 64, 1 << 24),
-    "max_clients": ("max_clients", int, 1, 100000),
-    "max_unread": ("max_unread", int, 1024, 1 << 30),
-    "partial_timeout": ("partial_timeout_s", float, 0.01, 86400),
-    "max_sleep": ("max_sleep_s", float, 0, 1e6),
+    "max_line": ("max_line", int, *bounds("text", "max_line")),
+    "max_clients": ("max_clients", int, *bounds("text", "max_clients")),
+    "max_unread": ("max_unread", int, *bounds("text", "max_unread")),
+    "partial_timeout": ("partial_timeout_s", float, *bounds("text", "partial_timeout_s")),
+    "max_sleep": ("max_sleep_s", float, *bounds("text", "max_sleep_s")),
     "speed": ("speed", float, 1, 100),
     "lspeed": ("lspeed", float, 0.001, 5),
     "trail_points": ("trail_points", int, 16, 10_000_000),
     "max_objects": ("max_objects", int, 0, 10_000),
-    "max_viewers": ("max_viewers", int, 1, 1024),
+    "max_viewers": ("max_viewers", int, *bounds("page", "max_clients")),
     "rosbridge_port": ("rosbridge_port", int, 0, 65535),
     "plan_timeout": ("plan_timeout_s", float, 0.001, 60),
     "seed": ("plan_seed", int, 0, 2**31 - 2),

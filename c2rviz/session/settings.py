@@ -16,20 +16,23 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from ..protocol.limits import default, default_s
+
 
 @dataclass(frozen=True)
 class ServerLimits:
-    """What one client may cost the server (README: "Limits")."""
+    """What one client of the text port may cost the server (README: "Limits"); the
+    defaults and bounds are the ``text`` rows of ``limits.LIMITS``."""
 
-    max_line: int = 8192
+    max_line: int = default("text", "max_line")
     """Longest line [bytes]; longer closes the connection."""
-    max_clients: int = 64
+    max_clients: int = default("text", "max_clients")
     """Clients connected at once; one more is told so and closed."""
-    max_unread: int = 1 << 20
+    max_unread: int = default("text", "max_unread")
     """Replies a client has not read [bytes]; more closes the connection."""
-    partial_timeout_s: float = 10.0
+    partial_timeout_s: float = default_s("text", "partial_timeout_s")
     """How long a started line may stay unfinished [s]."""
-    max_sleep_s: float = 3600.0
+    max_sleep_s: float = default_s("text", "max_sleep_s")
     """Longest ``sleep`` [s]."""
 
 

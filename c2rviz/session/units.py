@@ -1,9 +1,12 @@
 """A source's units at the edge: its chain limits in degrees or radians, and the factor to SI.
 
-Sources speak degrees or radians (metres for prismatic joints, always); everything
-past the session is SI. ``UnitTable`` holds, for one robot and one unit mode, the
-limits in the source's units and the factor that turns its values into SI, so the
-hot path (a stream of ``joints`` lines) checks and converts in C.
+Sources speak degrees or radians (metres for prismatic joints, always; CRCL may set its
+length unit too); everything past the session is SI. This is the one conversion layer:
+the SI size of each unit a door speaks (``DEGREE_RAD``, ``INCH_M``, ...), a chain's
+per-joint factor (``joint_scale``), and ``UnitTable``, which holds, for one robot and
+one unit mode, the limits in the source's units and the factor that turns its values
+into SI, so the hot path (a stream of ``joints`` lines) checks and converts in C.
+A door's own names for its units (CRCL's ``millimeter``, ``footPound``) stay with it.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from operator import le, mul
+from typing import Final
 
 import pinocchio as pin
 
@@ -22,7 +26,33 @@ from ..robot.frames import pose_se3, se3_pose
 from ..robot.model import Robot
 from ..tolerance import within_limit
 
-__all__ = ["UnitEdge", "UnitTable"]
+__all__ = [
+    "DEGREE_RAD",
+    "FOOT_M",
+    "INCH_M",
+    "MILLIMETER_M",
+    "POUND_FORCE_N",
+    "UnitEdge",
+    "UnitTable",
+    "joint_scale",
+]
+
+DEGREE_RAD: Final = math.pi / 180.0
+"""Radians in a degree."""
+MILLIMETER_M: Final = 1e-3
+"""Meters in a millimeter."""
+INCH_M: Final = 0.0254
+"""Meters in an inch (25.4 mm exactly)."""
+FOOT_M: Final = 0.3048
+"""Meters in a foot."""
+POUND_FORCE_N: Final = 4.4482216152605
+"""Newtons in a pound-force (0.45359237 kg * 9.80665 m/s^2)."""
+
+
+def joint_scale(prismatic: Sequence[bool], angle: float, length: float = 1.0) -> tuple[float, ...]:
+    """Per joint, SI per source unit: ``length`` [m] for a prismatic joint, ``angle`` [rad]
+    for a revolute one (SI value = source value * factor)."""
+    return tuple(length if p else angle for p in prismatic)
 
 
 @dataclass(frozen=True, slots=True)
@@ -44,8 +74,7 @@ class UnitTable:
 
     @classmethod
     def build(cls, robot: Robot, degrees: bool) -> UnitTable:
-        angle = math.pi / 180.0 if degrees else 1.0
-        scale = tuple(1.0 if p else angle for p in robot.prismatic)
+        scale = joint_scale(robot.prismatic, DEGREE_RAD if degrees else 1.0)
         angle_unit = "deg" if degrees else "rad"
         return cls(
             scale=scale,
@@ -85,7 +114,7 @@ class UnitEdge:
     @property
     def angle_scale(self) -> float:
         """SI angle = client angle * this (for poses)."""
-        return math.pi / 180.0 if self.degrees else 1.0
+        return DEGREE_RAD if self.degrees else 1.0
 
     def pose_se3(self, pose: Sequence[float]) -> pin.SE3:
         """A pose as this source writes it (x, y, z [m]; roll, pitch, yaw in its angle unit)

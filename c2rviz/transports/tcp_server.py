@@ -11,6 +11,7 @@ import asyncio
 import logging
 from collections.abc import Callable
 
+from ..protocol import replies
 from ..session.services import Services
 from .tcp_text import Connection
 
@@ -57,6 +58,29 @@ class CommandServer:
     def count_clients(self) -> None:
         """Tell the program how many clients this door serves now."""
         self.services.count_clients(self._door, len(self.connections))
+
+    def admit(self, connection: Connection) -> str | None:
+        """A client has connected: serve it, or say why not (None: served; else the reply
+        it gets before it is closed: the server stops, or ``max_clients`` are served)."""
+        self.open.add(connection)
+        if self.stopping:
+            return replies.SHUTTING_DOWN
+        served = len(self.connections)
+        if served >= self.limits.max_clients:
+            log.warning("refused %s: %d clients already", connection.peer, served)
+            return replies.too_many_clients(self.limits.max_clients)
+        self.connections.add(connection)
+        self.count_clients()
+        log.info("client %s connected", connection.peer)
+        return None
+
+    def release(self, connection: Connection) -> None:
+        """A client's socket has closed: it is served no more."""
+        self.open.discard(connection)
+        if connection in self.connections:
+            self.connections.discard(connection)
+            self.count_clients()
+            log.info("client %s left", connection.peer)
 
     async def start(self, host: str = "127.0.0.1", port: int = 0) -> tuple[str, int]:
         """Start listening; return the address actually bound (port 0 picks one)."""

@@ -23,16 +23,17 @@ from typing import Protocol
 
 from ..errors import C2rvizError, LineTooLong
 from ..observers.watch import STREAM_ALLOWANCE_BYTES
-from ..planning.cancel import STOPPED, WENT_AWAY
+from ..planning.cancel import WENT_AWAY
 from ..protocol import replies
 from ..protocol.framing import Line, LineFramer
-from ..protocol.grammar import ForeignProtocol, parse_line
-from ..protocol.verbs.motion import Stop
+from ..protocol.grammar import ForeignProtocol
 from ..session.services import Services
 from ..session.session import BATCHED, Session
 from ..session.settings import ServerLimits
+from .read_ahead import StopScan, is_command, is_stop, pace_reading, stop_plans, waited_reply
+from .tcp_rules import TURN_S, close_lingering
 
-__all__ = ["Connection", "Host", "TURN_S"]
+__all__ = ["Connection", "Host"]
 
 log = logging.getLogger("c2rviz.server")
 
@@ -44,11 +45,10 @@ class Host(Protocol):
     limits: ServerLimits
     robot: str | None
     viewer_url: str | None
-    stopping: bool
-    connections: set[Connection]
-    open: set[Connection]
 
-    def count_clients(self) -> None: ...
+    def admit(self, connection: Connection) -> str | None: ...
+
+    def release(self, connection: Connection) -> None: ...
 
     def request_quit(self) -> None: ...
 
@@ -58,11 +58,9 @@ class Connection(asyncio.Protocol):
 
     Lines run in order. A reply that waits (an awaitable from the handler, such as
     ``sleep``'s) holds the lines read behind it in ``backlog`` (and the framer) until it
-    comes, while other connections go on. Reading goes on behind it, up to
-    ``LOOK_AHEAD_BYTES`` buffered, to see two things at once: a ``stop`` line cancels the
-    connection's plans (searching, and those it sent before the ``stop``: ``Worker.halt``;
-    the ``stop`` itself still runs in its turn), and the end of the stream cancels them
-    all (its client went away: the plan lane is free for the others).
+    comes, while other connections go on. Reading goes on behind it (``read_ahead``): a
+    ``stop`` read there cancels the connection's plans at once, and the end of the stream
+    cancels them all (its client went away: the plan lane is free for the others).
     """
 
     def __init__(self, server: Host) -> None:
@@ -80,7 +78,7 @@ class Connection(asyncio.Protocol):
         self.closing = False
         self.eof = False
         self.halted = False  # a stop or the end was seen ahead: this client's plans stop
-        self.scanned = 0  # bytes of the framer's buffer looked at ahead for a `stop`
+        self.scan = StopScan()  # how far the framer's buffer was looked at for a `stop`
         self.closed = asyncio.get_running_loop().create_future()
         self.stream = server.services.watch.open(self.session, self)  # idle until `watch`
         clock = server.services.world.clock
@@ -100,19 +98,10 @@ class Connection(asyncio.Protocol):
         peer = transport.get_extra_info("peername")
         self.peer = f"{peer[0]}:{peer[1]}" if isinstance(peer, tuple) else str(peer)
         self.session.set_source(f"tcp {self.peer}")
-        server = self.server
-        server.open.add(self)
-        if server.stopping:
+        refusal = self.server.admit(self)
+        if refusal is not None:
             self.hold.close()
-            self._close_with(replies.SHUTTING_DOWN)
-        elif len(server.connections) >= self.limits.max_clients:
-            log.warning("refused %s: %d clients already", self.peer, len(server.connections))
-            self.hold.close()
-            self._close_with(replies.too_many_clients(self.limits.max_clients))
-        else:
-            server.connections.add(self)
-            server.count_clients()
-            log.info("client %s connected", self.peer)
+            self._close_with(refusal)
 
     def connection_lost(self, exc: Exception | None) -> None:
         self._cancel_timers()
@@ -122,12 +111,7 @@ class Connection(asyncio.Protocol):
         if self.pending is not None:
             self.pending.cancel()
         self.server.services.worker.go_on(self.session)
-        server = self.server
-        server.open.discard(self)
-        if self in server.connections:
-            server.connections.discard(self)
-            server.count_clients()
-            log.info("client %s left", self.peer)
+        self.server.release(self)
         if not self.closed.done():
             self.closed.set_result(None)
 
@@ -217,7 +201,7 @@ class Connection(asyncio.Protocol):
             try:
                 if not isinstance(line, str):
                     raise line
-                if self.halted and not self.eof and _is_stop(line):
+                if self.halted and not self.eof and is_stop(line):
                     self.halted = False  # its turn: the plans sent after it run
                     session.services.worker.go_on(session)
                 if line.startswith(BATCHED):
@@ -269,60 +253,30 @@ class Connection(asyncio.Protocol):
         pending = asyncio.ensure_future(answer)
         self.pending = pending
         pending.add_done_callback(self._answered)
-        self.scanned = 0
-        if not self.halted and any(map(_is_stop, rest)):
+        self.scan.reset()
+        if not self.halted and any(map(is_stop, rest)):
             self._stop_ahead()
         self._look_ahead()
 
     def _look_ahead(self) -> None:
-        """Behind a reply that waits: act on a ``stop`` read ahead (``_stop_ahead``), and
-        stop reading once ``LOOK_AHEAD_BYTES`` wait (the lines run in their turn)."""
-        framer = self.framer
-        buffer = framer.buffer
-        if not self.halted:
-            cut = buffer.rfind(b"\n")
-            if cut >= self.scanned:
-                fresh = framer.decode(buffer[self.scanned : cut])
-                self.scanned = cut + 1
-                if any(map(_is_stop, fresh)):
-                    self._stop_ahead()
-        transport = self.transport
-        if transport is None or self.closing:
-            return
-        if len(buffer) >= LOOK_AHEAD_BYTES:
-            if transport.is_reading():
-                transport.pause_reading()
-        elif not self.eof and not transport.is_reading():  # (paused by a yield or the bound)
-            transport.resume_reading()
+        """Behind a reply that waits: act on a ``stop`` read ahead, and stop reading once
+        ``read_ahead.LOOK_AHEAD_BYTES`` wait (the lines run in their turn)."""
+        if not self.halted and self.scan.stop_in(self.framer):
+            self._stop_ahead()
+        if self.transport is not None and not self.closing:
+            pace_reading(self.transport, len(self.framer.buffer), self.eof)
 
     def _stop_ahead(self) -> None:
-        """A ``stop`` waits behind the reply: its plan stops now, through the session's
-        ``stop`` if one searches, and so do the plans sent before the ``stop``."""
-        session, worker = self.session, self.session.services.worker
         self.halted = True
-        if worker.planning(session):
-            braked = session.stop()
-            if not isinstance(braked, str):  # (the arm was moving: its rest is not awaited)
-                asyncio.ensure_future(braked).add_done_callback(_quiet)
-        worker.halt(session, STOPPED)
+        stop_plans(self.session)
 
     def _answered(self, pending: asyncio.Future[str]) -> None:
         if pending is not self.pending:
             return
         self.pending = None
-        if self.closing:
-            return
-        if pending.cancelled():
-            text = replies.SHUTTING_DOWN
-        elif isinstance(pending.exception(), C2rvizError):
-            text = replies.error(pending.exception())
-        elif pending.exception() is not None:
-            log.error("internal error from %s", self.peer, exc_info=pending.exception())
-            text = replies.error("internal error (see the server log)")
-        else:
-            text = pending.result()
-        self._write([text])
-        self._go_on()
+        if not self.closing:
+            self._write([waited_reply(pending, self.peer)])
+            self._go_on()
 
     def _yield(self, rest: Sequence[Line]) -> None:
         """Stop reading for a loop turn, so the other clients go first; then run ``rest``."""
@@ -338,7 +292,7 @@ class Connection(asyncio.Protocol):
     def _go_on(self) -> None:
         """Run the lines that waited, then what is buffered; resume reading when done."""
         backlog, self.backlog = self.backlog, []
-        self.scanned = 0
+        self.scan.reset()
         self._run(backlog)
         if self.closing or self.waiting:
             return
@@ -396,29 +350,13 @@ class Connection(asyncio.Protocol):
         self._close()
 
     def _close(self) -> None:
-        """Send what is queued, then close.
-
-        A socket closed with input still unread sends RST, and RST throws away
-        replies not yet delivered. So unless the client has finished sending, we
-        half-close (FIN after the replies) and read and drop its input until it
-        closes too, for at most ``_LINGER_S``.
-        """
+        """Send what is queued, then close without a reset (``tcp_rules.close_lingering``:
+        what the client still sends is dropped, as ``closing`` is set)."""
         self.closing = True
         self.framer.clear()
         self._cancel_timers()
-        transport = self.transport
-        if transport is None or transport.is_closing():
-            return
-        if self.eof:
-            transport.close()  # nothing more will come: nothing to linger for
-            return
-        try:
-            transport.write_eof()
-        except OSError:  # the client is already gone (ENOTCONN): nothing to deliver
-            transport.abort()
-            return
-        transport.resume_reading()
-        self.linger_timer = asyncio.get_running_loop().call_later(_LINGER_S, transport.abort)
+        if self.transport is not None:
+            self.linger_timer = close_lingering(self.transport, self.eof)
 
     def _cancel_timers(self) -> None:
         for timer in (self.yield_timer, self.partial_timer, self.linger_timer):
@@ -439,36 +377,7 @@ class Connection(asyncio.Protocol):
 
     def _unanswered(self, rest: Sequence[Line]) -> int:
         """How many of ``rest`` and the complete lines still buffered would get a reply."""
-        return sum(map(_is_command, chain(rest, self.framer.complete())))
+        return sum(map(is_command, chain(rest, self.framer.complete())))
 
 
-def _is_stop(line: Line) -> bool:
-    """True for a ``stop`` line."""
-    if not isinstance(line, str) or "stop" not in line.lower():
-        return False
-    try:
-        return isinstance(parse_line(line), Stop)
-    except C2rvizError:
-        return False
-
-
-def _quiet(future: asyncio.Future[str]) -> None:
-    """A reply nobody awaits: read its outcome (asyncio logs one never read)."""
-    if not future.cancelled():
-        future.exception()
-
-
-def _is_command(line: Line) -> bool:
-    """True for a line that would get a reply (not blank, not only a comment)."""
-    if not isinstance(line, str):
-        return True
-    try:
-        return parse_line(line) is not None
-    except C2rvizError:
-        return True
-
-
-TURN_S = 0.002  # work per client per loop turn [s]: then the others go first
-LOOK_AHEAD_BYTES = 16384  # read behind a reply that waits at most [bytes], then reading pauses
 _TURN_CHECK = 32  # lines between looks at the clock
-_LINGER_S = 2.0  # after the last reply, how long a closing client's input is read and dropped

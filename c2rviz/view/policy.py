@@ -11,12 +11,12 @@ reverse proxy's origin is added by the user. A host name that resolves to
 
 from __future__ import annotations
 
-import hmac
 from dataclasses import dataclass
-from urllib.parse import parse_qs, quote, urlsplit
+from urllib.parse import quote
 
 from ..errors import C2rvizError, shown
-from ..origins import LOOPBACK_HOSTS, normalize_origin
+from ..origins import LOOPBACK_HOSTS, normalize_origin, token_ok
+from ..protocol.limits import below_floor, default, default_s
 
 __all__ = ["LOOPBACK_HOSTS", "DoorPolicy", "DoorPolicyError", "normalize_origin"]
 
@@ -48,10 +48,10 @@ class DoorPolicy:
 
     extra_origins: tuple[str, ...] = ()
     token: str | None = None
-    max_clients: int = 16
-    max_frame_bytes: int = 64 * 1024
-    max_queued_frames: int = 8
-    log_interval_s: float = 60.0
+    max_clients: int = default("page", "max_clients")
+    max_frame_bytes: int = default("page", "max_frame_bytes")
+    max_queued_frames: int = default("page", "max_queued_frames")
+    log_interval_s: float = default_s("page", "log_interval_s")
 
     def __post_init__(self) -> None:
         for origin in self.extra_origins:
@@ -59,9 +59,10 @@ class DoorPolicy:
                 raise DoorPolicyError("origin", origin, "scheme://host[:port] (http or https)")
         if self.token is not None and not (self.token.isascii() and self.token.isprintable()):
             raise DoorPolicyError("token", self.token, "printable ASCII")
-        for name in ("max_clients", "max_frame_bytes", "max_queued_frames"):
-            if getattr(self, name) < 1:
-                raise DoorPolicyError(name.replace("_", " "), getattr(self, name), "at least 1")
+        low = below_floor("page", self)
+        if low is not None:
+            name, value, floor = low
+            raise DoorPolicyError(name.replace("_", " "), value, f"at least {floor}")
 
     def origins(self, host: str, port: int) -> list[str]:
         """The origins allowed for a viewer served on ``host`` reached at ``port``."""
@@ -79,10 +80,7 @@ class DoorPolicy:
 
     def token_ok(self, path: str) -> bool:
         """Whether the request target ``path`` carries the token (or none is needed)."""
-        if self.token is None:
-            return True
-        given = parse_qs(urlsplit(path).query, keep_blank_values=True).get("token", [])
-        return any(hmac.compare_digest(g.encode(), self.token.encode()) for g in given)
+        return token_ok(self.token, path)
 
     def page_url(self, base_url: str) -> str:
         """The URL to print for the page at ``base_url`` (``http://host:port``).

@@ -19,11 +19,12 @@ from typing import Final
 
 from lxml import etree
 
+from ...protocol.limits import default
 from .errors import CrclSyntaxError
 
 __all__ = ["MAX_DOCUMENT_BYTES", "parse_xml"]
 
-MAX_DOCUMENT_BYTES: Final = 1 << 20
+MAX_DOCUMENT_BYTES: Final = default("crcl", "max_document_bytes")
 """The largest document accepted [bytes] (1 MiB), the splitter's default limit too."""
 
 _FORBIDDEN = re.compile(rb"<!\s*(DOCTYPE|ENTITY)", re.IGNORECASE)

@@ -43,7 +43,7 @@ from .status import (
     PoseStatus,
     SettingsStatus,
 )
-from .units import angle_factor, length_factor, matrix_to_pose
+from .units import angle_factor, joint_factors, length_factor, matrix_to_pose
 
 _STATUS_PARTS = record_fields(CrclStatus)  # the status's elements, in the schema's order
 
@@ -107,8 +107,7 @@ class ConnectionSettings:
 
     def joint_factors(self, prismatic: tuple[bool, ...]) -> list[float]:
         """SI per CRCL unit for each joint (length for prismatic, angle for revolute)."""
-        length, angle = self.length, self.angle
-        return [length if p else angle for p in prismatic]
+        return joint_factors(prismatic, self.length_unit, self.angle_unit)
 
 
 def tidy(value: float) -> float:

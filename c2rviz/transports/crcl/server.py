@@ -18,11 +18,11 @@ status whose ``StateDescription`` says what was wrong):
 - what the stream cannot be re-synchronised after (a document over
   ``max_document_bytes``, binary bytes, a ``<!DOCTYPE`` or other markup declaration):
   that error, then the documented close (the server ends its side, reads and drops
-  what the client still sends for up to ``LINGER_S``, then closes);
+  what the client still sends for up to ``tcp_rules.LINGER_S``, then closes);
 - one connection over ``max_connections``: an error status, then the close;
 - statuses left unread past ``max_unread``: the connection is reset.
 
-A long run of documents in one read is worked through ``TURN_S`` at a time, so one
+A long run of documents in one read is worked through ``tcp_rules.TURN_S`` at a time, so one
 client's flood delays the others by no more than that; a document too large to parse
 in that time (over ``PARSE_ON_LOOP_BYTES``) is parsed on the door's one parsing
 thread (lxml lets go of the interpreter's lock while it parses), big documents of
@@ -38,23 +38,22 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Final
 
+from ...protocol.limits import default, default_s
 from ...session.services import Services
 from ...session.session import Session
+from ..tcp_rules import TURN_S, close_lingering
 from .actions import ACTIONS
 from .controller import Controller
 from .documents import CommandInstance, parse_instance
 from .errors import CrclError, CrclFramingError
 from .framing import DocumentSplitter
-from .hardened import MAX_DOCUMENT_BYTES
 
 __all__ = [
     "DEFAULT_PORT",
-    "LINGER_S",
     "PARSE_ON_LOOP_BYTES",
     "READ_BYTES",
     "REFUSALS_SUMMED_S",
     "SPLIT_BYTES",
-    "TURN_S",
     "CrclLimits",
     "CrclServer",
 ]
@@ -65,10 +64,6 @@ DEFAULT_PORT: Final = 64444
 """NIST's Java tools' port."""
 READ_BYTES: Final = 65536
 """Most bytes read at once from a client."""
-TURN_S: Final = 0.002
-"""Work per client per event-loop turn [s]: then the other clients go first."""
-LINGER_S: Final = 2.0
-"""After the close is decided, how long a client's input is read and dropped [s]."""
 REFUSALS_SUMMED_S: Final = 60.0
 """Refused connections after the first are logged as one count per this interval [s]."""
 SPLIT_BYTES: Final = 16384
@@ -85,7 +80,8 @@ INTERNAL_ERROR: Final = "internal error reading the document (see the server log
 
 @dataclass(frozen=True)
 class CrclLimits:
-    """What one CRCL client may cost (docs/limits.md).
+    """What one CRCL client may cost (docs/limits.md; the ``crcl`` rows of
+    ``session.limits.LIMITS``).
 
     Attributes:
         max_document_bytes: The largest document [bytes]; larger closes the connection.
@@ -94,10 +90,10 @@ class CrclLimits:
         max_unread: Statuses a client has not read [bytes]; more resets the connection.
     """
 
-    max_document_bytes: int = MAX_DOCUMENT_BYTES
-    stall_timeout_s: float = 10.0
-    max_connections: int = 16
-    max_unread: int = 1 << 20
+    max_document_bytes: int = default("crcl", "max_document_bytes")
+    stall_timeout_s: float = default_s("crcl", "stall_timeout_s")
+    max_connections: int = default("crcl", "max_connections")
+    max_unread: int = default("crcl", "max_unread")
 
 
 class CrclServer:
@@ -375,22 +371,21 @@ class _Connection:
         self.writer.transport.abort()  # the reads end (EOF): run and close return
 
     async def close(self) -> None:
-        """The documented close: statuses out, our side ended, the client's rest read and
-        dropped for up to ``LINGER_S`` (a reset would lose the last status), then closed."""
+        """The documented close (``tcp_rules.close_lingering``): statuses out, our side
+        ended, the client's rest read and dropped until it closes or the linger ends (a
+        reset would lose the last status), then closed."""
         self.controller.close()
         self.closing = True
-        writer = self.writer
-        if writer.transport.is_closing():
+        transport = self.writer.transport
+        assert isinstance(transport, asyncio.Transport)  # a TCP stream: it reads too
+        linger = close_lingering(transport, eof=False)
+        if linger is None:
             return
-        deadline = asyncio.get_running_loop().time() + LINGER_S
         try:
-            if writer.can_write_eof():
-                writer.write_eof()
-            while True:
-                left = deadline - asyncio.get_running_loop().time()
-                if left <= 0 or not await asyncio.wait_for(self.reader.read(READ_BYTES), left):
-                    break
-        except (asyncio.TimeoutError, ConnectionError, OSError):
+            while await self.reader.read(READ_BYTES):
+                pass  # dropped; the linger's end aborts the transport, and the read ends
+        except (ConnectionError, OSError):
             pass
         finally:
-            writer.close()
+            linger.cancel()
+            self.writer.close()

@@ -1,13 +1,13 @@
-"""CRCL's units to SI, and CRCL poses to rotation matrices and back (numpy only).
+"""CRCL's unit names, and CRCL poses to rotation matrices and back (numpy only).
 
 CRCL documents carry values in the units their connection has set; c2rviz computes
 in SI (meters, radians, newtons, newton-meters). Each factor here is how many SI units
-one CRCL unit is: ``value_si = value * LENGTH_FACTORS[unit]``.
+one CRCL unit is: ``value_si = value * LENGTH_FACTORS[unit]``, its size taken from the
+session's conversion layer (``session.units``), which the text port's degrees use too.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from typing import Final
 
@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from ...protocol.ranges import POSITION_M
+from ...session.units import DEGREE_RAD, FOOT_M, INCH_M, MILLIMETER_M, POUND_FORCE_N, joint_scale
 from .errors import CrclValueError
 from .primitives import Point, Pose, Vector
 
@@ -25,6 +26,7 @@ __all__ = [
     "TORQUE_FACTORS",
     "angle_factor",
     "force_factor",
+    "joint_factors",
     "length_factor",
     "matrix_to_pose",
     "pose_rotation",
@@ -32,22 +34,26 @@ __all__ = [
     "torque_factor",
 ]
 
-LENGTH_FACTORS: Final[Mapping[str, float]] = {"meter": 1.0, "millimeter": 1e-3, "inch": 0.0254}
-"""Meters per CRCL length unit (the inch is 25.4 mm exactly)."""
+LENGTH_FACTORS: Final[Mapping[str, float]] = {
+    "meter": 1.0,
+    "millimeter": MILLIMETER_M,
+    "inch": INCH_M,
+}
+"""Meters per CRCL length unit."""
 
-ANGLE_FACTORS: Final[Mapping[str, float]] = {"radian": 1.0, "degree": math.pi / 180.0}
+ANGLE_FACTORS: Final[Mapping[str, float]] = {"radian": 1.0, "degree": DEGREE_RAD}
 """Radians per CRCL angle unit."""
 
 FORCE_FACTORS: Final[Mapping[str, float]] = {
     "newton": 1.0,
-    "pound": 4.4482216152605,  # pound-force: 0.45359237 kg * 9.80665 m/s^2
-    "ounce": 4.4482216152605 / 16.0,
+    "pound": POUND_FORCE_N,  # pound-force
+    "ounce": POUND_FORCE_N / 16.0,
 }
 """Newtons per CRCL force unit."""
 
 TORQUE_FACTORS: Final[Mapping[str, float]] = {
     "newtonMeter": 1.0,
-    "footPound": 4.4482216152605 * 0.3048,
+    "footPound": POUND_FORCE_N * FOOT_M,
 }
 """Newton-meters per CRCL torque unit."""
 
@@ -77,6 +83,12 @@ def force_factor(unit: str) -> float:
 def torque_factor(unit: str) -> float:
     """Newton-meters per ``unit`` (``newtonMeter`` or ``footPound``)."""
     return _factor(TORQUE_FACTORS, unit, "torque")
+
+
+def joint_factors(prismatic: tuple[bool, ...], length_unit: str, angle_unit: str) -> list[float]:
+    """SI per CRCL unit for each joint (``length_unit`` for a prismatic joint, ``angle_unit``
+    for a revolute one), through the session's ``joint_scale``."""
+    return list(joint_scale(prismatic, angle_factor(angle_unit), length_factor(length_unit)))
 
 
 def pose_rotation(pose: Pose) -> NDArray[np.float64]:

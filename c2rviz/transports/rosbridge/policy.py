@@ -13,12 +13,11 @@ connection needs ``?token=<token>`` in its URL. A host name that resolves to
 
 from __future__ import annotations
 
-import hmac
 from dataclasses import dataclass
-from urllib.parse import parse_qs, urlsplit
 
 from ...errors import C2rvizError
-from ...origins import LOOPBACK_HOSTS, normalize_origin
+from ...origins import LOOPBACK_HOSTS, normalize_origin, token_ok
+from ...protocol.limits import below_floor, default
 
 __all__ = ["LOOPBACK_HOSTS", "PolicyError", "RosbridgePolicy", "normalize_origin"]
 
@@ -63,12 +62,12 @@ class RosbridgePolicy:
 
     extra_origins: tuple[str, ...] = ()
     token: str | None = None
-    max_frame_bytes: int = 1 << 20
-    max_connections: int = 32
-    max_subscriptions: int = 64
-    max_queue_length: int = 100
+    max_frame_bytes: int = default("rosbridge", "max_frame_bytes")
+    max_connections: int = default("rosbridge", "max_connections")
+    max_subscriptions: int = default("rosbridge", "max_subscriptions")
+    max_queue_length: int = default("rosbridge", "max_queue_length")
     compression: bool = False
-    max_read_ahead: int = 2
+    max_read_ahead: int = default("rosbridge", "max_read_ahead")
 
     def __post_init__(self) -> None:
         for origin in self.extra_origins:
@@ -78,11 +77,10 @@ class RosbridgePolicy:
             self.token and self.token.isascii() and self.token.isprintable()
         ):
             raise PolicyError("token", self.token, "non-empty printable ASCII")
-        for name in ("max_frame_bytes", "max_connections", "max_subscriptions", "max_read_ahead"):
-            if getattr(self, name) < 1:
-                raise PolicyError(name.replace("_", " "), getattr(self, name), "at least 1")
-        if self.max_queue_length < 0:
-            raise PolicyError("max queue length", self.max_queue_length, "at least 0")
+        low = below_floor("rosbridge", self)
+        if low is not None:
+            name, value, floor = low
+            raise PolicyError(name.replace("_", " "), value, f"at least {floor}")
 
     def origins(self) -> list[str]:
         """The allowed browser origins, for a refusal's message."""
@@ -104,7 +102,4 @@ class RosbridgePolicy:
 
     def token_ok(self, path: str) -> bool:
         """Whether the request target ``path`` carries the token (or none is needed)."""
-        if self.token is None:
-            return True
-        given = parse_qs(urlsplit(path).query, keep_blank_values=True).get("token", [])
-        return any(hmac.compare_digest(g.encode(), self.token.encode()) for g in given)
+        return token_ok(self.token, path)

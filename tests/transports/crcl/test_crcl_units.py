@@ -76,3 +76,32 @@ def test_matrix_round_trip(
     again = matrix_to_pose(matrix, unit)
     assert np.allclose(pose_to_matrix(again, unit), matrix, atol=1e-12)
     assert (again.point.x, again.point.y, again.point.z) == pytest.approx(xyz, abs=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("length_unit", "angle_unit", "expected"),
+    [
+        ("meter", "radian", [1.0, 1.0, 1.0]),
+        ("millimeter", "degree", [math.pi / 180, 0.001, math.pi / 180]),
+        ("inch", "radian", [1.0, 0.0254, 1.0]),
+    ],
+    ids=["si", "mm-deg", "inch-rad"],
+)
+def test_joint_factors_are_length_for_prismatic_and_angle_for_revolute(
+    length_unit: str, angle_unit: str, expected: list[float]
+) -> None:
+    from c2rviz.transports.crcl.units import joint_factors
+
+    assert joint_factors((False, True, False), length_unit, angle_unit) == expected
+
+
+def test_crcl_and_the_text_port_convert_through_one_layer() -> None:
+    """A revolute joint in degrees scales alike at both doors (``session.units``)."""
+    from support import load_robot
+
+    from c2rviz.session.units import UnitTable
+    from c2rviz.transports.crcl.units import joint_factors
+
+    robot = load_robot("motoman_sia20d")
+    table = UnitTable.build(robot, degrees=True)
+    assert list(table.scale) == joint_factors(robot.prismatic, "meter", "degree")
