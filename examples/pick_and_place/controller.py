@@ -19,8 +19,8 @@ It recovers, as a cell's controller must (docs/faults.md):
   it lets the part land, opens the fingers, finds the part with the camera where it fell,
   picks it again and carries it on;
 - **a protective stop**: a move refused by one waits ``STOP_WAIT_S`` (a UR cannot be
-  unlocked sooner), ``reset``s and is sent again; a stop that keeps coming back
-  (``RESETS`` times) and an emergency stop are left to a person: they raise;
+  unlocked sooner), ``reset``s and is sent again; a move still refused after
+  ``RESETS`` resets, and an emergency stop, are left to a person: they raise;
 - **a camera blackout**: a camera that does not see the part is read again every
   ``LOOK_AGAIN_S`` until it does, for at most ``LOOK_FOR_S``.
 
@@ -97,7 +97,7 @@ RESETS = 3
 SETTLE_S = 1.0
 """A dropped part has landed this long after the drop was noticed [s] (it falls at g)."""
 REGRASPS = 3
-"""At most this many drops of one part before the controller gives up."""
+"""A dropped part is picked again at most this many times: then the controller gives up."""
 
 
 def tool_at(part: Sequence[float], lift_m: float = 0.0) -> Pose:
@@ -113,6 +113,26 @@ def in_world(camera: Sequence[float], seen: Sequence[float]) -> tuple[float, ...
     x, y, z = turn.apply(seen[:3]) + camera[:3]
     roll, pitch, yaw = (turn * Rotation.from_euler("xyz", seen[3:])).as_euler("xyz")
     return (float(x), float(y), float(z), float(roll), float(pitch), float(yaw))
+
+
+def move(robot: Client, command: Callable[..., T], *args: object) -> T:
+    """``command(*args)`` (a move or ``grip``), waiting out protective stops: refused by
+    one, wait ``STOP_WAIT_S``, ``reset`` and send it again.
+
+    Raises:
+        CommandError: any other refusal (an emergency stop, a collision ahead), or still
+            refused after ``RESETS`` resets.
+    """
+    for _ in range(RESETS):
+        try:
+            return command(*args)
+        except CommandError as error:
+            if not error.message.startswith("protective stop"):
+                raise
+            log.warning("%s; reset in %g s", error.message, STOP_WAIT_S)
+            robot.sleep(STOP_WAIT_S)
+            robot.reset()
+    return command(*args)  # refused again: a person must see to it
 
 
 def set_up(robot: Client, parts: int = len(PARTS)) -> None:
@@ -133,28 +153,8 @@ def set_up(robot: Client, parts: int = len(PARTS)) -> None:
         if name not in there:
             robot.add_part(name, "box", (PART_M,) * 3, PARTS[name], kind="cube", color=(1, 0.5, 0))
         robot.goal(name, SLOTS[name])
-    robot.grip(1.0)
+    move(robot, robot.grip, 1.0)
     robot.guard(True)
-
-
-def move(robot: Client, command: Callable[..., T], *args: object) -> T:
-    """``command(*args)`` (a move or ``grip``), waiting out protective stops: refused by
-    one, wait ``STOP_WAIT_S``, ``reset`` and send it again.
-
-    Raises:
-        CommandError: any other refusal (an emergency stop, a collision ahead), or the
-            stop came back ``RESETS`` times.
-    """
-    for resets in range(RESETS + 1):
-        try:
-            return command(*args)
-        except CommandError as error:
-            if not error.message.startswith("protective stop") or resets == RESETS:
-                raise
-            log.warning("%s; reset in %g s", error.message, STOP_WAIT_S)
-            robot.sleep(STOP_WAIT_S)
-            robot.reset()
-    raise AssertionError("unreachable")
 
 
 def locate(robot: Client, name: str) -> tuple[float, ...]:

@@ -101,6 +101,16 @@ def test_a_protective_stop_is_waited_out_and_reset(c2rviz, c2rviz_server, caplog
     assert not any("dropped" in message for message in caplog.messages)
 
 
+@pytest.mark.c2rviz(faults=["protective"])  # the cell starts in a protective stop
+def test_a_cell_that_starts_stopped_is_reset_once_the_wait_is_over(c2rviz, caplog):
+    set_up(c2rviz, parts=1)
+    assert caplog.messages == [
+        f"protective stop since t=0.000 (reset to move again); reset in {STOP_WAIT_S:g} s"
+    ]
+    pick_and_place(c2rviz, parts=1)
+    assert_goals_met(c2rviz)
+
+
 def test_an_emergency_stop_is_left_to_a_person(c2rviz):
     set_up(c2rviz, parts=1)
     c2rviz.fault("estop", after=CARRY_S)
