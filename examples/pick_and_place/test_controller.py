@@ -15,6 +15,7 @@ import pytest
 from controller import (
     CAMERA,
     LOOK_FOR_S,
+    PART_M,
     PARTS,
     ROBOT,
     SLOTS,
@@ -67,6 +68,15 @@ def test_a_part_not_where_it_was_said_is_not_grasped(c2rviz):
     with pytest.raises(RuntimeError, match="p1 was not grasped"):
         pick(c2rviz, "p1")
     assert_part_at(c2rviz, "p1", PARTS["p1"])  # untouched, on the table
+
+
+def test_a_part_lying_turned_is_grasped_square_and_placed_straight(c2rviz):
+    set_up(c2rviz, parts=1)
+    turned = (*PARTS["p1"][:5], 0.4)  # turned 0.4 rad about the vertical: as a drop leaves it
+    c2rviz.remove_part("p1")
+    c2rviz.add_part("p1", "box", (PART_M,) * 3, turned)
+    pick_and_place(c2rviz, parts=1)  # the camera sees it turned: the fingers turn with it
+    assert_goals_met(c2rviz)
 
 
 def test_with_the_tray_raised_the_guard_refuses_to_sweep_the_part_through_it(c2rviz):
