@@ -22,7 +22,7 @@ KITTING = ROOT / "examples" / "crcl_kitting"
 
 
 @pytest.mark.timeout(600)
-@pytest.mark.parametrize(("example", "tests"), [(EXAMPLE, 5), (KITTING, 3)], ids=["pick", "crcl"])
+@pytest.mark.parametrize(("example", "tests"), [(EXAMPLE, 12), (KITTING, 3)], ids=["pick", "crcl"])
 def test_the_example_suite_passes(example, tests):
     done = subprocess.run(
         [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-q"],
