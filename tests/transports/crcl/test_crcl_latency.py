@@ -66,4 +66,6 @@ def test_jittered_statuses_keep_their_order(virtual: CrclServerThread, crcl_conn
     statuses = [client.status() for _ in ids]  # CrclClient checks StatusID increases
     numbers = [s.command_status.status_id for s in statuses]
     assert numbers == sorted(numbers) and len(set(numbers)) == len(ids)
-    assert 0.1 <= now(virtual) - start <= 0.4 + 1e-9
+    # At least the base latency; no upper bound: the door holds no clock, so virtual time
+    # may jump between two reads of the write, and the later documents run later.
+    assert now(virtual) - start >= 0.1
