@@ -21,22 +21,26 @@ from ..collision.workcell import WorkcellObject
 from ..protocol import replies
 from ..robot.frames import se3_pose
 from ..world.parts import Part, Parts
+from ..world.world import World
 
 __all__ = [
     "PartSignature",
     "csv_columns",
     "csv_poses",
+    "exact",
     "object_lines",
     "part_changes",
     "part_line",
     "signature",
+    "workcell_lines",
 ]
 
 PartSignature = dict[str, tuple[object, ...]]
 """What identifies each part in a recording (name to shape, size, type, colour)."""
 
 
-def _exact(values: Sequence[float]) -> str:
+def exact(values: Sequence[float]) -> str:
+    """Exact values (shortest round-trip form), comma-separated: a replay is the same."""
     return ",".join(repr(float(v)) for v in values)
 
 
@@ -48,17 +52,17 @@ def object_lines(objects: Sequence[WorkcellObject]) -> str:
             lines.append(f"# object {obj.name}: a mesh from the ini ({obj.mesh_path})\n")
             continue
         lines.append(
-            f"object {obj.name} {obj.shape} {_exact(obj.size)} {_exact(se3_pose(obj.placement))}\n"
+            f"object {obj.name} {obj.shape} {exact(obj.size)} {exact(se3_pose(obj.placement))}\n"
         )
     return "".join(lines)
 
 
 def part_line(part: Part, base: pin.SE3) -> str:
     """The command that adds ``part`` where it is, in the frame whose world pose is ``base``."""
-    pose = _exact(se3_pose(base.inverse() * part.pose))
+    pose = exact(se3_pose(base.inverse() * part.pose))
     kind = f" type={part.kind}" if part.kind else ""
-    colour = f" color={_exact(part.obj.rgba[:3])}"
-    return f"part {part.name} {part.obj.shape} {_exact(part.obj.size)} {pose}{kind}{colour}\n"
+    colour = f" color={exact(part.obj.rgba[:3])}"
+    return f"part {part.name} {part.obj.shape} {exact(part.obj.size)} {pose}{kind}{colour}\n"
 
 
 def signature(parts: Sequence[Part]) -> PartSignature:
@@ -71,6 +75,22 @@ def part_changes(before: PartSignature, parts: Sequence[Part], base: pin.SE3) ->
     lines = [f"part {name} remove\n" for name in before if before[name] != now.get(name)]
     lines += [part_line(p, base) for p in parts if before.get(p.name) != now[p.name]]
     return "".join(lines)
+
+
+def workcell_lines(world: World, robot: str) -> str:
+    """The objects, the parts and the gripper of ``robot`` at a recording's start, when
+    there are parts or objects (a recording of neither is as it was before parts)."""
+    model = world.contacts.models.get(robot)
+    objects = model.object_list() if model is not None else []
+    parts = world.parts.parts.all()
+    if not objects and not parts:
+        return ""
+    state = world.state(robot)
+    lines = object_lines(objects) + "part all remove\n"
+    lines += "".join(part_line(part, state.base) for part in parts)
+    if state.robot.gripper is not None:
+        lines += f"grip {state.opening!r}\n"
+    return lines
 
 
 def csv_columns(name: str) -> str:

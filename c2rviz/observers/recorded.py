@@ -8,7 +8,7 @@ from datetime import datetime
 from pathlib import Path
 from typing import Protocol
 
-__all__ = ["FrameSink", "Recorded"]
+__all__ = ["FrameSink", "Recorded", "header"]
 
 
 @dataclass(frozen=True)
@@ -49,3 +49,34 @@ class FrameSink(Protocol):
     def frame(self, robot: str, t_s: float, at: float, q: Sequence[float]) -> None:
         """Robot ``robot`` was at ``q`` [rad or m] at ``t_s`` [s from the recording's
         start, as the CSV says], clock time ``at`` [s]."""
+
+
+def header(
+    name: str,
+    robot: str,
+    started: datetime,
+    tally: tuple[float, int, float],
+    sources: tuple[tuple[str, ...], int],
+    early: str | None,
+) -> str:
+    """A command file's opening comments: recording ``name`` of the robot model ``robot``,
+    begun at ``started``; ``tally``: its length [s], frames and most frames a second;
+    ``sources``: who sent commands and how many more were not named; ``early``: why it
+    stopped early, if it did (the player checks ``# robot:``)."""
+    seconds, frames, hz = tally
+    named, more = sources
+    who = ", ".join(named) or "none"
+    if more:
+        who += f" and {more} more"
+    stopped = "" if early is None else f"# stopped early: {early}\n"
+    return (
+        f"# c2rviz recording {name}: play it back with c2rviz-play {name}.txt\n"
+        f"# robot: {robot}\n"
+        f"# recorded: {started.isoformat(timespec='seconds')}, "
+        f"{seconds:.3f} s, {frames} frames "
+        f"(at most {hz:g} a second)\n"
+        f"# sources: {who}\n"
+        f"# frames: {name}.csv (time [s], joints [rad or m], tool pose x,y,z [m] "
+        "roll,pitch,yaw [rad] in the base frame)\n"
+        f"{stopped}"
+    )

@@ -44,21 +44,22 @@ from ..protocol import replies
 from ..robot.frames import in_base, se3_pose, wxyz_se3
 from ..world.cameras import Camera
 from ..world.effects import Marker, Observer
-from ..world.faults import at_once, replay_line
 from ..world.parts import Part
 from ..world.world import World
 from .camera_records import CameraSignature, camera_changes, camera_signature
+from .record_faults import FaultLines, opening_lines
 from .record_files import RecordFiles, body_tally, cut_to_line, join_body
 from .record_parts import (
     PartSignature,
     csv_columns,
     csv_poses,
+    exact,
     object_lines,
     part_changes,
-    part_line,
     signature,
+    workcell_lines,
 )
-from .recorded import FrameSink, Recorded
+from .recorded import FrameSink, Recorded, header
 
 __all__ = ["BUFFER_BYTES", "FLUSH_S", "FrameSink", "Recorded", "Recorder"]
 
@@ -69,11 +70,6 @@ BUFFER_BYTES = 1 << 18
 FLUSH_S = 1.0
 """Files are flushed at most this often [s of the world's clock] (and at the end)."""
 _MAX_SOURCES = 100  # sources named in the header; the rest are counted
-
-
-def _numbers(values: Sequence[float]) -> str:
-    """Exact values (shortest round-trip form), comma-separated."""
-    return ",".join([repr(float(v)) for v in values])
 
 
 class Recorder(Observer):
@@ -129,7 +125,7 @@ class Recorder(Observer):
         self._pending: Sequence[float] | None = None  # the latest state, not yet written
         self._written_us = 0  # time of the last line of the command file [us from t0]
         self._flushed = self.t0
-        self._faults: list[str] = []  # fault lines waiting for the arm to rest (`on_fault`)
+        self._faults = FaultLines()  # lines waiting for the arm to rest, the last slip outcome
         self._rgb = (1.0, 0.0, 0.0)  # a replaying session's marker style
         self._shape = "sphere"
         self._body: TextIO = self.files.open_text(".txt.part", BUFFER_BYTES)
@@ -146,11 +142,14 @@ class Recorder(Observer):
         self._write(self._body, "radians\nmotion off\nclear\n")
         for marker in self.state.markers:
             self._mark(marker)
-        self._parts: PartSignature = {}
-        self._workcell(world)
+        self._write(self._body, workcell_lines(world, robot))
+        self._parts: PartSignature = signature(world.parts.parts.all())
         self._cameras: CameraSignature = {}
         self.on_cameras(world.cameras.all())
         self._frame(self.state.q, self.t0)
+        names = self.state.robot.joint_names
+        on = opening_lines(world.faults.of(robot), world.cameras.all(), self.t0, names)
+        self._write(self._body, "".join(f"{line}\n" for line in on))  # the faults on now
 
     @property
     def seconds(self) -> float:
@@ -170,7 +169,7 @@ class Recorder(Observer):
                 self._frame(q, t)
             else:
                 self._pending = q
-        if self._faults and not self.world.moving(robot):  # a stop's braking has ended
+        if self._faults.waiting and not self.world.moving(robot):  # a stop's braking ended
             self._write_faults()
 
     def on_marker(self, robot: str, marker: Marker) -> None:
@@ -183,18 +182,24 @@ class Recorder(Observer):
             self._catch_up(self.world.clock.now())
             # `clear` also homes the arm: put it back at once where it is (the home move,
             # if this clear came with one, follows as frames).
-            self._write(self._body, f"clear\njoints {_numbers(self.state.q)}\n")
+            self._write(self._body, f"clear\njoints {exact(self.state.q)}\n")
 
     def on_fault(self, robot: str, text: str) -> None:
         """A fault's line goes after the frames it caused: at once, or (a protective stop
         braking) once the arm rests, so a replay never refuses its own frames; a drop at
         once, mid-move too, so the replay drops the part where the run did."""
-        line = replay_line(text)
-        if robot != self.robot or self.closed or line is None:
-            return
-        self._faults.append(line)
-        if not self.world.moving(robot) or (self._faults == [line] and at_once(line)):
+        mine = robot == self.robot and not self.closed
+        if mine and self._faults.add(text, self.world.moving(robot)):
             self._write_faults()
+
+    def on_part_event(self, robot: str | None, text: str) -> None:
+        """A grasp that drew for a slip: its outcome goes before its ``grip`` line, so the
+        replay makes the same grasp (record_faults)."""
+        if robot == self.robot and not self.closed:
+            line = self._faults.outcome(self.world.faults.of(robot), text)
+            if line is not None:
+                self._arm_now(self.world.clock.now())
+                self._write(self._body, f"{line}\n")
 
     def _write_faults(self) -> None:
         now = self.world.clock.now()
@@ -202,8 +207,7 @@ class Recorder(Observer):
             pending, self._pending = self._pending, None
             self._frame(pending, now)
         self._sleep_to(now)
-        lines, self._faults = self._faults, []
-        self._write(self._body, "".join(f"{line}\n" for line in lines))
+        self._write(self._body, "".join(f"{line}\n" for line in self._faults.take()))
 
     def on_objects(self, robot: str, objects: Sequence[WorkcellObject]) -> None:
         if robot == self.robot and not self.closed:
@@ -229,26 +233,16 @@ class Recorder(Observer):
 
     def on_gripper(self, robot: str, opening: float, t: float) -> None:
         if robot == self.robot and not self.closed:
-            self._catch_up(t)
-            if self._pending is not None:  # the grasp rule needs the joints of now
-                pending, self._pending = self._pending, None
-                self._frame(pending, t)
+            self._arm_now(t)
             self._write(self._body, f"grip {opening!r}\n")
 
-    def _workcell(self, world: World) -> None:
-        """The objects, the parts and the gripper at the start, when there are parts or
-        objects (a recording of neither is as it was before parts)."""
-        model = world.contacts.models.get(self.robot)
-        objects = model.object_list() if model is not None else []
-        parts = world.parts.parts.all()
-        if not objects and not parts:
-            return
-        lines = object_lines(objects) + "part all remove\n"
-        lines += "".join(part_line(part, self.state.base) for part in parts)
-        if self.state.robot.gripper is not None:
-            lines += f"grip {self.state.opening!r}\n"
-        self._write(self._body, lines)
-        self._parts = signature(parts)
+    def _arm_now(self, t: float) -> None:
+        """The arm as it is at ``t`` (its pending state), for a line whose rule needs the
+        joints of now (the grasp rule)."""
+        self._catch_up(t)
+        if self._pending is not None:
+            pending, self._pending = self._pending, None
+            self._frame(pending, t)
 
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         if accepted and source not in self.sources:
@@ -282,7 +276,7 @@ class Recorder(Observer):
         us = self._sleep_to(t)
         self._due = t + self.period_s
         pose = replies.numbers(se3_pose(self.state.robot.ee_pose(q) * self.state.tool))
-        self._write(self._body, f"joints {_numbers(q)}\n")  # exact: a replay is the same
+        self._write(self._body, f"joints {exact(q)}\n")  # exact: a replay is the same
         poses = csv_poses(self.world.parts.parts, self._csv_parts, self.state.base)
         self._write(self._rows, f"{us / 1e6:.6f},{replies.numbers(q)},{pose}{poses}\n")
         self.frames += 1
@@ -300,12 +294,12 @@ class Recorder(Observer):
         lines = []
         if marker.rgb != self._rgb:
             self._rgb = marker.rgb
-            lines.append(f"color {_numbers(marker.rgb)}\n")
+            lines.append(f"color {exact(marker.rgb)}\n")
         if marker.shape != self._shape:
             self._shape = marker.shape
             lines.append(f"marker {marker.shape}\n")
         pose = se3_pose(in_base(self.state.base, wxyz_se3(marker.position, marker.wxyz)))
-        lines.append(f"mark {_numbers(pose)}\n")
+        lines.append(f"mark {exact(pose)}\n")
         self._write(self._body, "".join(lines))
 
     def _write(self, file: TextIO, text: str) -> None:
@@ -395,20 +389,8 @@ class Recorder(Observer):
         self.part.unlink()
 
     def header(self) -> str:
-        sources = ", ".join(self.sources) or "none"
-        if self.more_sources:
-            sources += f" and {self.more_sources} more"
-        robot = self.state.robot.name
+        """NAME.txt's opening comments (``recorded.header``)."""
+        tally = (self._written_us / 1e6, self.frames, 1 / self.period_s)
+        sources = (tuple(self.sources), self.more_sources)
         why = self.error or self.early
-        early = "" if why is None else f"# stopped early: {why}\n"
-        return (
-            f"# c2rviz recording {self.name}: play it back with c2rviz-play {self.name}.txt\n"
-            f"# robot: {robot}\n"
-            f"# recorded: {self.started.isoformat(timespec='seconds')}, "
-            f"{self._written_us / 1e6:.3f} s, {self.frames} frames "
-            f"(at most {1 / self.period_s:g} a second)\n"
-            f"# sources: {sources}\n"
-            f"# frames: {self.name}.csv (time [s], joints [rad or m], tool pose x,y,z [m] "
-            "roll,pitch,yaw [rad] in the base frame)\n"
-            f"{early}"
-        )
+        return header(self.name, self.state.robot.name, self.started, tally, sources, why)

@@ -7,14 +7,15 @@ is refused (the page's last error, a guarded target in red), and
 ``World.replied`` with the session's reply text once it is known (recordings
 keep it). A ``Said`` is one command as its door shows it (a text line,
 ``/joint_command joint_s=0.5``, ``MoveToType (CommandID 3)``); each of the three
-is told at most once.
+is told at most once. A line's reply, ``ok`` or error, passes ``late`` here too: a
+latency fault delays them alike (docs/faults.md).
 """
 
 from __future__ import annotations
 
 import asyncio
 from collections.abc import Callable, Sequence
-from typing import Protocol
+from typing import Protocol, overload
 
 from ..errors import C2rvizError, MotionInterrupted
 from ..protocol import replies
@@ -23,7 +24,7 @@ from ..protocol.registry import Reply
 from ..world.state import RobotState
 from ..world.world import World
 
-__all__ = ["INTERNAL", "Said", "recorded", "taken", "taken_all"]
+__all__ = ["INTERNAL", "Said", "late", "recorded", "refused", "taken", "taken_all"]
 
 
 class Session(Protocol):
@@ -32,6 +33,7 @@ class Session(Protocol):
     world: World
     source: str
     state: RobotState
+    hangup: str | None
 
 
 INTERNAL = replies.error("internal error (see the server log)")
@@ -133,7 +135,10 @@ def taken_all(session: Session, texts: Sequence[str], reply: str) -> None:
 
 def taken(session: Session, text: str, reply: Reply) -> Reply:
     """``text`` was taken and ``reply`` is its reply: ``Said(...).accept()`` then
-    ``follow(reply)``, without the record for a reply at once (the hot path)."""
+    ``follow(reply)``, without the record for a reply at once (the hot path). With a
+    latency fault on the session's robot the reply comes late (``late``)."""
+    if session.world.faults.late:
+        reply = late(session, reply)
     if isinstance(reply, str):
         world, source = session.world, session.source
         world.note(source, text, True)
@@ -142,3 +147,32 @@ def taken(session: Session, text: str, reply: Reply) -> Reply:
     said = Said(session, text)
     said.accept()
     return said.follow(reply)
+
+
+def refused(session: Session, text: str, error: C2rvizError) -> Reply:
+    """``text`` was refused with ``error``: the world hears it now; the error is raised, or,
+    with a latency fault on the session's robot, handed back as a reply that raises it late.
+
+    Raises:
+        C2rvizError: ``error``, unless it comes late.
+    """
+    Said(session, text).refuse(error)
+    if session.world.faults.late and not isinstance(error, ForeignProtocol):
+        answer = late(session, error)
+        if not isinstance(answer, C2rvizError):
+            return answer
+    raise error
+
+
+@overload
+def late(session: Session, reply: Reply) -> Reply: ...
+@overload
+def late(session: Session, reply: C2rvizError) -> Reply | C2rvizError: ...
+def late(session: Session, reply: Reply | C2rvizError) -> Reply | C2rvizError:
+    """``reply`` to ``session``'s client as its robot's latency fault makes it: the one place
+    every reply of a line passes, ``ok`` or error, at once or waited for (the text port's,
+    rosbridge's command lines'). ``bye`` and ``quit`` are not delayed: the door closes
+    after them."""
+    if session.hangup is not None:
+        return reply
+    return session.world.faults.delayed(session.state.name, reply)

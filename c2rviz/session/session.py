@@ -33,7 +33,7 @@ from ..world.moves import Travel
 from ..world.state import RobotState
 from . import calls
 from .guarded import guarded_go
-from .notes import Said, recorded, taken, taken_all
+from .notes import Said, recorded, refused, taken, taken_all
 from .services import Services
 from .settings import Modes
 from .units import UnitEdge, UnitTable
@@ -138,7 +138,8 @@ class Session(UnitEdge, Modes):
     def run(self, line: str) -> Reply | None:
         """Parse and run one line (None for a blank or comment line), telling the world of it
         (``notes.Said``): taken or refused, and its reply once known (a reply that waits is
-        handed back as a future that tells it when it comes).
+        handed back as a future that tells it when it comes). A latency fault delays the
+        reply, an error too (``notes.late``: handed back as an awaitable that raises it).
 
         Raises:
             C2rvizError: the line is refused (nothing changed); the world was told.
@@ -149,12 +150,9 @@ class Session(UnitEdge, Modes):
                 return None
             self.listens = False
             reply = HANDLERS[command.__class__](self, command)
-            if self.world.faults.late and self.hangup is None:  # latency: the reply comes late
-                reply = self.world.faults.delayed(self.state.name, reply)
         except C2rvizError as exc:
             self.listens = False
-            Said(self, line).refuse(exc)
-            raise
+            return refused(self, line, exc)
         return taken(self, line, reply)
 
     def set_joints_batch(self, lines: Sequence[object], start: int) -> int:

@@ -3,10 +3,12 @@
 ``FaultRules`` belongs to the ``World`` (``world.faults``), so every door meets a fault
 alike: a move from any door reaches ``World.set_q`` or ``Travels.go``/``play``, which ask
 ``refuse``; a moving arm's samples pass through ``follow`` and its arrival through
-``arrival_error``. What a door reports of the joints passes through ``sensed``, and a
-session's replies through ``delayed``. A fault that begins, ends or is lifted is told
-to every observer (``Observer.on_fault``: ``watch`` streams, rosbridge's
-``/diagnostics``, the page) and listener (the TCP door, for ``disconnect``). A ``drop``
+``arrival_error``. What a door reports of the joints passes through ``sensed``; a
+session's replies pass through ``delayed`` (ok and error alike: ``session/notes``) and a
+CRCL connection's statuses through ``late_sends`` (``latency.py`` makes them wait on the
+clock). A fault that begins, ends or is lifted is told to every observer
+(``Observer.on_fault``: ``watch`` streams, rosbridge's ``/diagnostics``, the page) and
+listener (the text and CRCL doors and rosbridge's bridge, for ``disconnect``). A ``drop``
 releases what the robot holds through the world's parts (``WorldParts.release``), and
 the parts ask ``slips`` before each grasp the rule would make.
 
@@ -15,11 +17,10 @@ Scheduled faults are timers on the world's clock, so virtual time runs them exac
 
 from __future__ import annotations
 
-import asyncio
 import itertools
 import math
 from collections.abc import Awaitable, Callable, Mapping
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
@@ -27,6 +28,7 @@ from ..errors import BadArguments, C2rvizError, shown
 from ..protocol.registry import usage
 from .clock import Clock, Timer
 from .faults import Fault, RobotFaults, Scheduled
+from .latency import LateSends, late
 from .move_rules import MoveRules
 from .moves import Travels
 from .state import RobotState
@@ -37,6 +39,8 @@ if TYPE_CHECKING:
 
 __all__ = ["FaultRules"]
 
+T = TypeVar("T")
+
 
 class FaultRules(MoveRules):
     """Every robot's faults, applied to one world. Used from the asyncio thread only.
@@ -45,7 +49,7 @@ class FaultRules(MoveRules):
         origin: Clock time [s] that fault times count from (the server's start: the
             ``watch`` stream's origin, once the services bind it).
         rng: The noise and jitter draws (the services give a child of ``--seed``'s).
-        late: Some robot has a latency fault (``Session.run`` looks before anything else).
+        late: Some robot has a latency fault (``session/notes`` looks before anything else).
     """
 
     def __init__(
@@ -121,17 +125,25 @@ class FaultRules(MoveRules):
         faults = self.robots[robot]
         return faults.slips(self.rng) if faults.active else False
 
-    def delayed(self, robot: str, reply: str | Awaitable[str]) -> str | Awaitable[str]:
-        """``reply`` to a client of ``robot``, late by its latency fault (if on)."""
-        delay = self.robots[robot].delay_s(self.rng)
-        if delay <= 0.0:
-            return reply
-        clock = self.clock
-        if isinstance(reply, str):
-            future: asyncio.Future[str] = clock.future()  # its client waits on the clock
-            clock.call_later(delay, _settle, future, reply)
-            return future
-        return _later(reply, delay, clock)
+    def reply_delay(self, robot: str) -> float:
+        """How late the reply made now to a client of ``robot`` comes [s] (0: no latency
+        fault; a jitter is drawn per reply)."""
+        return self.robots[robot].delay_s(self.rng)
+
+    def delayed(
+        self, robot: str, reply: str | Awaitable[str] | C2rvizError
+    ) -> str | Awaitable[str] | C2rvizError:
+        """``reply`` to a client of ``robot`` (its text, an awaitable of it, or the error it
+        is refused with) as it is, or, with a latency fault on, an awaitable that gives the
+        text or raises the error that much later on the world's clock (a reply that waits:
+        that much after it comes, ``ok`` or error alike)."""
+        delay = self.reply_delay(robot)
+        return reply if delay <= 0.0 else late(reply, delay, self.clock)
+
+    def late_sends(self, robot: Callable[[], str], send: Callable[[T], None]) -> LateSends[T]:
+        """``send`` for a door that sends unasked (CRCL statuses), each message late by the
+        latency fault of ``robot()`` (its client's robot when it is made), in order."""
+        return LateSends(send, lambda: self.reply_delay(robot()), self.clock)
 
     # What the verbs do.
 
@@ -264,16 +276,3 @@ class FaultRules(MoveRules):
             self.tell(robot, text)
             for listener in list(self.listeners):
                 listener(robot, text)
-
-
-def _settle(future: asyncio.Future[str], reply: str) -> None:
-    if not future.done():
-        future.set_result(reply)
-
-
-async def _later(reply: Awaitable[str], delay: float, clock: Clock) -> str:
-    """``reply`` once it comes, ``delay`` [s] later on ``clock``."""
-    text = await reply
-    future: asyncio.Future[str] = clock.future()
-    clock.call_later(delay, _settle, future, text)
-    return await future

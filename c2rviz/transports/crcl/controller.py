@@ -26,7 +26,8 @@ does; motions are ``motions``' jobs). The rules:
 - **The world** hears of every command through the session (``Session.said``): taken
   or refused, and how it ended (``ok`` and its StateDescription, or the error).
 - **Faults**: while a stop holds the robot (``fault estop``, ``fault protective``,
-  docs/faults.md) every status is ``CRCL_Error`` with the stop as its description.
+  docs/faults.md) every status is ``CRCL_Error`` with the stop as its description; a
+  ``fault latency`` sends every status that much late, in order.
 
 Values in and out are in the connection's units; the session sees SI, its angles in
 the connection's angle unit (so its limit errors speak it).
@@ -135,7 +136,8 @@ class Controller:
         """An EndCanon came (so a command now is "after EndCanon")."""
         self.latest = Report(0, "no command yet", READY)
         self.lanes: dict[str, Job] = {}
-        self._send = send
+        self._send = session.world.faults.late_sends(lambda: session.state.name, send)
+        """Statuses go out through it: late by a latency fault, in order (docs/faults.md)."""
         self._actions = actions
         self._status_id = 0
         self._closed = False
@@ -296,7 +298,7 @@ class Controller:
         if self._closed:
             return
         try:
-            self._send(self.parts.write(self.status(report, full)))
+            self._send.send(self.parts.write(self.status(report, full)))
         except C2rvizError:  # a value a status cannot carry (a bug): say it in the log
             log.exception("cannot write a status for %s", report.what)
 
@@ -345,6 +347,7 @@ class Controller:
         """The connection ended: nothing more is sent; commands not yet moving are dropped
         (a motion under way goes on to its target, as a text client's does)."""
         self._closed = True
+        self._send.close()
         for job in self.lanes.values():
             if job.task is not None and not job.task.done():
                 job.task.cancel()

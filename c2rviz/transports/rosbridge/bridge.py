@@ -48,6 +48,11 @@ class Bridge(Protocol):
         """The client ``source`` is gone (its subscriptions are already stopped)."""
         ...
 
+    def hang_up_with(self, hang_up: Callable[[str], None]) -> None:
+        """From now on ``hang_up(source)`` closes the client ``source``'s connection (it may
+        connect again): the bridge calls it when a client must go (``fault disconnect``)."""
+        ...
+
     def subscribe(self, topic: str, deliver: Deliver) -> object:
         """Start calling ``deliver(msg)`` for each message of ``topic``; return a handle.
 

@@ -20,6 +20,7 @@ from typing import Any, Protocol
 
 from websockets.asyncio.server import ServerConnection
 from websockets.exceptions import ConnectionClosed
+from websockets.frames import CloseCode
 
 from ...errors import C2rvizError
 from . import messages, protocol, rosapi
@@ -79,6 +80,7 @@ class Connection:
         self.advertised: dict[str, str] = {}
         self.stopping = False
         self._serving: asyncio.Future[None] | None = None
+        self._hanging_up: asyncio.Future[None] | None = None
 
     async def run(self) -> None:
         """Serve the connection's frames in order until it closes or the server stops.
@@ -116,6 +118,21 @@ class Connection:
         self.stopping = True
         if self._serving is not None:
             self._serving.cancel()
+
+    def hang_up(self) -> None:
+        """Cut this client off (``fault disconnect``): read no more, and close with code 1012
+        (service restart: it may connect again) on the loop's next turn. By then the answer
+        to the request that cut it off is out; a request still waiting (a service call on a
+        move, a reply a latency delays) is given up, as the text port gives it up."""
+        if not self.stopping:
+            self.stopping = True
+            asyncio.get_running_loop().call_soon(self._hung_up)
+
+    def _hung_up(self) -> None:
+        if self._serving is not None and not self._serving.done():
+            self._serving.cancel()
+        close = self.websocket.close(CloseCode.SERVICE_RESTART, "fault disconnect")
+        self._hanging_up = asyncio.ensure_future(close)
 
     async def handle(self, frame: str | bytes) -> None:
         """Serve one frame; any error becomes a status (and a failed service_response)."""

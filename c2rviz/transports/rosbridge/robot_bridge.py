@@ -23,7 +23,8 @@ the text language; its reply on ``[NS]/c2rviz/reply``), the service
 (``sensor_msgs/msg/JointState``) and ``[NS]/joint_trajectory``
 (``trajectory_msgs/msg/JointTrajectory``), see ``joint_inputs``. Each client
 is a source of commands (``rosbridge HOST:PORT``) with a ``Session`` per robot
-(``command_lines``). The parameter ``robot_description`` is the (first)
+(``command_lines``): it is bound to the robots it has one on, and ``fault disconnect``
+on one of them closes its connection. The parameter ``robot_description`` is the (first)
 robot's URDF; in a cell ``NS/robot_description`` is each robot's too.
 """
 
@@ -103,6 +104,8 @@ class RobotBridge:
             for topics in self.robots.values():
                 self._params[f"{topics.namespace}/robot_description"] = topics.robot.source.xml
         self._clients = 0
+        self._hang_up: Callable[[str], None] = lambda source: None
+        world.faults.listeners.append(self._fault)
         world.add_observers([self.feed])
         frame = first.marker_frame  # the cameras hang where the parts do (world_feed._tf)
         to_frame = pin.SE3.Identity() if frame == WORLD_FRAME else world.state(names[0]).origin
@@ -111,6 +114,8 @@ class RobotBridge:
 
     def close(self) -> None:
         """The door stops: no more messages, every session dropped."""
+        if self._fault in self.world.faults.listeners:
+            self.world.faults.listeners.remove(self._fault)
         if self.feed in self.world.observers:
             self.world.remove_observer(self.feed)
         self.feed.close()
@@ -143,6 +148,17 @@ class RobotBridge:
         self.lines.closed(source)
         self._clients = max(0, self._clients - 1)
         self.shared.count_clients(DOOR, self._clients)
+
+    def hang_up_with(self, hang_up: Callable[[str], None]) -> None:
+        self._hang_up = hang_up
+
+    def _fault(self, robot: str, text: str) -> None:
+        """``fault disconnect`` on ``robot``: the clients bound to it go (those with a session
+        on it now: they sent it a command line, a service call or a joint input)."""
+        if text == "fault disconnect":
+            bound = {s for (s, _), q in self.lines.queues.items() if q.session.state.name == robot}
+            for source in sorted(bound):
+                self._hang_up(source)
 
     # What c2rviz publishes.
 

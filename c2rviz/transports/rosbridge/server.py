@@ -91,6 +91,7 @@ class RosbridgeServer:
         self.decoding: Executor | None = None
         """The thread large frames are decoded on (``connection.DECODE_ON_LOOP_BYTES``),
         one for every client, in the order they came; while the server runs."""
+        bridge.hang_up_with(self.hang_up)
 
     async def start(self, host: str = "127.0.0.1", port: int = 9090) -> tuple[str, int]:
         """Listen on ``host:port`` (0: any free port); return the address bound."""
@@ -136,6 +137,12 @@ class RosbridgeServer:
 
     async def __aexit__(self, *exc: object) -> None:
         await self.stop()
+
+    def hang_up(self, source: str) -> None:
+        """Close the client ``source``'s connection (``Connection.hang_up``); none: nothing."""
+        for connection in list(self._connections):
+            if connection.source == source:
+                connection.hang_up()
 
     @property
     def connections(self) -> int:

@@ -71,6 +71,9 @@ class CounterBridge:
     def closed(self, source: str) -> None:
         self.sources.put(("closed", source))
 
+    def hang_up_with(self, hang_up: Callable[[str], None]) -> None:
+        self.hang_up = hang_up
+
     def subscribe(self, topic: str, deliver: Callable[[dict[str, Any]], None]) -> object:
         if topic not in ("/counter", "/latched"):
             raise C2rvizError(f"{topic} is not published here")

@@ -30,6 +30,7 @@ from c2rviz.robot.model import Robot
 from c2rviz.session import Services
 from c2rviz.transports.rosbridge import COMMAND_SERVICE_TYPE
 from c2rviz.transports.tcp_server import CommandServer
+from c2rviz.world.clock import Clock
 from c2rviz.world.effects import Observer
 from c2rviz.world.world import World
 
@@ -122,7 +123,9 @@ class WorldServer:
         cell: bool = False,
         origins: Mapping[str, pin.SE3] | None = None,
         settings: Settings | None = None,
+        clock: Clock | None = None,
     ) -> None:
+        self.clock = clock
         self.loop = asyncio.new_event_loop()
         self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
         self.thread.start()
@@ -133,7 +136,7 @@ class WorldServer:
     async def _start(
         self, robots: Mapping[str, Robot], origins: Mapping[str, pin.SE3] | None
     ) -> None:
-        self.world = World(dict(robots), origins=origins)
+        self.world = World(dict(robots), origins=origins, clock=self.clock)
         self.notes = Notes(self.world)
         self.world.add_observers([self.notes])
         self.services = Services(self.world)
