@@ -50,7 +50,7 @@ def test_the_joint_chart_is_in_view_at_1400_by_900(
             shown = settled and box["viewTop"] <= box["top"] and box["bottom"] <= box["viewBottom"]
             return shown and box["scrollTop"] == 0 and box["windowHeight"] == 900, box
 
-        box = wait_until(in_view, "the joint chart laid out in view, the panel not scrolled")
+        wait_until(in_view, "the joint chart laid out in view, the panel not scrolled")
         ARTIFACTS.mkdir(exist_ok=True)
         page.screenshot(path=str(ARTIFACTS / f"layout-1400x900-{robot}.png"))
     finally:

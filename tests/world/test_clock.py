@@ -49,19 +49,28 @@ def test_bad_clock_forms_name_the_valid_ones(text):
 
 
 def test_scaled_time_runs_faster():
+    """50 x: the clock's span is fifty times the wall's, read just inside and just outside
+    it, whatever the machine's load; and its timers fire on the clock."""
     clock = ScaledClock(50.0)
-    start_real, start = time.monotonic(), clock.now()
+    outer_start = time.monotonic()
+    start = clock.now()
+    inner_start = time.monotonic()
 
-    async def sleep_one_clock_second() -> float:
+    async def sleep_one_clock_second() -> tuple[float, float, float]:
         loop = asyncio.get_running_loop()
         done = loop.create_future()
         clock.call_later(1.0, done.set_result, None)
         await done
-        return clock.now() - start
+        return time.monotonic(), clock.now(), time.monotonic()
 
-    clock_s = asyncio.run(sleep_one_clock_second())
+    inner_end, end, outer_end = asyncio.run(sleep_one_clock_second())
+    clock_s = end - start
     assert clock_s >= 1.0 - 1e-6
-    assert time.monotonic() - start_real < 1.0  # 1 s of the clock is 20 ms of real time
+    assert (
+        50.0 * (inner_end - inner_start) - 1e-6
+        <= clock_s
+        <= 50.0 * (outer_end - outer_start) + 1e-6
+    )
 
 
 def test_real_and_scaled_clocks_hold_nothing():
@@ -82,11 +91,9 @@ def test_virtual_time_jumps_through_timers_in_order():
         clock.call_at(3600.0, done.set_result, None)
         await done
 
-    start = time.monotonic()
-    asyncio.run(main())
+    asyncio.run(main())  # an hour of the clock, which on the real one outlasts the time limit
     assert fired == [("a", 10.0), ("b", 10.0), ("c", 30.0)]
-    assert clock.now() == 3600.0
-    assert time.monotonic() - start < 30  # an hour of the clock in no time at all
+    assert clock.now() == 3600.0  # how fast: benchmarks/testing_bench.py
 
 
 def test_a_hold_stops_time_until_released():
