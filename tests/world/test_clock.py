@@ -204,3 +204,34 @@ def test_a_timed_future_outside_any_hold_is_a_plain_one_and_cancelling_one_ends_
         return type(plain) is asyncio.Future and released == 0, clock.busy_count
 
     assert asyncio.run(main()) == (True, 1)
+
+
+LATE_S = 0.01
+"""How late every timer of ``LateClock`` fires [s]: a busy machine's loop, within the
+session's cadence window (``session._CADENCE_S``, 20 ms)."""
+
+
+class LateClock(VirtualClock):
+    """Virtual time whose every timer fires ``LATE_S`` late, as a busy machine's loop does:
+    lateness made exact, so what it adds up to is a fact, not a figure of the wall."""
+
+    def call_at(self, when, fn, *args):  # type: ignore[no-untyped-def]
+        return super().call_at(when + LATE_S, fn, *args)
+
+
+def test_consecutive_sleeps_keep_the_cadence_when_timers_fire_late():
+    """A played script's sleeps, each timer late: the lateness does not add up (a replay
+    of a recording keeps its cadence: tests/observers/test_record.py plays one)."""
+    clock = LateClock()
+    server = ServerThread(load_robot(), ServerLimits(), clock=clock).start()
+    client = Client(server.host, server.port)
+    try:
+        start = server.call(clock.now)
+        client.send("sleep 0.1\n" * 20)
+        assert [client.read_line() for _ in range(20)] == ["ok"] * 20
+        # One timer's lateness at the end, not twenty (2.2 s if each sleep counted from
+        # its late start).
+        assert server.call(clock.now) - start == pytest.approx(2.0 + LATE_S, abs=1e-9)
+    finally:
+        client.close()
+        server.stop()
