@@ -16,7 +16,8 @@ this process with plain sockets. Rows (issue 23, items 2 and 6; issue 28):
   path a box blocks (the planner's own timings: ``planning_bench.py``).
 
 Figures only, beside their goals; nothing passes or fails on time.
-Run: ``python benchmarks/guard_bench.py`` (``--quick``: shorter runs).
+Run: ``python benchmarks/guard_bench.py`` (``--quick``: shorter runs; ``--smoke``: every
+row on the least work, the test suite's run).
 """
 
 from __future__ import annotations
@@ -188,10 +189,12 @@ def plan_round_trips(address: tuple[str, int], count: int) -> list[float]:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="shorter runs")
+    parser.add_argument("--smoke", action="store_true", help="every row, the least work")
     parser.add_argument("--seconds", type=float, default=10.0, help="each bystander run [s]")
     parser.add_argument("--clients", type=int, default=10, help="clients looping")
     args = parser.parse_args(argv)
-    seconds = 1.5 if args.quick else args.seconds
+    seconds = 0.3 if args.smoke else 1.5 if args.quick else args.seconds
+    clients = args.clients
     print(machine())
     proc: Launched = launch([sys.executable, "-m", "c2rviz", "--port", "0", "--no-viewer"], False)
     rows: list[tuple[str, str, str, str]] = []
@@ -200,10 +203,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         setup = Line(address)
         fill_cell(setup, 100)
         setup.close()
-        rand = bystander(address, "rand", ("guard on",), args.clients, seconds)
-        joints = bystander(address, "j 0.3,0.2,0,0.4,0,0.2,0", ("guard on",), args.clients, seconds)
+        rand = bystander(address, "rand", ("guard on",), clients, seconds)
+        joints = bystander(address, "j 0.3,0.2,0,0.4,0,0.2,0", ("guard on",), clients, seconds)
         for name, figures in (("guarded `rand`", rand), ("guarded `joints`", joints)):
-            label = f"bystander `where` while {args.clients} clients loop {name}, 100 objects"
+            label = f"bystander `where` while {clients} clients loop {name}, 100 objects"
             rows.append((f"{label} p50", f"{figures['p50']:.2f}", "ms", ""))
             rows.append((f"{label} p99", f"{figures['p99']:.2f}", "ms", f"<= {GOAL_P99_MS:g} ms"))
             rows.append((f"{label} max", f"{figures['max']:.2f}", "ms", ""))
@@ -220,7 +223,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                     f"was {before:g} s",
                 )
             )
-        plans = plan_round_trips(address, 3 if args.quick else 30)
+        plans = plan_round_trips(address, 2 if args.smoke else 3 if args.quick else 30)
         if plans:
             rows.append(
                 (

@@ -7,7 +7,8 @@ Then runs it with pytest-xdist, ``python -m pytest -n 1`` and ``-n 2`` (alternat
 best of ``--repeat`` runs each), and prints the wall time of each and their ratio beside
 the goal (2 workers >= 1.6x as fast as 1). Figures only: nothing here passes or fails.
 
-Run: ``python benchmarks/plugin_xdist.py`` (``--quick``: 4 tests, one run each).
+Run: ``python benchmarks/plugin_xdist.py`` (``--quick``: 4 tests, one run each;
+``--smoke``: 2 tests, one a worker, one run each: the test suite's run).
 """
 
 from __future__ import annotations
@@ -76,8 +77,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--repeat", type=int, default=2, help="runs per worker count")
     parser.add_argument("--speed", type=int, default=100, help="the moves' speed [%%]")
     parser.add_argument("--quick", action="store_true", help="4 tests, one run each")
+    parser.add_argument("--smoke", action="store_true", help="2 tests, one run each")
     args = parser.parse_args(argv)
-    tests, repeat = (4, 1) if args.quick else (args.tests, args.repeat)
+    tests, repeat = (2, 1) if args.smoke else (4, 1) if args.quick else (args.tests, args.repeat)
     print(machine())
     with tempfile.TemporaryDirectory(prefix="c2rviz-plugin-xdist-") as folder:
         write_suite(Path(folder), tests, args.speed)

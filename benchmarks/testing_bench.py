@@ -15,7 +15,8 @@
    simulated minute.
 
 Run: ``python benchmarks/testing_bench.py`` (``--quick``: fewer calls, 10 simulated
-seconds scaled to a minute). Servers on one CPU, clients on the other (when there are two).
+seconds scaled to a minute; ``--smoke``: every row on the least work, the test suite's
+run). Servers on one CPU, clients on the other (when there are two).
 """
 
 from __future__ import annotations
@@ -65,8 +66,7 @@ def client_calls(call: Callable[[], object], count: int) -> float:
     return (time.perf_counter() - start) / count
 
 
-def measure_overhead(quick: bool) -> list[tuple[str, str, float, str, str]]:
-    blocks, per_block = (6, 200) if quick else (20, 1000)
+def measure_overhead(blocks: int, per_block: int) -> list[tuple[str, str, float, str, str]]:
     server = launch([sys.executable, "-m", "c2rviz", "--no-viewer", "--port", "0"], False)
     rows = []
     try:
@@ -173,12 +173,16 @@ def measure_virtual(robots: int, simulated_s: float) -> tuple[float, float]:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer calls, 10 s simulated")
+    parser.add_argument("--smoke", action="store_true", help="every row, the least work")
     args = parser.parse_args(argv)
+    # (blocks, calls a block, simulated seconds)
+    blocks, per_block, simulated = (
+        (2, 50, 2.0) if args.smoke else (6, 200, 10.0) if args.quick else (20, 1000, 60.0)
+    )
     pinned = pin_cpus(True)
     print(machine())
     print(f"pinning: {pinned}")
-    rows = measure_overhead(args.quick)
-    simulated = 10.0 if args.quick else 60.0
+    rows = measure_overhead(blocks, per_block)
     for robots in (1, 8):
         wall, cpu = measure_virtual(robots, simulated)
         per_minute = wall * 60.0 / simulated

@@ -19,9 +19,17 @@ from typing import Any
 
 import pytest
 from browser_support import FreshContexts
+from hypothesis import settings
 from support import ARGS, CHROMIUM, ROOT, Client, Process, ServerThread, load_robot
 
 from c2rviz.session import ServerLimits
+
+settings.register_profile("ci", deadline=None, print_blob=True)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+"""Hypothesis for every run of the suite (``HYPOTHESIS_PROFILE=default`` for its own
+defaults): its examples as each test sets them (docs/testing.md), no deadline (a time
+limit per example on the wall clock, 200 ms by default, fails a test on a busy machine),
+and a failure's blob printed for ``@reproduce_failure``."""
 
 
 @pytest.fixture

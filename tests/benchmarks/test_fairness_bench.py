@@ -1,4 +1,4 @@
-"""The fairness benchmark cannot rot: ``benchmarks/fairness.py --quick`` prints every row.
+"""The fairness benchmark cannot rot: ``benchmarks/fairness.py --smoke`` prints every row.
 
 No timing is judged (the figures depend on the machine, and rows that other branches
 fix may say NOT MET); only that each row is there with a figure, a goal and a verdict.
@@ -23,7 +23,7 @@ ROWS = [
 
 @pytest.mark.timeout(600)
 def test_quick_run_prints_every_row() -> None:
-    stdout, cells = quick_table("fairness.py", 540)
+    stdout, cells = quick_table("fairness.py", 540, "--smoke")
     for label in ROWS:
         assert label in cells, f"row {label!r} missing from:\n{stdout}"
         _, figure, goal, verdict = cells[label]

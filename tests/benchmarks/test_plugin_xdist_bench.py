@@ -1,4 +1,4 @@
-"""The plugin's xdist benchmark cannot rot: ``benchmarks/plugin_xdist.py --quick`` runs its
+"""The plugin's xdist benchmark cannot rot: ``benchmarks/plugin_xdist.py --smoke`` runs its
 generated suite with 1 and 2 workers and prints every row (no timing is judged here)."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from support import ROOT
 @pytest.mark.timeout(600)
 def test_quick_run_prints_both_times_and_the_ratio() -> None:
     done = subprocess.run(
-        [sys.executable, str(ROOT / "benchmarks" / "plugin_xdist.py"), "--quick"],
+        [sys.executable, str(ROOT / "benchmarks" / "plugin_xdist.py"), "--smoke"],
         cwd=ROOT,
         capture_output=True,
         text=True,

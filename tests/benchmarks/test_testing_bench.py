@@ -1,4 +1,4 @@
-"""``benchmarks/testing_bench.py --quick`` prints every row (no timing is checked: the figures
+"""``benchmarks/testing_bench.py --smoke`` prints every row (no timing is checked: the figures
 depend on the machine; only that each row has a number)."""
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ ROWS = [
 
 @pytest.mark.timeout(600)
 def test_quick_run_prints_every_row() -> None:
-    stdout, cells = quick_table("testing_bench.py", 540)
+    stdout, cells = quick_table("testing_bench.py", 540, "--smoke")
     for label in ROWS:
         assert label in cells, f"row {label!r} missing from:\n{stdout}"
         _, unit, figure, _goal, _met = cells[label]

@@ -112,6 +112,7 @@ def test_moves_and_settings(robot, server):
     robot.rand()
     assert robot.where() != (0.0,) * 7
     assert robot.speed(25) == 25.0 and robot.speed() == 25.0
+    assert robot.speed(100) == 100.0  # the moves below on the real clock: no slower than needed
     assert robot.lspeed(0.1) == 0.1 and robot.lspeed() == 0.1
     assert robot.motion("on") == "on" and robot.motion() == "on"
     robot.home()  # on arrival

@@ -27,6 +27,7 @@ from c2rviz.collision import CollisionModel
 from c2rviz.motion import motion_limits
 from c2rviz.robot import Robot
 from c2rviz.session import ServerLimits, SessionDefaults
+from c2rviz.world.virtual_clock import VirtualClock
 
 ARMS = [
     *BUNDLED,
@@ -48,11 +49,14 @@ def numbers(values: np.ndarray | tuple[float, ...]) -> str:
 
 @pytest.fixture
 def serve() -> Iterator[Callable[..., tuple[ServerThread, Client]]]:
-    """Factory: ``serve(robot)`` -> a live server on ``robot`` and a client (radians)."""
+    """Factory: ``serve(robot)`` -> a live server on ``robot`` and a client (radians).
+
+    On virtual time: these tests judge paths and frames, not how long a move takes on
+    the wall, and the one client waits on the clock (a reply on arrival, ``wait``)."""
     started: list[tuple[ServerThread, Client]] = []
 
     def start(robot: Robot, **defaults: object) -> tuple[ServerThread, Client]:
-        server = ServerThread(robot, ServerLimits()).start()
+        server = ServerThread(robot, ServerLimits(), clock=VirtualClock()).start()
         if defaults:
             server.services.defaults = SessionDefaults(**defaults)  # type: ignore[arg-type]
         client = Client(server.host, server.port)

@@ -27,7 +27,8 @@ def transcript() -> list[tuple[str, str]]:
 
 def test_the_workcell_example_replies_as_written(c2rviz_process) -> None:
     assert "c2rviz --seed 1" in DOC.read_text()
-    proc = c2rviz_process("--no-viewer", "--seed", "1")
+    # Virtual time: the same replies (docs/testing.md), without waiting out its moves.
+    proc = c2rviz_process("--no-viewer", "--seed", "1", "--clock", "virtual")
     client = Client("127.0.0.1", proc.port)
     try:
         pairs = transcript()

@@ -16,12 +16,12 @@ from support import ROOT
 
 SAMPLE = """
 import math
-import time
 
 import pytest
 
 from c2rviz import Client, CommandError
 from c2rviz.testing import assert_arrives, assert_no_collision_during
+from c2rviz.world.virtual_clock import VirtualClock
 
 HOME = (0.0,) * 7
 
@@ -57,13 +57,16 @@ def test_a_parameter_chooses_the_robot(c2rviz, c2rviz_server):
 
 
 @pytest.mark.c2rviz(clock="virtual", motion="follow", speed=5)
-def test_virtual_time_runs_a_slow_move_at_once(c2rviz):
-    start = time.monotonic()
+def test_virtual_time_runs_a_slow_move_at_once(c2rviz, c2rviz_server):
+    # Judged on the server's clock: ten minutes and more of it pass in this test (on the
+    # real clock that outlasts the suite's time limit); how fast, benchmarks/testing_bench.py.
+    assert isinstance(c2rviz_server.world.clock, VirtualClock)
+    start = c2rviz_server.now()
     c2rviz.joints([1, 0.5, 0, -0.5, 0, 0.5, 0])
     assert c2rviz.status().seconds_left > 20  # 20 s of the server's clock
     assert_arrives(c2rviz, within=60, at=[1, 0.5, 0, -0.5, 0, 0.5, 0])
     c2rviz.sleep(600)
-    assert time.monotonic() - start < 60
+    assert c2rviz_server.now() - start >= 620
 
 
 @pytest.mark.c2rviz(motion="follow", speed=50)
