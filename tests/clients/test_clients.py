@@ -270,6 +270,7 @@ def test_a_file_for_another_robot_is_warned_about(server, capsys):
     assert "warning" not in capsys.readouterr().err  # motoman.txt says motoman_sia20d
 
 
+@pytest.mark.wall_clock
 def test_strict_refuses_a_file_for_another_robot(server, connect, capsys):
     other = connect(server)
     assert other.ask("move 2 0.5") == "ok"
