@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import re
 import shutil
+import time
 import zlib
 from collections.abc import Iterator
 from pathlib import Path
@@ -53,6 +54,7 @@ DEFAULT_CLOCK = "virtual"
 """Every server's clock unless the test, the command line or the ini says otherwise: a test
 judges what happened, which virtual time gives at once and the same every run; a test that
 needs the wall clock says ``@pytest.mark.c2rviz(clock="real")``."""
+_SERVED_WITHIN_S = 60.0
 _REPORTS = pytest.StashKey[dict[str, pytest.TestReport]]()
 _KEPT = pytest.StashKey[list[Path]]()
 _KEPT_PROPERTY = "c2rviz_recording"  # a kept recording's NAME.txt, in the report
@@ -209,5 +211,15 @@ def c2rviz(c2rviz_server: TestServer) -> Iterator[Client]:
     """A ``c2rviz.Client`` connected to this test's server (its first robot, radians)."""
     from ..clients.client import Client
 
+    before = c2rviz_server.text_clients()
     with Client(c2rviz_server.host, c2rviz_server.port, retry_s=0) as client:
+        # Served before the test runs: else a test's first idle_clients() could come before
+        # the server knows this client, which then holds virtual time inside it.
+        deadline = time.monotonic() + _SERVED_WITHIN_S
+        while c2rviz_server.text_clients() <= before:
+            if time.monotonic() > deadline:
+                raise RuntimeError(
+                    f"the c2rviz server did not take the client in {_SERVED_WITHIN_S} s"
+                )
+            time.sleep(0.001)
         yield client

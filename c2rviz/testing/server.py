@@ -185,6 +185,10 @@ class TestServer:
         with self.idle_clients():
             return asyncio.run_coroutine_threadsafe(ask(), self._loop).result(_START_TIMEOUT_S)
 
+    def text_clients(self) -> int:
+        """How many clients the text ports serve now (counted on the server's loop)."""
+        return self.call(lambda: sum(len(server.connections) for server in self._servers))
+
     @contextlib.contextmanager
     def idle_clients(self) -> Iterator[None]:
         """Inside, the clients connected now that have no command running wait for nothing.
