@@ -21,6 +21,7 @@ from c2rviz.robot.model import Robot
 from c2rviz.session import ServerLimits
 from c2rviz.testing.server import TestServer
 from c2rviz.world.effects import RecordingScene
+from c2rviz.world.virtual_clock import VirtualClock
 
 ROOT = Path(__file__).resolve().parent.parent
 CTRL_C_ABLE = [
@@ -61,7 +62,8 @@ def load_robot(name: str = "motoman_sia20d") -> Robot:
 class ServerThread:
     """A live server on its own loop and thread: the plugin's ``TestServer`` (the harness
     c2rviz's users get) with robots built here, a ``RecordingScene`` watching its world and
-    the limits given. ``clock`` is a clock object (default: real time)."""
+    the limits given. ``clock`` is a clock object: virtual time unless the test gives
+    another (None: the wall clock, for a test that needs it)."""
 
     robot: Robot | Mapping[str, Robot]
     limits: ServerLimits
@@ -69,7 +71,7 @@ class ServerThread:
     quit: threading.Event = field(default_factory=threading.Event)
     host: str = "127.0.0.1"
     port: int = 0
-    clock: Any = None  # a world.clock.Clock (default: real time)
+    clock: Any = field(default_factory=VirtualClock)  # a world.clock.Clock; None: real time
     hz: float = 100.0
     record_dir: Path | None = None
 

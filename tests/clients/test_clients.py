@@ -162,7 +162,8 @@ def cell():
     from c2rviz.app.config import ServerLimits
 
     robots = {"left": load_robot("motoman_sia20d"), "right": load_robot("kuka_lwr")}
-    server = ServerThread(robots, ServerLimits()).start()  # type: ignore[arg-type]
+    # The wall clock (clock=None): its REPL tests race a move with Ctrl-C.
+    server = ServerThread(robots, ServerLimits(), clock=None).start()  # type: ignore[arg-type]
     yield server
     server.stop()
 
