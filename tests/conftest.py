@@ -23,6 +23,15 @@ from hypothesis import settings
 from support import ARGS, CHROMIUM, ROOT, Client, Process, ServerThread, load_robot
 
 from c2rviz.session import ServerLimits
+from c2rviz.world.virtual_clock import VirtualClock
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers",
+        "wall_clock(reason): start_server and server run on the real clock (else virtual): "
+        "the test judges how long something took, or polls while the arm moves",
+    )
 
 settings.register_profile("ci", deadline=None, print_blob=True)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
@@ -33,12 +42,15 @@ and a failure's blob printed for ``@reproduce_failure``."""
 
 
 @pytest.fixture
-def start_server() -> Iterator[Callable[..., ServerThread]]:
-    """Factory: ``start_server(robot="motoman_sia20d", **limits)``; always stopped."""
+def start_server(request: pytest.FixtureRequest) -> Iterator[Callable[..., ServerThread]]:
+    """Factory: ``start_server(robot="motoman_sia20d", **limits)``; always stopped. Each
+    server runs on a virtual clock of its own unless the test is marked ``wall_clock``."""
     started: list[ServerThread] = []
+    wall = request.node.get_closest_marker("wall_clock") is not None
 
     def start(robot: str = "motoman_sia20d", **limits: Any) -> ServerThread:
-        server = ServerThread(load_robot(robot), ServerLimits(**limits)).start()
+        clock = None if wall else VirtualClock()
+        server = ServerThread(load_robot(robot), ServerLimits(**limits), clock=clock).start()
         started.append(server)
         return server
 
@@ -49,7 +61,7 @@ def start_server() -> Iterator[Callable[..., ServerThread]]:
 
 @pytest.fixture
 def server(start_server: Callable[..., ServerThread]) -> ServerThread:
-    """A live motoman server with default limits."""
+    """A live motoman server with default limits (virtual time unless ``wall_clock``)."""
     return start_server()
 
 

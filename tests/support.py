@@ -7,24 +7,21 @@ path because the root ``conftest.py`` lives there.
 
 from __future__ import annotations
 
-import asyncio
 import socket
 import subprocess
 import sys
 import threading
-from collections.abc import Callable
-from concurrent.futures import Future
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
 from typing import Any
 
-from c2rviz.app.program import write_page
 from c2rviz.robot.model import Robot
-from c2rviz.session import ServerLimits, Services
-from c2rviz.transports.tcp_server import CommandServer
+from c2rviz.session import ServerLimits
+from c2rviz.testing.server import TestServer
 from c2rviz.world.effects import RecordingScene
-from c2rviz.world.world import World
+from c2rviz.world.virtual_clock import VirtualClock
 
 ROOT = Path(__file__).resolve().parent.parent
 CTRL_C_ABLE = [
@@ -63,44 +60,43 @@ def load_robot(name: str = "motoman_sia20d") -> Robot:
 
 @dataclass
 class ServerThread:
-    """A live server on its own loop and thread."""
+    """A live server on its own loop and thread: the plugin's ``TestServer`` (the harness
+    c2rviz's users get) with robots built here, a ``RecordingScene`` watching its world and
+    the limits given. ``clock`` is a clock object: virtual time unless the test gives
+    another (None: the wall clock, for a test that needs it)."""
 
-    robot: Robot
+    robot: Robot | Mapping[str, Robot]
     limits: ServerLimits
     scene: RecordingScene = field(default_factory=RecordingScene)
     quit: threading.Event = field(default_factory=threading.Event)
     host: str = "127.0.0.1"
     port: int = 0
-    clock: Any = None  # a world.clock.Clock (default: real time)
+    clock: Any = field(default_factory=VirtualClock)  # a world.clock.Clock; None: real time
     hz: float = 100.0
     record_dir: Path | None = None
 
     def start(self) -> ServerThread:
-        self.loop = asyncio.new_event_loop()
-        self.world = World(self.robot, self.scene, clock=self.clock, hz=self.hz)
-        folder = {} if self.record_dir is None else {"record_dir": self.record_dir}
-        self.services = Services(self.world, limits=self.limits, exporters=(write_page,), **folder)
-        self.server = CommandServer(self.services, on_quit=self.quit.set)
-        self.thread = threading.Thread(target=self.loop.run_forever, daemon=True)
-        self.thread.start()
-        self.host, self.port = self.call_async(self.server.start("127.0.0.1", 0))
+        options: dict[str, Any] = {"limits": self.limits, "hz": self.hz, "clock": self.clock}
+        if self.record_dir is not None:
+            options["record_dir"] = str(self.record_dir)
+        harness = TestServer(options, robots=self.robot, observers=[self.scene])
+        harness.keep_page(True)  # a recording writes its page, as the program's do
+        self.harness = harness.start()
+        self.loop = harness.loop
+        self.thread = harness.thread
+        self.world = harness.world
+        self.services = harness.services
+        self.server = harness.command_servers[0]
+        self.quit = harness.quit_requested
+        self.host, self.port = harness.host, harness.port
         return self
 
     def call(self, fn: Callable[..., Any], *args: Any) -> Any:
         """Run ``fn(*args)`` on the server's loop and return its result."""
-        done: Future[Any] = Future()
-
-        def run() -> None:
-            try:
-                done.set_result(fn(*args))
-            except BaseException as exc:  # handed to the caller
-                done.set_exception(exc)
-
-        self.loop.call_soon_threadsafe(run)
-        return done.result(timeout=60)
+        return self.harness.call(fn, *args)
 
     def call_async(self, coro: Any) -> Any:
-        return asyncio.run_coroutine_threadsafe(coro, self.loop).result(timeout=60)
+        return self.harness.call_async(coro)
 
     @property
     def q(self) -> tuple[float, ...]:
@@ -108,11 +104,7 @@ class ServerThread:
         return self.call(lambda: self.world.q)
 
     def stop(self) -> None:
-        if self.loop.is_running():
-            self.call_async(self.server.stop())
-            self.loop.call_soon_threadsafe(self.loop.stop)
-        self.thread.join(timeout=60)
-        self.loop.close()
+        self.harness.stop()
 
 
 class Client:

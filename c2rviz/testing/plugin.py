@@ -13,9 +13,12 @@ the nearest winning) and then a fixture parameter (``indirect=True``, a dict): a
 ``c2rviz`` by its name (``robot``, ``cell``, ``urdf``, ``clock``, ``motion``, ``speed``,
 ``guard``, ``hz``, ``max_objects``...), ``ini`` (a cmdinterpreter.ini), ``viewer=True``
 (the page, on a free port), ``doors=True`` (the other doors too, on free ports),
-``faults=["after 2 estop", ...]`` (``fault`` lines run on the first robot at the start,
-docs/faults.md) and ``record=False``. ``--c2rviz-clock`` (or the ini option
-``c2rviz_clock``) sets every test's clock, e.g. ``virtual``.
+``crcl=True`` or ``rosbridge=True`` (that door alone, on a free port:
+``c2rviz_server.crcl_port``, ``.rosbridge_port``), ``faults=["after 2 estop", ...]``
+(``fault`` lines run on the first robot at the start, docs/faults.md) and
+``record=False``. The clock is virtual (``DEFAULT_CLOCK``) unless ``--c2rviz-clock`` (or
+the ini option ``c2rviz_clock``) sets every test's, or a mark's ``clock=`` one test's
+(``clock="real"`` for a test that needs the wall clock).
 
 Each test's run is recorded (``record NAME`` on its first robot, NAME from the test's
 id); when the test fails, NAME.txt, NAME.csv and NAME.html are kept in
@@ -33,6 +36,7 @@ from __future__ import annotations
 
 import re
 import shutil
+import time
 import zlib
 from collections.abc import Iterator
 from pathlib import Path
@@ -44,8 +48,13 @@ if TYPE_CHECKING:  # the server side loads when a test asks for a server, not wi
     from ..clients.client import Client
     from .server import TestServer
 
-__all__ = ["c2rviz", "c2rviz_server", "recording_name"]
+__all__ = ["DEFAULT_CLOCK", "c2rviz", "c2rviz_server", "recording_name"]
 
+DEFAULT_CLOCK = "virtual"
+"""Every server's clock unless the test, the command line or the ini says otherwise: a test
+judges what happened, which virtual time gives at once and the same every run; a test that
+needs the wall clock says ``@pytest.mark.c2rviz(clock="real")``."""
+_SERVED_WITHIN_S = 60.0
 _REPORTS = pytest.StashKey[dict[str, pytest.TestReport]]()
 _KEPT = pytest.StashKey[list[Path]]()
 _KEPT_PROPERTY = "c2rviz_recording"  # a kept recording's NAME.txt, in the report
@@ -57,7 +66,7 @@ def pytest_addoption(parser: pytest.Parser) -> None:
     group.addoption(
         "--c2rviz-clock",
         metavar="real|scaled:N|virtual",
-        help="the clock of every c2rviz_server (default: the ini's c2rviz_clock, else real)",
+        help="the clock of every c2rviz_server (default: the ini's c2rviz_clock, else virtual)",
     )
     group.addoption(
         "--c2rviz-recordings",
@@ -72,7 +81,7 @@ def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
         "markers",
         "c2rviz(**options): the c2rviz_server this test gets (robot=, cell=, ini=, clock=, "
-        "viewer=, doors=, faults=, record=, and any c2rviz flag by its name)",
+        "viewer=, doors=, crcl=, rosbridge=, faults=, record=, and any c2rviz flag by its name)",
     )
     config.stash[_KEPT] = []
     config.pluginmanager.register(_KeptRecordings(config), "c2rviz-kept-recordings")
@@ -126,10 +135,8 @@ def _worker(config: pytest.Config) -> str:
 
 
 def _options(request: pytest.FixtureRequest) -> dict[str, Any]:
-    options: dict[str, Any] = {}
     clock = request.config.getoption("--c2rviz-clock") or request.config.getini("c2rviz_clock")
-    if clock:
-        options["clock"] = clock
+    options: dict[str, Any] = {"clock": clock or DEFAULT_CLOCK}
     for mark in reversed(list(request.node.iter_markers("c2rviz"))):  # farthest first
         if mark.args:
             raise pytest.UsageError("@pytest.mark.c2rviz takes options by name only")
@@ -204,5 +211,15 @@ def c2rviz(c2rviz_server: TestServer) -> Iterator[Client]:
     """A ``c2rviz.Client`` connected to this test's server (its first robot, radians)."""
     from ..clients.client import Client
 
+    before = c2rviz_server.text_clients()
     with Client(c2rviz_server.host, c2rviz_server.port, retry_s=0) as client:
+        # Served before the test runs: else a test's first idle_clients() could come before
+        # the server knows this client, which then holds virtual time inside it.
+        deadline = time.monotonic() + _SERVED_WITHIN_S
+        while c2rviz_server.text_clients() <= before:
+            if time.monotonic() > deadline:
+                raise RuntimeError(
+                    f"the c2rviz server did not take the client in {_SERVED_WITHIN_S} s"
+                )
+            time.sleep(0.001)
         yield client

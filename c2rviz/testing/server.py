@@ -3,7 +3,14 @@
 It is the program's own wiring (``app.config`` settings, ``app.members`` robots, a
 ``World`` on the chosen clock, ``Services``, a ``CommandServer`` per robot, the page and
 the other doors if asked) on an asyncio loop in a thread of its own, on free ports. A
-controller's test talks to it over TCP like to any c2rviz, with ``c2rviz.Client``.
+controller's test talks to it over TCP like to any c2rviz, with ``c2rviz.Client``; the
+CRCL and rosbridge doors, when asked (``crcl=True``, ``rosbridge=True``, ``doors=True``),
+say their free ports (``crcl_port``, ``rosbridge_port``).
+
+A test that built its own robots (``Robot`` objects, not the ini's) passes them as
+``robots=`` (no ini is read then, unless ``ini`` is given), and may add observers of its
+own (``observers=``) and give a clock object (``clock=VirtualClock()``) or the server's
+limits (``limits=ServerLimits(...)``) among the options: c2rviz's own tests do.
 
 Robots are loaded once per set of options and kept for the next server (loading a URDF
 is most of a start); each server has a world of its own, so nothing a test does reaches
@@ -14,59 +21,33 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
-import dataclasses
 import threading
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Coroutine, Iterator, Mapping, Sequence
+from concurrent.futures import Future
 from pathlib import Path
 from typing import Any, TypeVar
 
 import numpy as np
 
 from .. import CommandServer  # the package's lazy name follows the text door's home
-from ..app.config import Settings, find_ini, load_settings
 from ..app.doors import Opened, close_doors, open_doors
-from ..app.members import Member, furnish, members
+from ..app.members import furnish
 from ..app.program import write_page
 from ..observers.recorder import Recorded
+from ..robot.model import Robot
 from ..session.services import Services
 from ..session.session import Session
-from ..world.clock import Hold
+from ..world.clock import Clock, Hold
 from ..world.clocks import parse_clock
-from ..world.effects import NullScene, Scene
+from ..world.effects import NullScene, Observer, Scene
 from ..world.state import RobotState
 from ..world.world import World
+from .options import RUNTIME_OPTIONS, give_back, given_members, settings_for, take_members
 
 __all__ = ["RUNTIME_OPTIONS", "TestServer"]
 
 T = TypeVar("T")
-
-RUNTIME_OPTIONS = (
-    "clock",
-    "viewer",
-    "doors",
-    "record",
-    "motion",
-    "speed",
-    "guard",
-    "lspeed",
-    "faults",
-)
-"""Options that do not change which robots are loaded (the rest key the robot cache)."""
 _START_TIMEOUT_S = 120.0
-_loaded: dict[str, tuple[list[Member], str | None]] = {}
-_in_use: set[str] = set()
-
-
-def _settings(options: Mapping[str, Any]) -> Settings:
-    """The program's settings for ``options``: flag names as keys (``robot``, ``cell``,
-    ``ini``, ``clock``, ``motion``, ``max_objects``...), every port free, no page unless
-    ``viewer=True``."""
-    given = {k: v for k, v in options.items() if k not in ("ini", "doors", "record", "faults")}
-    ports = {name: 0 for name in Settings.__dataclass_fields__ if name.endswith("port")}
-    overrides: dict[str, Any] = {**ports, "viewer": False, **given}
-    overrides["robot_flag"] = "robot" in given
-    overrides["urdf_flag"] = "urdf" in given
-    return load_settings(find_ini(options.get("ini")), overrides)
 
 
 class TestServer:
@@ -78,28 +59,37 @@ class TestServer:
         ports: Each robot's command port, by name (the first is ``port``).
         world, services: Its state (use them through ``call``: they live on its loop).
         viewer_url: The page's address (None: no page).
+        crcl_ports: Each robot's CRCL port, by name, when the CRCL door is open (the
+            first is ``crcl_port``).
+        rosbridge_port: The rosbridge websocket's port (None: no rosbridge door).
     """
 
     __test__ = False  # not a test class, whatever pytest thinks of the name
 
-    def __init__(self, options: Mapping[str, Any]) -> None:
-        """Load the robots (or take them from the cache); ``start`` serves them."""
-        self.options = dict(options)
-        self.settings = _settings(self.options)
-        parse_clock(self.settings.clock)  # a bad clock says so here
-        key = repr(sorted((k, v) for k, v in options.items() if k not in RUNTIME_OPTIONS))
+    def __init__(
+        self,
+        options: Mapping[str, Any] | None = None,
+        *,
+        robots: Robot | Mapping[str, Robot] | None = None,
+        observers: Sequence[Observer] = (),
+    ) -> None:
+        """Load the robots (or take them from the cache, or ``robots``); ``start`` serves
+        them, each world telling ``observers`` too."""
+        self.options = dict(options or {})
+        self.settings = settings_for(self.options, read_ini=robots is None)
+        clock = self.options.get("clock")
+        self._clock = clock if isinstance(clock, Clock) else parse_clock(self.settings.clock)
+        self._observers = list(observers)
         self._key: str | None = None  # the cache entry this server uses (one server at a time)
-        if key in _in_use or key not in _loaded:
-            loaded = members(self.settings)
-            _loaded.setdefault(key, loaded)
-        if key not in _in_use:
-            loaded = _loaded[key]
-            self._key = key
-            _in_use.add(key)
-        self.members = [dataclasses.replace(m, port=0) for m in loaded[0]]
-        self.cell = loaded[1]
+        if robots is not None:
+            self.members, self.cell = given_members(robots), None
+        else:
+            self.members, self.cell, self._key = take_members(self.options, self.settings)
+        self._as_program = robots is None  # given robots: their URDF's limits, no ports told
         self.host = self.settings.host
         self.ports: dict[str, int] = {}
+        self.crcl_ports: dict[str, int] = {}
+        self.rosbridge_port: int | None = None
         self.viewer_url: str | None = None
         self.quit_requested = threading.Event()
         self._ready = threading.Event()
@@ -114,6 +104,29 @@ class TestServer:
     def port(self) -> int:
         """The first robot's command port."""
         return next(iter(self.ports.values()))
+
+    @property
+    def crcl_port(self) -> int:
+        """The first robot's CRCL port (asked with ``crcl=True`` or ``doors=True``)."""
+        if not self.crcl_ports:
+            raise RuntimeError("no CRCL door: ask for one with crcl=True (or doors=True)")
+        return next(iter(self.crcl_ports.values()))
+
+    @property
+    def loop(self) -> asyncio.AbstractEventLoop:
+        """The server's event loop (its world and services live there)."""
+        assert self._loop is not None, "start() first"
+        return self._loop
+
+    @property
+    def thread(self) -> threading.Thread:
+        """The thread the server runs in."""
+        return self._thread
+
+    @property
+    def command_servers(self) -> list[CommandServer]:
+        """Each robot's text door, in the order of ``ports``."""
+        return self._servers
 
     @property
     def robot(self) -> str:
@@ -136,12 +149,20 @@ class TestServer:
 
     def call(self, fn: Callable[..., T], *args: Any) -> T:
         """Run ``fn(*args)`` on the server's loop (where its world lives); return its result."""
-        assert self._loop is not None
+        done: Future[T] = Future()
 
-        async def run() -> T:
-            return fn(*args)
+        def run() -> None:  # a plain callback: no task, one turn of the loop
+            try:
+                done.set_result(fn(*args))
+            except BaseException as exc:  # handed to the caller
+                done.set_exception(exc)
 
-        return asyncio.run_coroutine_threadsafe(run(), self._loop).result(60)
+        self.loop.call_soon_threadsafe(run)
+        return done.result(60)
+
+    def call_async(self, coro: Coroutine[Any, Any, T]) -> T:
+        """Run ``coro`` on the server's loop; return its result."""
+        return asyncio.run_coroutine_threadsafe(coro, self.loop).result(60)
 
     def now(self) -> float:
         """The server's clock [s]."""
@@ -163,6 +184,10 @@ class TestServer:
         assert self._loop is not None
         with self.idle_clients():
             return asyncio.run_coroutine_threadsafe(ask(), self._loop).result(_START_TIMEOUT_S)
+
+    def text_clients(self) -> int:
+        """How many clients the text ports serve now (counted on the server's loop)."""
+        return self.call(lambda: sum(len(server.connections) for server in self._servers))
 
     @contextlib.contextmanager
     def idle_clients(self) -> Iterator[None]:
@@ -201,9 +226,8 @@ class TestServer:
         if self._loop is not None and self._stop is not None and self._thread.is_alive():
             self._loop.call_soon_threadsafe(self._stop.set)
         self._thread.join(timeout=60)
-        if self._key is not None:
-            _in_use.discard(self._key)
-            self._key = None
+        give_back(self._key)
+        self._key = None
 
     # The server's thread.
 
@@ -228,12 +252,13 @@ class TestServer:
         self._stop = asyncio.Event()
         world = World(
             {m.name: m.robot for m in self.members},
-            clock=parse_clock(settings.clock),
+            clock=self._clock,
             hz=settings.hz,
             origins={m.name: m.origin for m in self.members},
-            limits={m.name: m.limits for m in self.members},
+            limits={m.name: m.limits for m in self.members} if self._as_program else None,
             max_objects=settings.max_objects,
         )
+        world.add_observers(self._observers)
         self.world = world
         self.services = Services(
             world,
@@ -255,10 +280,13 @@ class TestServer:
             for member in self.members:
                 server = CommandServer(self.services, on_quit=self._quit, robot=member.name)
                 _, port = await server.start(settings.host, 0)
-                world.state(member.name).port = self.ports[member.name] = port
+                self.ports[member.name] = port
+                if self._as_program:  # (robots a test built: the world as it built it)
+                    world.state(member.name).port = port
                 servers.append(server)
-            if self.options.get("doors"):
+            if settings.crcl or settings.rosbridge:
                 doors = await open_doors(settings, self.services, self.members, self._quit)
+                self._door_ports(doors)
             if settings.viewer:
                 scene = self._open_viewer()
                 world.add_observers([scene])
@@ -278,6 +306,17 @@ class TestServer:
                 await server.stop()
             self.services.close()
             scene.stop()
+
+    def _door_ports(self, doors: Sequence[Opened]) -> None:
+        from ..app.rosbridge_door import RosbridgeDoor
+        from ..transports.crcl.server import CrclServer
+
+        for opened in doors:
+            door = opened.door
+            if isinstance(door, CrclServer) and door.address is not None:
+                self.crcl_ports[door.robot or self.robot] = door.address[1]
+            elif isinstance(door, RosbridgeDoor):
+                self.rosbridge_port = door.port
 
     def _quit(self) -> None:
         self.quit_requested.set()

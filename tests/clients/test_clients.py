@@ -175,7 +175,8 @@ def cell():
     from c2rviz.app.config import ServerLimits
 
     robots = {"left": load_robot("motoman_sia20d"), "right": load_robot("kuka_lwr")}
-    server = ServerThread(robots, ServerLimits()).start()  # type: ignore[arg-type]
+    # The wall clock (clock=None): its REPL tests race a move with Ctrl-C.
+    server = ServerThread(robots, ServerLimits(), clock=None).start()  # type: ignore[arg-type]
     yield server
     server.stop()
 
@@ -283,6 +284,7 @@ def test_a_file_for_another_robot_is_warned_about(server, capsys):
     assert "warning" not in capsys.readouterr().err  # motoman.txt says motoman_sia20d
 
 
+@pytest.mark.wall_clock
 def test_strict_refuses_a_file_for_another_robot(server, connect, capsys):
     other = connect(server)
     assert other.ask("move 2 0.5") == "ok"

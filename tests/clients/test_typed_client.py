@@ -167,6 +167,7 @@ def test_cartesian_markers_and_the_workcell(robot, server):
     assert robot.objects() == [] and robot.collisions() == []
 
 
+@pytest.mark.wall_clock
 def test_watching_trails_and_recording(robot, server, tmp_path):
     server.services.recordings.folder = tmp_path
     assert robot.recording() is None
@@ -340,6 +341,7 @@ def cell():
     server.stop()
 
 
+@pytest.mark.wall_clock
 def test_the_async_client(server):
     async def main() -> None:
         async with AsyncClient(server.host, server.port) as robot:

@@ -79,6 +79,7 @@ def read_frames(path: Path) -> tuple[list[str], np.ndarray]:
     return rows[0], np.array(rows[1:], dtype=float)
 
 
+@pytest.mark.wall_clock
 def test_a_recorded_session_replays_to_the_same_states(
     start_server, connect, tmp_path: Path, capsys
 ):
@@ -457,6 +458,7 @@ RECORDED_MARKERS = """() => {
 
 
 @pytest.mark.browser
+@pytest.mark.wall_clock
 def test_the_recorded_page_plays_in_a_browser_without_a_server(
     start_server, connect, tmp_path: Path, browser
 ):

@@ -46,6 +46,7 @@ def frames_of(folder: Path, name: str) -> tuple[int, int, int]:
     return joints, rows, states
 
 
+@pytest.mark.wall_clock
 def test_racing_stop_and_overwrite_lose_neither(
     start_server: Callable[..., ServerThread], connect: Callable[..., Client], tmp_path: Path
 ):

@@ -22,6 +22,7 @@ from c2rviz.session.session import Session
 FAR = "90,45,0,-30,0,60,0"  # degrees, motoman_sia20d
 
 
+@pytest.mark.wall_clock
 def test_a_fast_mover_is_streamed_at_most_hz_times_a_second(server: ServerThread, connect):
     mover, watcher = connect(server), connect(server)
     for line in ("degrees", "motion on", "speed 100"):
@@ -50,6 +51,7 @@ def test_a_fast_mover_is_streamed_at_most_hz_times_a_second(server: ServerThread
     assert ((values[1:-1, moved] != 0) & (values[1:-1, moved] != values[-1, moved])).any()
 
 
+@pytest.mark.wall_clock
 def test_state_times_count_from_the_server_start_and_rise(server: ServerThread, connect):
     watcher, mover = connect(server), connect(server)
     assert watcher.ask("watch 1000") == "ok"
@@ -63,6 +65,7 @@ def test_state_times_count_from_the_server_start_and_rise(server: ServerThread, 
     assert 0 <= times[0] <= times[-1] <= now
 
 
+@pytest.mark.wall_clock
 def test_events_marker_clear_stopped(server: ServerThread, connect):
     watcher, other = connect(server), connect(server)
     assert watcher.ask("degrees") == "ok"
@@ -87,6 +90,7 @@ def test_events_marker_clear_stopped(server: ServerThread, connect):
     assert rest != f"ok {FAR}"  # it stopped short
 
 
+@pytest.mark.wall_clock
 def test_a_movel_in_motion_ends_with_event_arrived(server: ServerThread, connect):
     watcher, mover = connect(server), connect(server)
     assert mover.ask("j 0.1,0.4,0,-0.6,0,0.7,0") == "ok"
@@ -101,6 +105,7 @@ def test_a_movel_in_motion_ends_with_event_arrived(server: ServerThread, connect
     assert seen[-1] == "event arrived"
 
 
+@pytest.mark.wall_clock
 def test_collisions_are_events_when_they_begin_and_end(server: ServerThread, connect):
     watcher, other = connect(server), connect(server)
     assert watcher.ask("watch") == "ok"
@@ -158,6 +163,7 @@ def _rss_mb() -> float:
         return int(re.search(r"VmRSS:\s+(\d+)", status.read()).group(1)) / 1024  # type: ignore[union-attr]
 
 
+@pytest.mark.wall_clock
 def test_a_watcher_that_never_reads_costs_nothing(server: ServerThread, connect):
     """A long flood of moves and markers while a watcher reads nothing: the
     flooder's replies all come, the server holds at most a small buffer for the watcher
@@ -227,6 +233,7 @@ def _read_lines(client: Client, count: int, into: list[str]) -> None:
     into.extend(client.read_line() for _ in range(count))
 
 
+@pytest.mark.wall_clock
 def test_cli_watch_prints_the_stream_until_ctrl_c(server: ServerThread, connect):
     proc = subprocess.Popen(
         [*CTRL_C_ABLE, "-m", "c2rviz.clients.repl", "--watch", "50", "--port", str(server.port)],
@@ -255,6 +262,7 @@ def test_cli_watch_prints_the_stream_until_ctrl_c(server: ServerThread, connect)
         proc.stderr.close()  # type: ignore[union-attr]
 
 
+@pytest.mark.wall_clock
 def test_repl_watch_prints_the_stream_until_ctrl_c_then_goes_on(server: ServerThread, connect):
     proc = subprocess.Popen(
         [*CTRL_C_ABLE, "-m", "c2rviz.clients.repl", "--port", str(server.port)],

@@ -180,6 +180,7 @@ def test_movel_keeps_the_tool_on_the_line_within_lspeed_and_the_limits(
     assert client.ask("lspeed") == "ok 0.2"
 
 
+@pytest.mark.wall_clock
 def test_stop_during_movel_brakes_on_the_line_short_of_the_goal(server: ServerThread, connect):
     mover, other = connect(server), connect(server)
     mover.ask("j 0.1,0.4,0,-0.6,0,0.7,0")

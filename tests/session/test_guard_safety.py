@@ -104,6 +104,7 @@ def colliding_frames(server: ServerThread, since: int) -> list[tuple[str, str]]:
 
 
 @pytest.mark.parametrize("speed", [100, 20, 5])
+@pytest.mark.wall_clock
 def test_a_stop_brakes_along_the_checked_path_at_the_full_limits(
     server: ServerThread, open_client, speed: int
 ):
@@ -132,6 +133,7 @@ def test_a_stop_brakes_along_the_checked_path_at_the_full_limits(
     assert rested_after < 1.0, f"rest {rested_after:.2f} s after the stop at speed {speed}"
 
 
+@pytest.mark.wall_clock
 def test_a_guarded_preemption_brakes_on_the_path_then_goes(server: ServerThread, open_client):
     first = open_client("guard on", "motion on", "speed 30")
     second = open_client("guard on", "motion on", "speed 100")
@@ -159,6 +161,7 @@ def degrees_of(text: str) -> np.ndarray:
 # --- 23.3: the guard protects a move already running -------------------------------------
 
 
+@pytest.mark.wall_clock
 def test_a_new_object_stops_a_running_guarded_move_before_it(server: ServerThread, open_client):
     mover = open_client(f"j {REACH}", "guard on", "motion on", "speed 20")
     other = open_client()

@@ -68,6 +68,7 @@ def assert_within_limits(server: ServerThread, t: np.ndarray, q: np.ndarray, spe
     assert (velocity <= limits * SLACK + 1e-9).all(), velocity.max(axis=0) / limits
 
 
+@pytest.mark.wall_clock
 def test_a_move_replies_on_arrival_and_where_tells_the_arm_as_it_is(server, open_client):
     mover = open_client("on", 25)
     watcher = open_client()
@@ -101,6 +102,7 @@ def test_a_move_replies_on_arrival_and_where_tells_the_arm_as_it_is(server, open
     assert max(firsts) - min(firsts) <= 0.02 and max(lasts) - min(lasts) <= 1e-9
 
 
+@pytest.mark.wall_clock
 def test_a_second_client_preempts_without_a_jump(server: ServerThread, open_client):
     first = open_client("on", 30)
     second = open_client("on", 100)
@@ -124,6 +126,7 @@ def test_a_second_client_preempts_without_a_jump(server: ServerThread, open_clie
     np.testing.assert_allclose(q[-1], np.radians(degrees(OTHER)), atol=1e-12)
 
 
+@pytest.mark.wall_clock
 def test_stop_brings_the_arm_to_rest_and_tells_the_waiting_client(
     server: ServerThread, open_client
 ):
@@ -199,6 +202,7 @@ def test_speed_scales_the_duration_as_the_profile_predicts(server: ServerThread,
 
 
 @pytest.mark.parametrize("verb", ["home", "rand", "clear"])
+@pytest.mark.wall_clock
 def test_home_rand_and_clear_travel_too(server: ServerThread, open_client, verb: str):
     mover = open_client("off")
     mover.ask(f"j {FAR}")

@@ -30,7 +30,7 @@ def test_a_client_and_a_server(c2rviz, c2rviz_server):
     assert isinstance(c2rviz, Client)
     assert c2rviz.where() == HOME
     assert c2rviz_server.viewer_url is None  # no page unless asked
-    assert c2rviz_server.world.clock.describe() == "real"
+    assert c2rviz_server.world.clock.describe() == "virtual"  # the default
 
 
 def test_leaves_the_arm_moving(c2rviz):

@@ -441,6 +441,7 @@ def test_a_steady_stream_split_across_reads_is_not_dropped(live, connect):
     check()
 
 
+@pytest.mark.wall_clock
 def test_a_sleep_does_not_count_against_the_partial_timeout(live, connect):
     """While a client sleeps the server is not reading it: its line cannot finish."""
     server, _bystander, check = live(partial_timeout_s=1.0)  # each step: 10x slack
@@ -456,6 +457,7 @@ def test_a_sleep_does_not_count_against_the_partial_timeout(live, connect):
     check()
 
 
+@pytest.mark.wall_clock
 def test_thousands_of_lines_in_one_write_are_all_answered_in_order(live, connect):
     """A big read runs in batches (other clients get turns in between); nothing is lost."""
     server, bystander, check = live()

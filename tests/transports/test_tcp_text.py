@@ -218,6 +218,7 @@ def test_every_state_change_reaches_the_scene(server, connect):
     assert shown[2] == (1.0,) * 7
 
 
+@pytest.mark.wall_clock
 def test_sleep_pauses_only_its_own_connection(server, connect):
     sleeper, other = connect(server), connect(server)
     sleeper.send("sleep 0.5\nmove 0 1\n")

@@ -14,15 +14,20 @@ from c2rviz.transports.crcl.server import CrclLimits
 
 
 @pytest.fixture
-def start_crcl() -> Iterator[Callable[..., CrclServerThread]]:
-    """Factory: ``start_crcl(robot="motoman_sia20d", limits=ServerLimits(), **crcl_limits)``."""
+def start_crcl(request: pytest.FixtureRequest) -> Iterator[Callable[..., CrclServerThread]]:
+    """Factory: ``start_crcl(robot="motoman_sia20d", limits=ServerLimits(), **crcl_limits)``;
+    virtual time unless the test is marked ``wall_clock``."""
     started: list[CrclServerThread] = []
+    wall = request.node.get_closest_marker("wall_clock") is not None
 
     def start(
         robot: str = "motoman_sia20d", limits: ServerLimits | None = None, **crcl: Any
     ) -> CrclServerThread:
         server = CrclServerThread(
-            load_robot(robot), limits or ServerLimits(), crcl_limits=CrclLimits(**crcl)
+            load_robot(robot),
+            limits or ServerLimits(),
+            crcl_limits=CrclLimits(**crcl),
+            **({"clock": None} if wall else {}),
         )
         started.append(server.start())
         return server

@@ -11,6 +11,7 @@ from test_crcl_server import _wait_moving, started
 STOPPED = "emergency stop since t="
 
 
+@pytest.mark.wall_clock
 def test_an_estop_is_crcl_error_until_reset(crcl_server, crcl_connect, connect) -> None:
     client: CrclClient = started(crcl_connect(crcl_server))
     text: Client = connect(crcl_server)

@@ -4,12 +4,14 @@ and ``fault drop`` lets go of what a CRCL grasp took."""
 
 from __future__ import annotations
 
+import pytest
 from crcl_support import DONE, actuate, command
 
 PICK = {1: 0.0, 2: 0.3, 3: -0.3, 4: 0.0, 5: -0.9707963, 6: 0.0}  # the fanuc pointing down
 LIFT = {2: 0.0, 3: 0.0, 5: -1.5707963}
 
 
+@pytest.mark.wall_clock
 def test_a_crcl_grasp_slips_and_a_crcl_held_part_drops(start_crcl, crcl_connect, connect):
     server = start_crcl("fanuc_lrmate200id")
     text = connect(server)

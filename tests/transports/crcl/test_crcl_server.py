@@ -195,6 +195,7 @@ def test_stop_motion_brakes_and_reports_both(crcl_server, crcl_connect) -> None:
     assert not crcl_server.call(lambda: crcl_server.world.moving(crcl_server.world.default))
 
 
+@pytest.mark.wall_clock
 def test_stop_from_the_text_port_is_an_error_naming_it(crcl_server, crcl_connect, connect) -> None:
     client = started(crcl_connect(crcl_server))
     text: Client = connect(crcl_server)
@@ -242,6 +243,7 @@ def test_message_shows_in_the_last_commands(crcl_server, crcl_connect) -> None:
     assert "InitCanonType (CommandID 1)" in lines
 
 
+@pytest.mark.wall_clock
 def test_dwell_works_then_is_done(crcl_server, crcl_connect) -> None:
     client = started(crcl_connect(crcl_server))
     client.send(command("Dwell", 2, "<DwellTime>2</DwellTime>"))
