@@ -33,6 +33,7 @@ def pytest_configure(config: pytest.Config) -> None:
         "the test judges how long something took, or polls while the arm moves",
     )
 
+
 settings.register_profile("ci", deadline=None, print_blob=True)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 """Hypothesis for every run of the suite (``HYPOTHESIS_PROFILE=default`` for its own
