@@ -87,6 +87,17 @@ def pytest_configure(config: pytest.Config) -> None:
     config.pluginmanager.register(_KeptRecordings(config), "c2rviz-kept-recordings")
 
 
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_call(item: pytest.Item) -> Any:
+    """The test's body begins: its servers' clocks run from here (``TestServer.begin``)."""
+    from .server import TestServer
+
+    for value in getattr(item, "funcargs", {}).values():
+        if isinstance(value, TestServer):
+            value.begin()
+    return (yield)
+
+
 @pytest.hookimpl(wrapper=True, tryfirst=True)
 def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> Any:
     """Keep each phase's report on the item: the fixture's teardown reads whether it failed."""
@@ -165,7 +176,7 @@ def c2rviz_server(
     record = options.pop("record", True)
     folder = tmp_path_factory.mktemp("c2rviz-recording")
     options.setdefault("record_dir", str(folder))
-    server = TestServer(options).start()
+    server = TestServer(options, held=True).start()
     name = recording_name(request.node.nodeid, _worker(request.config))
     if record:
         reply = server.run(f"record {name} overwrite", server.robot)
@@ -222,4 +233,5 @@ def c2rviz(c2rviz_server: TestServer) -> Iterator[Client]:
                     f"the c2rviz server did not take the client in {_SERVED_WITHIN_S} s"
                 )
             time.sleep(0.001)
+        c2rviz_server.begin()
         yield client

@@ -72,9 +72,14 @@ class TestServer:
         *,
         robots: Robot | Mapping[str, Robot] | None = None,
         observers: Sequence[Observer] = (),
+        held: bool = False,
     ) -> None:
         """Load the robots (or take them from the cache, or ``robots``); ``start`` serves
-        them, each world telling ``observers`` too."""
+        them, each world telling ``observers`` too. ``held``: a virtual clock stands still
+        from the start until ``begin`` (the plugin's servers: a fault the marker schedules
+        ``after 6`` comes 6 s into the test, not before its first line)."""
+        self._held = held
+        self._start_hold: Hold | None = None
         self.options = dict(options or {})
         self.settings = settings_for(self.options, read_ini=robots is None)
         clock = self.options.get("clock")
@@ -164,6 +169,15 @@ class TestServer:
         """Run ``coro`` on the server's loop; return its result."""
         return asyncio.run_coroutine_threadsafe(coro, self.loop).result(60)
 
+    def begin(self) -> None:
+        """The test begins: a ``held`` server's clock runs from now on (again: nothing)."""
+        self.call(self._let_go)
+
+    def _let_go(self) -> None:
+        hold, self._start_hold = self._start_hold, None
+        if hold is not None:
+            hold.close()
+
     def now(self) -> float:
         """The server's clock [s]."""
         return self.call(lambda: self.world.clock.now())
@@ -177,7 +191,10 @@ class TestServer:
             session = Session(self.services, "test", robot)
             try:
                 reply = session.run(line)
-                return "" if reply is None else reply if isinstance(reply, str) else await reply
+                if reply is None or isinstance(reply, str):
+                    return reply or ""
+                self._let_go()  # a reply that waits on the clock: the clock must run
+                return await reply
             except Exception as exc:  # a C2rvizError: its error reply, as a door would send
                 return f"error: {exc}"
 
@@ -260,6 +277,8 @@ class TestServer:
         )
         world.add_observers(self._observers)
         self.world = world
+        if self._held:
+            self._start_hold = world.clock.hold()
         self.services = Services(
             world,
             limits=settings.limits,

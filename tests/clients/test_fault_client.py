@@ -92,6 +92,18 @@ def test_the_marker_schedules_faults(c2rviz):
     c2rviz.home()
 
 
+@pytest.mark.c2rviz(clock="virtual", faults=["after 6 protective"])
+def test_a_marker_fault_counts_from_the_test_not_the_server(c2rviz_server, c2rviz):
+    # The server's clock stands still from its start until the test's client is served:
+    # else nothing holds virtual time and the fault is due before the test's first line.
+    assert c2rviz_server.now() < 6.0
+    assert c2rviz.faults()[0].startswith("protective at 6")
+    c2rviz.sleep(5)
+    assert c2rviz.faults()[0].startswith("protective at 6")  # still ahead, 5 s in
+    c2rviz.sleep(2)
+    assert c2rviz.faults()[0].startswith("protective since 6")
+
+
 def test_a_bad_marker_fault_stops_the_start():
     with pytest.raises(C2rvizError, match="unknown fault 'bogus'"):
         TestServer({"faults": ["bogus"], "record": False}).start()
