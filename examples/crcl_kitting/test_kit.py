@@ -6,7 +6,6 @@ parts ended (``assert_goals_met``, ``assert_part_at``).
 
 from __future__ import annotations
 
-import socket
 from pathlib import Path
 
 import pytest
@@ -30,20 +29,13 @@ START = {
 }
 """Where kitting.ini puts the parts, on the table [m, rad]."""
 
-pytestmark = pytest.mark.c2rviz(
-    ini=str(HERE / "kitting.ini"), clock="virtual", doors=True, rosbridge=False
-)
+pytestmark = pytest.mark.c2rviz(ini=str(HERE / "kitting.ini"), clock="virtual", crcl=True)
 
 
 @pytest.fixture
-def crcl_port(request: pytest.FixtureRequest) -> int:
-    """A free port for the server's CRCL door: ask for it before ``c2rviz`` (the server
-    reads it from the test's marks)."""
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = int(probe.getsockname()[1])
-    request.node.add_marker(pytest.mark.c2rviz(crcl_port=port))
-    return port
+def crcl_port(c2rviz_server) -> int:
+    """The server's CRCL door (``crcl=True``: opened alone, on a free port)."""
+    return c2rviz_server.crcl_port
 
 
 def run_kit(server, port: int, program: Path = KIT) -> int:
