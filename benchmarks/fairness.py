@@ -48,6 +48,7 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))  # this checkout's c2rviz
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
+from processes import Line  # noqa: E402
 from report import machine  # noqa: E402
 
 from c2rviz.transports.crcl import (  # noqa: E402
@@ -66,41 +67,6 @@ GOAL_PLANS_RATIO = 1.25  # ten plans at once: each within one plan alone x this
 GOAL_WHERE_P99_MS = 5.0
 GOAL = "0,90,0,0,0,0,0"  # [deg] the arm lying along +x, at its shoulder's height
 SHOULDER_Z, HALF, WALL, MOUTH_X, END_X = 0.41, 0.16, 0.02, 0.30, 1.40  # [m] the chimney
-
-
-class Line:
-    """One blocking TCP client of the text port: a line out, a line back."""
-
-    def __init__(self, port: int) -> None:
-        self.sock = socket.create_connection(("127.0.0.1", port), timeout=120)
-        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self.file = self.sock.makefile("rb")
-
-    def send(self, line: str) -> None:
-        self.sock.sendall(line.encode() + b"\n")
-
-    def read(self) -> str:
-        return self.file.readline().decode().rstrip("\n")
-
-    def ask(self, line: str) -> str:
-        self.send(line)
-        return self.read()
-
-    def ok(self, line: str) -> str:
-        reply = self.ask(line)
-        if not reply.startswith("ok"):
-            raise RuntimeError(f"{line!r}: {reply!r}")
-        return reply
-
-    def timed(self, line: str) -> float:
-        """The round trip of ``line`` [ms] (its reply must be ``ok...``)."""
-        began = time.perf_counter()
-        self.ok(line)
-        return (time.perf_counter() - began) * 1e3
-
-    def close(self) -> None:
-        self.file.close()
-        self.sock.close()
 
 
 class Program:
@@ -202,7 +168,7 @@ def during(reply_of: Line, work: Callable[[], float], least: int) -> list[float]
 
 
 def long_plan_rows(program: Program, plan_s: float, quick: bool) -> None:
-    planner, bystander = Line(program.text), Line(program.text)
+    planner, bystander = Line(("127.0.0.1", program.text)), Line(("127.0.0.1", program.text))
     build_chimney(planner)
     bystander.ok("degrees")
     pose = bystander.ok("pose")[3:]
@@ -245,7 +211,7 @@ def long_plan_rows(program: Program, plan_s: float, quick: bool) -> None:
 
 
 def ten_plans_row(program: Program, plan_s: float, count: int) -> None:
-    clients = [Line(program.text) for _ in range(count)]
+    clients = [Line(("127.0.0.1", program.text)) for _ in range(count)]
     for client in clients:
         client.ok("degrees")
         client.ok(f"plan timeout {plan_s:g}")
@@ -278,7 +244,7 @@ def ten_plans_row(program: Program, plan_s: float, count: int) -> None:
 
 def bystander_where(program: Program, load: Callable[[], None], name: str, what: str) -> None:
     """A bystander's ``where`` round trips while ``load()`` runs; the row."""
-    bystander = Line(program.text)
+    bystander = Line(("127.0.0.1", program.text))
     done = threading.Event()
     times: list[float] = []
 
@@ -455,7 +421,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("| row | figure | goal | |\n|---|---|---|---|")
         long_plan_rows(program, 0.5 if args.smoke else 2.0 if quick else 15.0, quick)
         ten_plans_row(program, 0.2 if args.smoke else 0.5 if quick else 1.0, 10)
-        clear = Line(program.text)
+        clear = Line(("127.0.0.1", program.text))
         clear.ok("object all remove")
         clear.ok("guard off")
         clear.close()

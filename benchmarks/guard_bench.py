@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import socket
 import statistics
 import sys
 import threading
@@ -38,40 +37,11 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from processes import Launched, launch  # noqa: E402
+from processes import Launched, Line, launch  # noqa: E402
 from report import machine  # noqa: E402
 
 GOAL_P99_MS = 5.0
 ISSUE_REST_S = {100: 0.90, 20: 4.0, 5: 16.0}  # rest after the stop before the change (issue 23.2)
-
-
-class Line:
-    """One blocking TCP client: a line out, a line back."""
-
-    def __init__(self, address: tuple[str, int]) -> None:
-        self.sock = socket.create_connection(address, timeout=120)
-        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self.file = self.sock.makefile("rb")
-
-    def send(self, line: str) -> None:
-        self.sock.sendall(line.encode() + b"\n")
-
-    def read(self) -> str:
-        return self.file.readline().decode().rstrip("\n")
-
-    def ask(self, line: str) -> str:
-        self.send(line)
-        return self.read()
-
-    def ok(self, line: str) -> str:
-        reply = self.ask(line)
-        if not reply.startswith("ok"):
-            raise RuntimeError(f"{line!r}: {reply!r}")
-        return reply
-
-    def close(self) -> None:
-        self.file.close()
-        self.sock.close()
 
 
 def fill_cell(client: Line, count: int, seed: int = 3) -> None:

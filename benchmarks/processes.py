@@ -62,6 +62,42 @@ class Launched:
                 self.popen.wait(timeout=10)
 
 
+class Line:
+    """One blocking TCP client of the text port: a line out, a line back (the benchmarks'
+    own, so each row measures the socket and not a client library)."""
+
+    def __init__(self, address: tuple[str, int]) -> None:
+        self.sock = socket.create_connection(address, timeout=120)
+        self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self.file = self.sock.makefile("rb")
+
+    def send(self, line: str) -> None:
+        self.sock.sendall(line.encode() + b"\n")
+
+    def read(self) -> str:
+        return self.file.readline().decode().rstrip("\n")
+
+    def ask(self, line: str) -> str:
+        self.send(line)
+        return self.read()
+
+    def ok(self, line: str) -> str:
+        reply = self.ask(line)
+        if not reply.startswith("ok"):
+            raise RuntimeError(f"{line!r}: {reply!r}")
+        return reply
+
+    def timed(self, line: str) -> float:
+        """The round trip of ``line`` [ms] (its reply must be ``ok...``)."""
+        began = time.perf_counter()
+        self.ok(line)
+        return (time.perf_counter() - began) * 1e3
+
+    def close(self) -> None:
+        self.file.close()
+        self.sock.close()
+
+
 def free_port() -> int:
     with socket.socket() as sock:
         sock.bind((HOST, 0))
