@@ -161,8 +161,12 @@ def test_a_killed_page_process_comes_back_and_commands_go_on(
         # applied: a later tab is opened until then.)
         both = {"/markers/motoman_sia20d/cube", "/markers/motoman_sia20d/sphere"}
         deadline = time.monotonic() + DEADLINE_S
-        while not both <= node_names(messages := scene(proc.viewer_url)):
-            assert time.monotonic() < deadline, node_names(messages)
+        # (the markers and the readouts come in frames of their own: wait for both)
+        while not (
+            both <= node_names(messages := scene(proc.viewer_url))
+            and "move 0 90" in gui_values(messages).get("Last commands", "")
+        ):
+            assert time.monotonic() < deadline, (node_names(messages), gui_values(messages))
             time.sleep(0.1)
         values = gui_values(messages)
         assert values["joint_s"] == pytest.approx(90.0)

@@ -31,7 +31,8 @@ def test_an_estop_is_crcl_error_until_reset(crcl_server, crcl_connect, connect) 
     assert text.ask("fault clear estop") == "ok"
     assert client.ask(51).command_status.description.endswith("(reset to move again)")
     assert text.ask("reset") == "ok"
-    assert client.run(actuate(4, {2: 0.3}), 4).command_status.state == DONE
+    after = client.run(actuate(4, {2: 0.3}), 4).command_status
+    assert after.state == DONE, after.description
     assert crcl_server.q[1] == pytest.approx(0.3)
 
 
