@@ -170,10 +170,14 @@ async def checked_move(
 
     Raises:
         PathCollides, PlanningError: refused (nothing moved).
+        FaultStop, MotionInterrupted: a stop holds the arm, or came while it was checked.
         PlanCancelled: its plan was cancelled (nothing moved).
         WorldChanged: the world changed under each of ``TRIES`` checks.
     """
     at_once = session.motion == "off" and plan != "always" and path_from is None
+    faults, state = session.world.faults, session.state
+    faults.refuse(state)  # a stop holds the arm: nothing to check
+    stops = faults.of(state.name).stops
     for _ in range(TRIES):
         if not at_once and session.travel.active:  # brake on the checked path first
             session.world.travels.stop(
@@ -183,6 +187,7 @@ async def checked_move(
         if at_once:
             start = session.now()
         asked, checked = await _check(session, start, goals, path_from, at_once, plan)
+        faults.refuse(state, stops)  # a stop came meanwhile: the move asked before it is over
         if not at_once:
             if session.travel.active and not session.travel.stopping:
                 raise ArmMoved(_TAKEN)  # not our brake: another command took the arm

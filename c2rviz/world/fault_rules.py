@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, TypeVar
 
 import numpy as np
 
-from ..errors import BadArguments, C2rvizError, shown
+from ..errors import BadArguments, C2rvizError, MotionInterrupted, shown
 from ..protocol.registry import usage
 from .clock import Clock, Timer
 from .faults import Fault, RobotFaults, Scheduled
@@ -96,13 +96,22 @@ class FaultRules(MoveRules):
 
     # What moves ask (Travels and World.set_q).
 
-    def refuse(self, state: RobotState) -> None:
-        """Raise why a move of ``state`` is refused now (a stop), if it is."""
+    def refuse(self, state: RobotState, stops: int | None = None) -> None:
+        """Raise why a move of ``state`` is refused now (a stop), if it is; and, given
+        ``stops`` (``of(robot).stops`` when the move was asked), why a move asked before a
+        stop that came since (and may be lifted now) is refused: it was asked of an arm
+        that stopped, and never plays after the stop's ``reset``."""
         faults = self.robots[state.name]
         if faults.latch is not None:
             error = faults.refusal(self.origin)
             if error is not None:
                 raise error
+        stop = faults.last_stop
+        if stops is not None and faults.stops != stops and stop is not None:
+            raise MotionInterrupted(
+                f"a stop ({stop.kind} at t={stop.since - self.origin:.3f}) came while this "
+                "move was checked; nothing moved, send it again"
+            )
 
     def follow(self, state: RobotState, q: tuple[float, ...]) -> tuple[float, ...]:
         """Where ``state``'s joints are when commanded to ``q``."""

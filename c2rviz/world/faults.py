@@ -137,6 +137,9 @@ class RobotFaults:
         latch: The stop that holds the robot, if any.
         held: Stalled joints: index -> the value it holds [rad or m].
         scheduled: Faults waiting for their time, soonest first.
+        stops: The stops that have held the robot, counted: a move checked off the loop
+            while one came (and maybe went) is refused (``FaultRules.refuse``).
+        last_stop: The latest of them (it may be lifted now).
     """
 
     joint_names: tuple[str, ...]
@@ -145,6 +148,8 @@ class RobotFaults:
     latch: Latch | None = None
     held: dict[int, float] = field(default_factory=dict)
     scheduled: list[Scheduled] = field(default_factory=list)
+    stops: int = 0
+    last_stop: Latch | None = None
 
     @property
     def any(self) -> bool:
@@ -164,13 +169,18 @@ class RobotFaults:
             self.active[fault.key] = (fault, self.active[fault.key][1])
         if fault.kind == "estop":
             if self.latch is None or self.latch.kind != "estop":
-                self.latch = Latch("estop", t)
-            self.latch.released = False
+                self._latch(Latch("estop", t))
+            else:
+                self.latch.released = False  # engaged again before its reset
         elif fault.kind == "protective" and self.latch is None:
-            self.latch = Latch("protective", t)
+            self._latch(Latch("protective", t))
         elif fault.kind == "stall" and fault.joint is not None:
             self.held.setdefault(fault.joint, q[fault.joint])
         return events
+
+    def _latch(self, latch: Latch) -> None:
+        self.latch = self.last_stop = latch
+        self.stops += 1
 
     def clear(self, what: str) -> list[str]:
         """End the active faults of kind ``what`` (``all``: every one, and every scheduled

@@ -4,12 +4,18 @@ seed (noise and jitter included)."""
 
 from __future__ import annotations
 
+import asyncio
+import inspect
 import re
 
 import pytest
-from support import Client
+from support import Client, load_robot
 
+from c2rviz.errors import MotionInterrupted
+from c2rviz.session import Session
+from c2rviz.session.services import Services
 from c2rviz.testing.server import TestServer
+from c2rviz.world.world import World
 
 FAR = "1,0.5,0.3,-0.5,0.2,0.5,0.1"  # radians, motoman_sia20d
 STOP_RE = re.compile(r"emergency stop since t=(\d+\.\d{3}) \(fault clear estop, then reset\)")
@@ -304,3 +310,38 @@ def test_a_stop_refuses_the_gripper_too(c2rviz_server, connect):
     assert client.ask("grip") == "ok 1"
     assert client.ask("reset") == "ok"
     assert client.ask("grip 0") == "ok"
+
+
+@pytest.mark.parametrize("verb", ["joints", "movel"])
+def test_a_move_checked_while_a_stop_came_and_went_never_plays(verb) -> None:
+    """A move asked before an estop whose check (or line) is still off the loop when the
+    estop is cleared and reset is refused, never played after the reset (a CRCL test saw
+    the move asked during the stop arrive after it, under load)."""
+
+    async def run() -> None:
+        services = Services(World(load_robot("motoman_sia20d")))
+        mover, pendant = Session(services, "mover"), Session(services, "pendant")
+        for setting in ("joints " + FAR, "motion on", "guard on"):  # away from the upright
+            assert mover.run(setting) == "ok"
+        start = mover.state.q
+        x, y, z, *rpy = values(str(mover.run("pose")))
+        line = (
+            "joints " + FAR
+            if verb == "joints"
+            else f"movel {x},{y},{z - 0.05},{rpy[0]},{rpy[1]},{rpy[2]}"
+        )
+        asked = asyncio.ensure_future(_awaited(mover.run(line)))
+        await asyncio.sleep(0)  # it has asked the worker, which answers on a later turn
+        for step in ("fault estop", "fault clear estop", "reset"):
+            assert pendant.run(step) == "ok", step
+        with pytest.raises(MotionInterrupted, match=r"a stop \(estop at t=0\.\d{3}\) came while"):
+            await asyncio.wait_for(asked, 100.0)
+        assert mover.state.q == start and not mover.travel.active
+        assert await _awaited(mover.run(line)) == "ok"  # asked after the reset: it plays
+        services.close()
+
+    asyncio.run(run())
+
+
+async def _awaited(reply: object) -> object:
+    return await reply if inspect.isawaitable(reply) else reply

@@ -89,11 +89,14 @@ async def plan_straight(
     if start is None and session.travel.active:
         raise ArmMoved("movel starts from rest: send wait (or stop) first")
     first, tool_offset = tuple(state.q if start is None else start), state.tool
-    worker = session.services.worker
+    worker, faults = session.services.worker, session.world.faults
     solver = worker.ik_solver(state)
+    stops = faults.of(state.name).stops
     line = await worker.run(lambda: plan_line(solver, first, goal, tool_offset), owner=session)
     if start is None and (state.q != first or session.travel.active):
         raise ArmMoved("the arm moved while the line was planned: send movel again")
+    if start is None:
+        faults.refuse(state, stops)  # a stop came while it was planned
     waypoints = [waypoint.q for waypoint in line.waypoints]
     allowed: frozenset[tuple[str, str]] = frozenset()
     if session.guard:  # the whole line, off the loop
