@@ -22,11 +22,11 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # what type checkers see of the lazy names below
+    from .clients.arm_calls import PlanSummary
     from .clients.async_client import AsyncClient
     from .clients.client import Client
     from .clients.connect import ServerUnavailable
     from .clients.errors import CommandError, ConnectionLost
-    from .clients.plan_verbs import PlanSummary
     from .clients.records import Event, JointLimit, Pose, State
 
 __all__ = [
@@ -75,7 +75,7 @@ _HOME.update(  # a controller's side: the clients (no Pinocchio, no viser)
         "Event": "clients.records",
         "JointLimit": "clients.records",
         "Pose": "clients.records",
-        "PlanSummary": "clients.plan_verbs",
+        "PlanSummary": "clients.arm_calls",
         "ServerUnavailable": "clients.connect",
         "State": "clients.records",
     }

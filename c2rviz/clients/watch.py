@@ -3,7 +3,7 @@
 ``watch_lines`` opens a connection of its own (``stream.WatchStream``), asks
 ``watch [HZ]`` and yields the stream's lines; ``watch_main`` is ``c2rviz-cli --watch``,
 and the REPL's local ``watch`` prints the same lines until Ctrl-C. Lines are printed
-with control characters escaped (``text.shown``).
+with control characters escaped (``display.shown``).
 """
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ from ..errors import C2rvizError
 from ..protocol.grammar import parse_line
 from ..protocol.verbs.observe import Watch
 from .connect import ServerUnavailable
+from .display import shown
 from .stream import WatchStream
-from .text import shown
 
 __all__ = ["watch_lines", "watch_main"]
 
