@@ -20,7 +20,7 @@ from ...planning.edge_resolution import RANGES
 from ...planning.errors import checked_setting
 from ...protocol import replies
 from ...protocol.registry import Reply, handler, usage
-from ...protocol.verbs.planning import Plan
+from ...protocol.verbs.workcell import Plan
 from ..guarded import checked_move, play_checked
 
 if TYPE_CHECKING:
