@@ -6,8 +6,8 @@ module                    verb families (``protocol.verbs``)
 ========================  ==============================================================
 ``arm``                   ``joints``, ``motion``: the arm moved by its joints
 ``cartesian``             ``cartesian``: the tool, IK, moves to a tool pose
-``planning``              ``planning``: ``plan``, a path around obstacles
-``scene``                 ``markers``, ``workcell``, ``cell``: what the scene holds
+``scene``                 ``markers``, ``workcell``, ``cell``: what the scene holds, and
+                          ``plan``: a path around it
 ``parts``                 ``parts``: the gripper, parts, goals, the score
 ``cameras``               ``cameras``
 ``faults``                ``faults``
@@ -20,7 +20,7 @@ The import below is the whole list: importing this package registers every handl
 ``tests/protocol/test_registry.py`` checks that every verb has exactly one).
 """
 
-from . import arm, cameras, cartesian, faults, observe, parts, planning, queries, scene
+from . import arm, cameras, cartesian, faults, observe, parts, queries, scene
 
 __all__ = [
     "arm",
@@ -29,7 +29,6 @@ __all__ = [
     "faults",
     "observe",
     "parts",
-    "planning",
     "queries",
     "scene",
 ]
