@@ -23,8 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # what type checkers see of the lazy names below
     from .clients.arm_calls import PlanSummary
-    from .clients.async_client import AsyncClient
-    from .clients.client import Client
+    from .clients.client import AsyncClient, Client
     from .clients.connect import ServerUnavailable
     from .clients.errors import CommandError, ConnectionLost
     from .clients.records import Event, JointLimit, Pose, State
@@ -68,7 +67,7 @@ _HOME = {
 
 _HOME.update(  # a controller's side: the clients (no Pinocchio, no viser)
     {
-        "AsyncClient": "clients.async_client",
+        "AsyncClient": "clients.client",
         "Client": "clients.client",
         "CommandError": "clients.errors",
         "ConnectionLost": "clients.errors",

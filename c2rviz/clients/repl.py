@@ -36,7 +36,7 @@ from ..protocol.registry import usages
 from .client import Client, ServerUnavailable, add_connection_args, server_address
 from .errors import CommandError, UnexpectedReply
 from .repl_local import LOCAL_USAGE, LocalCommands
-from .watch import watch_lines, watch_main
+from .stream import watch_lines, watch_main
 
 __all__ = ["LOCAL_USAGE", "Repl", "build_parser", "main", "watch_lines"]
 

@@ -25,7 +25,7 @@ from .display import shown
 from .goto import motion_of, step, target_problem, travel
 from .player import Progress, play
 from .script import check_robot, load_script, robot_mismatch
-from .watch import watch_lines
+from .stream import watch_lines
 
 __all__ = ["DEFAULT_STEP_DEG", "LOCAL_USAGE", "LocalCommands"]
 
