@@ -8,8 +8,7 @@ module                    verb families (``protocol.verbs``)
 ``cartesian``             ``cartesian``: the tool, IK, moves to a tool pose
 ``scene``                 ``markers``, ``workcell``, ``cell``: what the scene holds, and
                           ``plan``: a path around it
-``parts``                 ``parts``: the gripper, parts, goals, the score
-``cameras``               ``cameras``
+``parts``                 ``parts``: the gripper, parts, goals, the score; ``cameras``
 ``faults``                ``faults``
 ``queries``               ``queries``: questions, and ``sleep``, ``bye``, ``quit``
 ``observe``               ``observe``: watch, trail, ghost, and record
@@ -20,11 +19,10 @@ The import below is the whole list: importing this package registers every handl
 ``tests/protocol/test_registry.py`` checks that every verb has exactly one).
 """
 
-from . import arm, cameras, cartesian, faults, observe, parts, queries, scene
+from . import arm, cartesian, faults, observe, parts, queries, scene
 
 __all__ = [
     "arm",
-    "cameras",
     "cartesian",
     "faults",
     "observe",
