@@ -50,7 +50,8 @@ __all__ = [
     "World",
     "parse_line",
 ]
-from .version import __version__
+__version__ = "0.2.0"
+"""The version of c2rviz (the ``version`` verb and the package report it)."""
 
 _HOME = {
     "C2rvizError": "errors",
