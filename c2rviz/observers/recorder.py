@@ -46,7 +46,7 @@ from ..world.cameras import Camera
 from ..world.effects import Marker, Observer
 from ..world.parts import Part
 from ..world.world import World
-from .camera_records import CameraSignature, camera_changes, camera_signature
+from .camera_feed import CameraSignature, camera_changes, camera_signature
 from .record_cell import (
     FaultLines,
     PartSignature,
@@ -226,7 +226,7 @@ class Recorder(Observer):
             self.on_joints(self.robot, self.state.q, t)
 
     def on_cameras(self, cameras: Sequence[Camera]) -> None:
-        """The cameras as commands, whenever they change (camera_records)."""
+        """The cameras as commands, whenever they change (camera_feed)."""
         if not self.closed and camera_signature(cameras) != self._cameras:
             self._catch_up(self.world.clock.now())
             self._write(self._body, camera_changes(self._cameras, cameras))
