@@ -6,13 +6,16 @@ arm moves in a viser page. A controller talks to it with ``Client`` (blocking) o
 ``AsyncClient`` (asyncio): one typed method per verb (docs/testing.md). The parts, each
 usable alone:
 
-- ``commands``: the pure parser (line -> frozen command);
-- ``robot`` / ``sources``: the Pinocchio model and its serial chain, and where
-  its URDF and meshes come from;
+- ``protocol``: the pure parser (line -> frozen command), the verbs and the replies;
+- ``robot``: the Pinocchio model and its serial chain, and where its URDF and meshes
+  come from;
 - ``session`` / ``world``: one client's units and the shared state;
-- ``server``: the asyncio TCP server;
-- ``scene`` / ``viewer``: what is drawn, and the viser implementation;
-- ``config`` / ``cli``: cmdinterpreter.ini, flags, ``main``.
+- ``transports``: the doors (the text TCP port, CRCL, rosbridge);
+- ``view``: what is drawn, with viser;
+- ``app``: cmdinterpreter.ini, flags, ``main``;
+- ``clients``: ``Client``, ``AsyncClient``, the REPL and the player.
+
+docs/architecture.md has every package and module.
 
 Importing the package is cheap (the clients use the parser alone); the heavy
 parts (Pinocchio, viser) load when first named.
