@@ -6,13 +6,16 @@ arm moves in a viser page. A controller talks to it with ``Client`` (blocking) o
 ``AsyncClient`` (asyncio): one typed method per verb (docs/testing.md). The parts, each
 usable alone:
 
-- ``commands``: the pure parser (line -> frozen command);
-- ``robot`` / ``sources``: the Pinocchio model and its serial chain, and where
-  its URDF and meshes come from;
+- ``protocol``: the pure parser (line -> frozen command), the verbs and the replies;
+- ``robot``: the Pinocchio model and its serial chain, and where its URDF and meshes
+  come from;
 - ``session`` / ``world``: one client's units and the shared state;
-- ``server``: the asyncio TCP server;
-- ``scene`` / ``viewer``: what is drawn, and the viser implementation;
-- ``config`` / ``cli``: cmdinterpreter.ini, flags, ``main``.
+- ``transports``: the doors (the text TCP port, CRCL, rosbridge);
+- ``view``: what is drawn, with viser;
+- ``app``: cmdinterpreter.ini, flags, ``main``;
+- ``clients``: ``Client``, ``AsyncClient``, the REPL and the player.
+
+docs/architecture.md has every package and module.
 
 Importing the package is cheap (the clients use the parser alone); the heavy
 parts (Pinocchio, viser) load when first named.
@@ -22,11 +25,10 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # what type checkers see of the lazy names below
-    from .clients.async_client import AsyncClient
-    from .clients.client import Client
+    from .clients.arm_calls import PlanSummary
+    from .clients.client import AsyncClient, Client
     from .clients.connect import ServerUnavailable
     from .clients.errors import CommandError, ConnectionLost
-    from .clients.plan_verbs import PlanSummary
     from .clients.records import Event, JointLimit, Pose, State
 
 __all__ = [
@@ -51,7 +53,8 @@ __all__ = [
     "World",
     "parse_line",
 ]
-from .version import __version__
+__version__ = "0.2.0"
+"""The version of c2rviz (the ``version`` verb and the package report it)."""
 
 _HOME = {
     "C2rvizError": "errors",
@@ -68,14 +71,14 @@ _HOME = {
 
 _HOME.update(  # a controller's side: the clients (no Pinocchio, no viser)
     {
-        "AsyncClient": "clients.async_client",
+        "AsyncClient": "clients.client",
         "Client": "clients.client",
         "CommandError": "clients.errors",
         "ConnectionLost": "clients.errors",
         "Event": "clients.records",
         "JointLimit": "clients.records",
         "Pose": "clients.records",
-        "PlanSummary": "clients.plan_verbs",
+        "PlanSummary": "clients.arm_calls",
         "ServerUnavailable": "clients.connect",
         "State": "clients.records",
     }

@@ -1,4 +1,4 @@
-"""What an ini puts in the world beside the robots: parts and logical cameras.
+"""What an ini puts in the world beside the robots: parts, logical cameras and faults.
 
 Parts: ``[parts]`` (around the first robot) and ``[parts:NAME]`` (around robot NAME of a
 cell), one per line, in that robot's base frame::
@@ -19,11 +19,20 @@ Cameras: ``[cameras]``, one per line, in the world frame (metres, degrees)::
 The pose, then optionally h_fov,v_fov (deg),range (m), ``rate=HZ`` and
 ``noise=SIGMA_M,SIGMA_DEG``: the ``camera`` verb's words (docs/cameras.md), each checked
 again when the camera is placed (a bad one is an error that names it).
+
+Faults: ``[faults]`` (the first robot's) and ``[faults:ROBOT]``, each entry a ``fault``
+command's arguments, started or scheduled when the server starts::
+
+    [faults]
+    # name = what `fault` takes (radians; `at T` counts from the server's start)
+    early_stop = at 5 estop
+    shaky = noise 0.002
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,7 +40,10 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import C2rvizError, ConfigError
+from ..protocol.verbs.faults import FaultVerb
+from ..robot.model import Robot
 from ..world.cameras import DEFAULT_FOV_RAD, DEFAULT_RANGE_M, MAX_RATE_HZ, Camera
+from ..world.faults import Fault, to_fault
 from ..world.world import World
 from .robot_options import ini_entries, ini_numbers, pose_from
 
@@ -140,3 +152,39 @@ def _numbers(where: str, text: str, needed: int) -> list[float]:
     if not all(map(math.isfinite, values)) or len(values) != needed:
         raise ConfigError(f"{where}: {text!r} must be {needed} finite numbers")
     return values
+
+
+IniFault = tuple[FaultVerb, Fault]
+"""A fault of the ini: the command as read, and the fault it starts (SI)."""
+
+
+def ini_faults(ini: Path, name: str, robot: Robot, first: bool) -> list[IniFault]:
+    """The faults the ini gives robot ``name`` (``[faults]`` too when it is the first).
+
+    Raises:
+        ConfigError: an entry ``fault`` would refuse, naming it and why.
+    """
+    found: list[IniFault] = []
+    for where, _, text in ini_entries(ini, "faults", name, first):
+        try:
+            command = FaultVerb.parse("fault", text.split())
+            if command.spec is None:
+                raise ConfigError("clear is not a fault to start")
+            fault = to_fault(name, robot.joint_names, 1.0, command.spec)
+        except C2rvizError as exc:
+            raise ConfigError(f"{where} = {text!r}: {exc}") from None
+        found.append((command, fault))
+    return found
+
+
+def start_faults(world: World, robot: str, commands: Sequence[IniFault]) -> None:
+    """Start or schedule the ini's faults of ``robot`` (``at T``: from the server's start;
+    a time already past starts it now)."""
+    rules = world.faults
+    for command, fault in commands:
+        if command.at_s is not None:
+            rules.schedule(robot, fault, rules.origin + command.at_s)
+        elif command.after_s is not None:
+            rules.schedule(robot, fault, world.clock.now() + command.after_s)
+        else:
+            rules.start(robot, fault)

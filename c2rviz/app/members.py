@@ -20,8 +20,7 @@ from ..robot.model import Robot
 from ..world.world import World
 from .cell import load_cell
 from .config import Settings
-from .ini_faults import IniFault, ini_faults, start_faults
-from .ini_world import IniPart, ini_parts
+from .ini_world import IniFault, IniPart, ini_faults, ini_parts, start_faults
 from .robot_options import IniObject, gripper_from, ini_objects, limits_from, tool_from
 
 __all__ = ["Member", "furnish", "members"]

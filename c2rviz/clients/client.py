@@ -11,7 +11,8 @@
 
 Every verb of the command language (``protocol.registry.VERBS``) has a method here
 (``speaks`` tags it) taking typed arguments and returning a typed result (``records``);
-the methods are written once, for ``AsyncClient`` (``aio_verbs``, ``aio_scene_verbs``),
+the methods are written once, for ``AsyncClient`` (below; ``aio_verbs``,
+``aio_scene_verbs``),
 and ``scripts/unasync_clients.py`` writes their blocking twins (``verbs``,
 ``scene_verbs``). A verb of the registry with no typed method yet is still a method:
 ``robot.VERB(*words)`` sends the line and returns its ``ok`` reply, as ``send`` does.
@@ -22,13 +23,40 @@ the server's message; a server gone mid-call raises ``ConnectionLost`` (a
 ``ConnectionError``) naming the command, also when it said it is shutting down
 (``ServerShutdown``, a ``CommandError`` too).
 ``send(line)`` sends any line as typed. The REPL and the player use this client too.
+
+``AsyncClient``: ``Client`` for asyncio, the same methods as coroutines.
+
+::
+
+    import asyncio
+    from c2rviz import AsyncClient
+
+    async def main() -> None:
+        async with AsyncClient(port=31000) as robot:
+            await robot.motion("on")
+            await robot.joints([0.5, 0, 0, 0, 0, 0, 0])   # [rad]; returns on arrival
+            print(await robot.where())
+
+    asyncio.run(main())
+
+Every method takes the arguments of ``Client``'s of the same name, in the same units
+(radians and metres, or degrees once the connection chose them), checks them before
+anything is sent, and returns the same record: the verbs are written once, here
+(``aio_verbs``, ``aio_scene_verbs``), and ``Client``'s are generated from them.
+Calls on one client are taken in turn; open several clients to have several commands
+waiting at once (each is a connection, a session of its own).
 """
 
 from __future__ import annotations
 
 from typing import TypeVar
 
+from ..errors import C2rvizError
+from ..protocol.grammar import parse_line
 from ..protocol.replies import SHUTTING_DOWN
+from .aio_lines import AsyncLineClient, AsyncWatchStream
+from .aio_scene_verbs import AsyncSceneVerbs
+from .aio_verbs import AsyncVerbs
 from .calls import Call, count_problem, read_call, speaks
 from .connect import ServerUnavailable
 from .errors import CommandError, ConnectionLost, ServerShutdown
@@ -39,6 +67,7 @@ from .stream import WatchStream
 from .verbs import Verbs
 
 __all__ = [
+    "AsyncClient",
     "COMMANDS_DIR",
     "Client",
     "ConnectionLost",
@@ -48,6 +77,7 @@ __all__ = [
     "find_script",
     "server_address",
 ]
+
 
 T = TypeVar("T")
 
@@ -116,6 +146,63 @@ class Client(LineClient, Verbs, SceneVerbs):
             hz: Most ``state`` lines a second [1/s] (None: the server's frame rate).
         """
         return WatchStream(
+            self.host,
+            self.port,
+            hz,
+            degrees=self.in_degrees,
+            robot=self.chosen_robot,
+            max_line=self.max_reply,
+        )
+
+
+class AsyncClient(AsyncLineClient, AsyncVerbs, AsyncSceneVerbs):
+    """An asyncio connection with a coroutine per verb; arguments as ``Client``'s.
+
+    It connects when entering ``async with`` or at the first call; after a lost
+    connection the next call reconnects (restoring the units and the robot).
+    """
+
+    async def __aenter__(self) -> AsyncClient:
+        await self.open()
+        return self
+
+    async def call(self, call: Call[T]) -> T:
+        """Send ``call``'s line and read its reply (see ``Client.call``)."""
+        if call.joint_count is not None or call.highest_index is not None:
+            names = await self.joint_names()
+            count_problem(call, self.robot_name or "the robot", names)
+        reply = await self.ask(call.line, call.track)
+        if reply == SHUTTING_DOWN:  # the server goes away mid-call: ConnectionLost's case
+            await self.close()
+            raise ServerShutdown(self.host, self.port, call.line, reply)
+        return read_call(call, reply)
+
+    async def send(self, line: str) -> str:
+        """Send one line as typed; return its ``ok`` reply (``CommandError`` for an error).
+
+        Raises:
+            ValueError: the line is blank or only a comment (nothing would answer).
+        """
+        try:
+            command = parse_line(line)
+        except C2rvizError:
+            command = False  # the server will answer with an error
+        if command is None:
+            raise ValueError(f"{line!r} is not a command: the server would not answer")
+        text = line.strip()
+        reply = await self.ask(text, command)
+        if reply == SHUTTING_DOWN:
+            await self.close()
+            raise ServerShutdown(self.host, self.port, text, reply)
+        if reply.startswith("error"):
+            raise CommandError(text, reply)
+        return reply
+
+    @speaks("watch")
+    def watch(self, hz: float | None = None) -> AsyncWatchStream:
+        """The ``watch`` stream on a connection of its own (``async for`` its ``State`` and
+        ``Event`` records; ``async with`` or ``close()``); ``hz``: most states a second."""
+        return AsyncWatchStream(
             self.host,
             self.port,
             hz,

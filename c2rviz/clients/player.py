@@ -49,8 +49,8 @@ from .client import (
     find_script,
     server_address,
 )
+from .display import Progress, shown
 from .goto import motion_of
-from .progress import Progress
 from .script import (
     Script,
     ScriptLine,
@@ -60,7 +60,6 @@ from .script import (
     robot_mismatch,
     waits_for_the_arm,
 )
-from .text import shown
 
 __all__ = [
     "Progress",

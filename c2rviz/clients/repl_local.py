@@ -21,11 +21,11 @@ from ..protocol.verbs.observe import Watch
 from ..protocol.verbs.queries import Sleep
 from .bag_play import is_bag, play_in_repl
 from .client import Client, ConnectionLost, find_script
+from .display import shown
 from .goto import motion_of, step, target_problem, travel
 from .player import Progress, play
 from .script import check_robot, load_script, robot_mismatch
-from .text import shown
-from .watch import watch_lines
+from .stream import watch_lines
 
 __all__ = ["DEFAULT_STEP_DEG", "LOCAL_USAGE", "LocalCommands"]
 
@@ -119,11 +119,11 @@ class LocalCommands:
         """Each local word's runner: it returns False when the REPL should end."""
 
     def say(self, message: str) -> None:
-        """A connection message (the server's text in it escaped: ``text.shown``)."""
+        """A connection message (the server's text in it escaped: ``display.shown``)."""
         print(shown(message), file=self.info, flush=True)
 
     def show(self, message: str) -> None:
-        """A reply or a result (the server's text in it escaped: ``text.shown``)."""
+        """A reply or a result (the server's text in it escaped: ``display.shown``)."""
         print(shown(message), file=self.out, flush=True)
 
     def ask(self, line: str) -> str:

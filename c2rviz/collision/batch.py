@@ -61,7 +61,7 @@ class CheckGeometry:
     revision: int
     touch: frozenset[str] = frozenset()
     """Links that may touch parts (the fingers): never checked against another robot's
-    held part (``part_checks``)."""
+    held part (``checks.held_as_links``)."""
     parts: frozenset[str] = frozenset()
     """Every part's name."""
     other_touch: frozenset[str] = frozenset()

@@ -27,9 +27,16 @@ import pinocchio as pin
 
 from ..robot.model import Robot
 from .batch import BatchCheck, CheckGeometry, PlacedShape
-from .checks import DEFAULT_SAMPLES, build_checks, choose_pairs, hits
+from .checks import (
+    DEFAULT_SAMPLES,
+    PartShape,
+    build_checks,
+    choose_pairs,
+    held_as_links,
+    held_shapes,
+    hits,
+)
 from .geometry import CollisionError, Pair, moving_joints, ordered_pair, robot_geometry
-from .part_checks import PartShape, held_as_links, held_shapes
 from .workcell import MAX_OBJECTS, Workcell, WorkcellObject
 
 MAX_STEP_RAD = math.radians(1.0)  # guarded paths: most a revolute joint moves between checks
@@ -227,7 +234,7 @@ class CollisionModel:
         names: frozenset[str] = frozenset(),
         other_touch: frozenset[str] = frozenset(),
     ) -> None:
-        """The parts now (``part_checks.add_parts`` says how each is checked); ``touch``:
+        """The parts now (``checks.add_parts`` says how each is checked); ``touch``:
         this robot's links that may touch parts, ``names``: every part's (those other
         robots hold too), ``other_touch``: the other robots' links that may touch a part
         (as ``robot/link``)."""

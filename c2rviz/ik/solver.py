@@ -31,12 +31,10 @@ import numpy as np
 import pinocchio as pin
 
 from ..robot.model import Robot
-from .chain import IkChain
+from .chain import IkChain, ReachBound
 from .newton import Descent, NewtonDescent
-from .reach import ReachBound
 from .seeds import SeedPool
-from .target import Goal, PointTarget, Target, goal_in_world
-from .unreachable import Unreachable
+from .target import Goal, PointTarget, Target, Unreachable, goal_in_world
 
 __all__ = ["Attempt", "IkSettings", "IkSolver", "PointTarget", "Target", "Unreachable"]
 

@@ -1,13 +1,11 @@
 """Moves that take time, pure (no asyncio, no clock of their own: times are the caller's):
-the ruckig planner (``planner``), the joints' motion limits (``limits``), a joint
-path played along its own timing (``line_play``), timed joint points planned and
-checked whole (``trajectory``), and what any path played on the clock offers, with the
-trajectory's play (``path_play``).
+the ruckig planner (``planner``), the joints' motion limits (``limits``), timed joint
+points planned and checked whole (``trajectory``), and what any path played on the clock
+offers, with the straight line's and the trajectory's plays (``path_play``).
 """
 
 from .limits import MotionLimitError, MotionLimits, motion_limits
-from .line_play import LinePlay, brake_limits, ramp_limits
-from .path_play import PathPlay, TrajectoryPlay
+from .path_play import LinePlay, PathPlay, TrajectoryPlay, brake_limits, ramp_limits
 from .planner import Motion, MotionPlanError
 from .trajectory import PlannedTrajectory, TrajectoryError, plan_trajectory
 

@@ -19,7 +19,7 @@ or for several robots of a cell at once:
   or changed, DELETE when removed), in the frames the page shows them in;
 - the parts (``bag_parts``): each one's frame ``parts/NAME`` on ``/tf`` as they move,
   and a marker of it (namespace ``parts``) on the first robot's marker topic;
-- each logical camera's reports (``camera_records``): ``/c2rviz/cameras/NAME``
+- each logical camera's reports (``camera_feed``): ``/c2rviz/cameras/NAME``
   (``geometry_msgs/msg/PoseArray`` in the frame ``cameras/NAME``) at its rate on the
   world's clock, and its frames on ``/tf`` (``cameras/NAME``, ``cameras/NAME/PART``);
 - ``/c2rviz/commands``: each accepted command as ``SOURCE: LINE``, and
@@ -56,8 +56,7 @@ from ..world.state import MAX_MARKERS, Marker, RobotState
 from ..world.world import World
 from .bag_parts import PartFrames, part_transforms
 from .bag_topics import TextLines, marker_message, namespaces, object_message, xyz_xyzw
-from .camera_feed import CameraFeed
-from .camera_records import CAMERA_TOPIC, POSE_ARRAY, camera_items, pose_array
+from .camera_feed import CAMERA_TOPIC, POSE_ARRAY, CameraFeed, camera_items, pose_array
 
 if TYPE_CHECKING:
     from ..collision.workcell import WorkcellObject
@@ -148,7 +147,7 @@ class BagRecorder(Observer):
         self.part_frames = PartFrames(world.frame_s)
         if world.parts.parts.all():
             self.on_parts(world.parts.parts.all(), t0)
-        self.cameras = CameraFeed(world, self._camera)  # each camera's reports (camera_records)
+        self.cameras = CameraFeed(world, self._camera)  # each camera's reports (camera_feed)
         self.cameras.sync(True)
 
     def _t(self) -> float:

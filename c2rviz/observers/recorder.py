@@ -46,19 +46,20 @@ from ..world.cameras import Camera
 from ..world.effects import Marker, Observer
 from ..world.parts import Part
 from ..world.world import World
-from .camera_records import CameraSignature, camera_changes, camera_signature
-from .record_faults import FaultLines, opening_lines
-from .record_files import RecordFiles, body_tally, cut_to_line, join_body
-from .record_parts import (
+from .camera_feed import CameraSignature, camera_changes, camera_signature
+from .record_cell import (
+    FaultLines,
     PartSignature,
     csv_columns,
     csv_poses,
     exact,
     object_lines,
+    opening_lines,
     part_changes,
     signature,
     workcell_lines,
 )
+from .record_files import RecordFiles, body_tally, cut_to_line, join_body
 from .recorded import FrameSink, Recorded, header
 
 __all__ = ["BUFFER_BYTES", "FLUSH_S", "FrameSink", "Recorded", "Recorder"]
@@ -194,7 +195,7 @@ class Recorder(Observer):
 
     def on_part_event(self, robot: str | None, text: str) -> None:
         """A grasp that drew for a slip: its outcome goes before its ``grip`` line, so the
-        replay makes the same grasp (record_faults)."""
+        replay makes the same grasp (record_cell)."""
         if robot == self.robot and not self.closed:
             line = self._faults.outcome(self.world.faults.of(robot), text)
             if line is not None:
@@ -225,7 +226,7 @@ class Recorder(Observer):
             self.on_joints(self.robot, self.state.q, t)
 
     def on_cameras(self, cameras: Sequence[Camera]) -> None:
-        """The cameras as commands, whenever they change (camera_records)."""
+        """The cameras as commands, whenever they change (camera_feed)."""
         if not self.closed and camera_signature(cameras) != self._cameras:
             self._catch_up(self.world.clock.now())
             self._write(self._body, camera_changes(self._cameras, cameras))

@@ -33,20 +33,20 @@ from ..errors import C2rvizError
 from ..world.effects import Observer
 from ..world.state import RobotState
 from ..world.world import World
-from .record_errors import (
+from .record_files import RecordFiles, existing, is_bag_folder, links
+from .record_finish import Exporter, Recording, finish
+from .recorded import (
     AlreadyRecording,
     LinkedName,
     NameInUse,
     NotABagFolder,
     NotRecording,
     NotYourRecording,
+    Recorded,
     RecordFolderError,
     RecordingError,
     RecordingExists,
 )
-from .record_files import RecordFiles, existing, is_bag_folder, links
-from .record_finish import Exporter, Recording, finish
-from .recorded import Recorded
 from .recorder import Recorder
 
 if TYPE_CHECKING:  # rosbags is loaded at the first recording, not at start

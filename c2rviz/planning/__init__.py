@@ -4,10 +4,10 @@
 workcell and the other robots of a cell, at the resolution of
 ``edge_resolution.py``; ``plan_for``/``plan_path`` (``ompl_planner.py``) plan
 with RRT-Connect and shorten the path; ``time_path`` (``timing.py``) turns the
-waypoints into a motion that stays on them. The guard's path check
-(``path_check.py``: contacts at the start may be left), several IK answers of a
+waypoints into a motion that stays on them. Several IK answers of a
 pose to plan to (``ik_goals.py``), and a move checked or planned off the event
-loop (``guarded_move.py``) build on them. No asyncio and no world here: the
+loop with the guard's path check (``guarded_move.py``: contacts at the start may be
+left) build on them. No asyncio and no world here: the
 caller owns the clock.
 """
 
@@ -29,10 +29,16 @@ from .errors import (
     PlanningError,
     StartCollides,
 )
-from .guarded_move import PLAN_MODES, CheckedMove, MoveChecker, MoveRequest
+from .guarded_move import (
+    PLAN_MODES,
+    CheckedMove,
+    MoveChecker,
+    MoveRequest,
+    first_blocked,
+    path_points,
+)
 from .ik_goals import goal_candidates
 from .ompl_planner import MAX_TIMEOUT_S, SEEDS, EdgeCheck, PlannedPath, plan_for, plan_path
-from .path_check import first_blocked, path_points
 from .timing import TimedPath, TimingFailed, time_path
 from .validity import PlacedShape, ValidityChecker, robot_shapes
 

@@ -13,7 +13,7 @@ clock's seconds. Both return a handle with ``cancel()``.
 - ``Clock``: real time, the monotonic clock asyncio's loop runs on (``--clock real``).
 - ``ScaledClock(factor)``: time runs ``factor`` times faster than real time (its
   timers fire ``factor`` times sooner), from the moment it is made (``scaled:N``).
-- ``virtual_clock.VirtualClock``: time jumps to the next timer whenever nobody is busy
+- ``clocks.VirtualClock``: time jumps to the next timer whenever nobody is busy
   (``virtual``): a program runs as fast as the CPU allows, with the same replies, the
   same order and the same stamps as in real time.
 

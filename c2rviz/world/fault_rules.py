@@ -29,9 +29,8 @@ from ..protocol.registry import usage
 from .clock import Clock, Timer
 from .faults import Fault, RobotFaults, Scheduled
 from .latency import LateSends, late
-from .move_rules import MoveRules
 from .moves import Travels
-from .state import RobotState
+from .state import MoveRules, RobotState
 
 if TYPE_CHECKING:
     from .cameras import Cameras

@@ -18,8 +18,7 @@ from dataclasses import dataclass, field
 from ..errors import MotionInterrupted
 from ..protocol import replies
 from .clock import Clock, Timer
-from .move_rules import MoveRules
-from .state import RobotState
+from .state import MoveRules, RobotState
 
 __all__ = ["Grip", "Grips"]
 

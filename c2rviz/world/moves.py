@@ -20,8 +20,7 @@ from ..motion.path_play import PathPlay
 from ..motion.planner import Motion, MotionLimits
 from ..protocol import replies
 from .clock import Clock, Timer
-from .move_rules import MoveRules
-from .state import RobotState
+from .state import MoveRules, RobotState
 
 __all__ = ["TICK_ROBOTS", "MoveRules", "Travel", "Travels"]
 

@@ -22,10 +22,9 @@ import pinocchio as pin
 
 from ..collision.geometry import robot_geometry
 from ..collision.part_geometry import Obstacle, drop, signed_distance
-from .falls import G_M_S2, Falls
 from .goals import Goal, GoalBook, GoalResult, score
 from .grasp import at_cup, extent, finger_links, jaws, opening_for, take
-from .parts import FLOOR, Part, PartError, Parts
+from .parts import FLOOR, G_M_S2, Falls, Part, PartError, Parts
 
 if TYPE_CHECKING:
     from ..collision.model import CollisionModel, PartShape

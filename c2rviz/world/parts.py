@@ -6,15 +6,22 @@ name, a pose in the world (cell) frame, an optional type and colour, and a state
 ``free`` (lying where it was put), ``held`` by a robot's gripper link (its pose follows
 that link at a fixed offset) or ``resting on`` an object, another part or the floor.
 ``Parts`` holds them in the order they were added and checks every input; what moves
-them (grasps, releases, falls on the clock) is ``part_world.py``. Pure: no asyncio.
+them (grasps, releases) is ``part_world.py``. No asyncio.
+
+``Falls`` lowers parts falling straight down on the world's clock, at g, one frame at a
+time. It belongs to a world's ``WorldParts``: ``start`` a part's fall of so many metres
+onto something, and a timer on the clock lowers every falling part once per frame
+(``z = z0 - g t² / 2``, never past where it lands), calls ``landed(part, onto)`` when it
+gets there and ``stepped(done)`` after each frame (``done``: no part falls any more).
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 
 import coal
+import numpy as np
 import pinocchio as pin
 
 from ..collision.workcell import (
@@ -25,13 +32,16 @@ from ..collision.workcell import (
     make_object,
 )
 from ..errors import shown
+from .clock import Clock, Timer
 
 __all__ = [
+    "CHECK_MARGIN_M",
+    "FLOOR",
+    "Falls",
+    "G_M_S2",
     "MAX_PARTS",
     "PART_SHAPES",
     "PART_SIZE_M",
-    "CHECK_MARGIN_M",
-    "FLOOR",
     "Part",
     "PartError",
     "PartNameInUse",
@@ -39,6 +49,7 @@ __all__ = [
     "TooManyParts",
     "UnknownPart",
 ]
+
 
 MAX_PARTS = 100
 """Parts in a world at once."""
@@ -218,3 +229,61 @@ class Parts:
 
     def __len__(self) -> int:
         return len(self._parts)
+
+
+G_M_S2 = 9.81
+"""A falling part's acceleration [m/s²]."""
+
+
+class Falls:
+    """The parts falling now, and the frame timer that lowers them."""
+
+    def __init__(
+        self,
+        clock: Clock,
+        frame_s: float,
+        landed: Callable[[Part, str], None],
+        stepped: Callable[[bool], None],
+    ) -> None:
+        self.clock = clock
+        self.frame_s = frame_s
+        self.landed = landed
+        self.stepped = stepped
+        self._falls: dict[str, tuple[Part, float, float, float, str]] = {}
+        self._timer: Timer | None = None
+
+    def start(self, part: Part, down_m: float, onto: str) -> None:
+        """``part`` falls ``down_m`` [m] from where it is now, onto ``onto``."""
+        part.falling, part.on = True, None
+        z0 = float(part.pose.translation[2])
+        self._falls[part.name] = (part, self.clock.now(), z0, down_m, onto)
+        if self._timer is None:
+            self._timer = self.clock.call_later(self.frame_s, self._tick)
+
+    def cancel(self, name: str) -> None:
+        """Part ``name`` falls no more (taken, or removed)."""
+        fall = self._falls.pop(name, None)
+        if fall is not None:
+            fall[0].falling = False
+
+    def stop(self) -> None:
+        """The program stops: no more frames."""
+        if self._timer is not None:
+            self._timer.cancel()
+            self._timer = None
+
+    def _tick(self) -> None:
+        self._timer = None
+        t = self.clock.now()
+        for name, (part, t0, z0, down, onto) in list(self._falls.items()):
+            fallen = min(down, 0.5 * G_M_S2 * (t - t0) ** 2)
+            part.pose = pin.SE3(
+                part.pose.rotation, np.array([*part.pose.translation[:2], z0 - fallen])
+            )
+            if fallen >= down:
+                del self._falls[name]
+                part.falling = False
+                self.landed(part, onto)
+        self.stepped(not self._falls)
+        if self._falls:
+            self._timer = self.clock.call_later(self.frame_s, self._tick)

@@ -3,6 +3,9 @@
 ``RobotState`` is one robot of the world; ``Marker`` one of its markers, in the
 world frame. Values are SI (radians, metres). Only the world writes them; everyone
 else reads.
+
+``MoveRules`` is what faults make of moves: the hooks ``Travels`` asks
+(``fault_rules.FaultRules`` fills them in); the base changes nothing.
 """
 
 from __future__ import annotations
@@ -12,9 +15,11 @@ from dataclasses import dataclass, field
 
 import pinocchio as pin
 
+from ..errors import C2rvizError
 from ..robot.model import Robot
 
-__all__ = ["MAX_MARKERS", "Marker", "RobotState"]
+__all__ = ["MAX_MARKERS", "Marker", "MoveRules", "RobotState"]
+
 
 MAX_MARKERS = 1000
 """Markers kept at once per robot; beyond it the oldest goes first, so a flood of
@@ -81,3 +86,18 @@ class RobotState:
     def base(self) -> pin.SE3:
         """The robot's base frame (where poses are given) in the world frame."""
         return self.origin * self.robot.base_placement
+
+
+class MoveRules:
+    """What faults make of moves; this base changes nothing."""
+
+    def refuse(self, state: RobotState) -> None:
+        """Raise if a move of ``state`` is refused now."""
+
+    def follow(self, state: RobotState, q: tuple[float, ...]) -> tuple[float, ...]:
+        """Where ``state``'s joints are when commanded to ``q``."""
+        return q
+
+    def arrival_error(self, state: RobotState) -> C2rvizError | None:
+        """The error a move that came to rest at its target ends with (None: ``ok``)."""
+        return None

@@ -17,7 +17,7 @@ from test_ik import BENT_ELBOW, BUNDLED, EXAMPLE_ARMS, errors, solver, within_li
 from c2rviz.ik import IkSolver, PointTarget, Unreachable, plan_line
 from c2rviz.ik.target import goal_in_world
 from c2rviz.robot import Robot
-from c2rviz.robot.rpy import canonical_rpy
+from c2rviz.robot.frames import canonical_rpy
 
 ALL_ARMS = BUNDLED + EXAMPLE_ARMS
 PROMISE_M, PROMISE_RAD = 1e-4, math.radians(0.1)

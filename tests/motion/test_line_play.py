@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from support import load_robot
 
-from c2rviz.motion.line_play import LinePlay, ramp_limits
+from c2rviz.motion.path_play import LinePlay, ramp_limits
 from c2rviz.motion.planner import motion_limits
 
 DT = 1e-3  # sampling step [s]

@@ -22,7 +22,6 @@ from c2rviz.protocol.verbs.markers import Clear, Color, Mark, MarkerShape
 from c2rviz.protocol.verbs.motion import MotionMode, Speed, Status, Stop, Target, Wait
 from c2rviz.protocol.verbs.observe import Ghost, Record, Trail, Unwatch, Watch
 from c2rviz.protocol.verbs.parts import GoalEdit, Grip, PartEdit, PartsQuery, Score
-from c2rviz.protocol.verbs.planning import Plan
 from c2rviz.protocol.verbs.queries import (
     Bye,
     Help,
@@ -34,7 +33,7 @@ from c2rviz.protocol.verbs.queries import (
     Version,
     Where,
 )
-from c2rviz.protocol.verbs.workcell import Collisions, Guard, ObjectEdit, Objects
+from c2rviz.protocol.verbs.workcell import Collisions, Guard, ObjectEdit, Objects, Plan
 
 GOOD = [
     ("home", Home(), "home"),

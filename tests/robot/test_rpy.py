@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from c2rviz.robot.rpy import canonical_rpy
+from c2rviz.robot.frames import canonical_rpy
 
 
 def matrix(roll_deg: float, pitch_deg: float, yaw_deg: float) -> np.ndarray:

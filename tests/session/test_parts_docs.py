@@ -11,7 +11,7 @@ from support import ROOT, Client, ServerLimits, ServerThread, load_robot
 
 from c2rviz.protocol.verbs import parts as verbs_parts
 from c2rviz.world import goals, grasp, part_world, parts
-from c2rviz.world.virtual_clock import VirtualClock
+from c2rviz.world.clocks import VirtualClock
 
 DOC = ROOT / "docs" / "parts.md"
 NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?")

@@ -8,8 +8,8 @@ import asyncio
 import pytest
 
 from c2rviz.errors import C2rvizError
+from c2rviz.world.clocks import VirtualClock
 from c2rviz.world.latency import LateSends, late
-from c2rviz.world.virtual_clock import VirtualClock
 
 
 def test_sends_keep_their_order_whatever_the_delays_drew() -> None:

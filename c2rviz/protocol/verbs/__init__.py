@@ -6,8 +6,13 @@ Importing this package registers every verb in ``registry.VERBS``, in the order
 
 # isort: off
 from . import joints, markers, queries  # the seed's verbs (queries: then sleep, bye, quit)
-from . import cartesian, cell, motion, observe, workcell  # observe: then record
-from . import planning
+from . import (
+    cartesian,
+    cell,
+    motion,
+    observe,
+    workcell,
+)  # observe: then record; workcell: then plan
 from . import parts  # grip first, then the part verbs
 from . import cameras
 from . import faults
@@ -23,7 +28,6 @@ __all__ = [
     "motion",
     "observe",
     "parts",
-    "planning",
     "queries",
     "workcell",
 ]

@@ -80,7 +80,7 @@ DOCS_PAGES = {
     "observe": "docs/watch.md",
     "record": "docs/recording.md",  # a verb of observe.py, by name
     "workcell": "docs/workcell.md",
-    "planning": "docs/planning.md",
+    "plan": "docs/planning.md",  # a verb of workcell.py, by name
     "ghost": "docs/page.md",
     "objects": "docs/commands.md",  # workcell.md shows objects, not this question
 }

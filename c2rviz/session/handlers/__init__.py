@@ -6,10 +6,9 @@ module                    verb families (``protocol.verbs``)
 ========================  ==============================================================
 ``arm``                   ``joints``, ``motion``: the arm moved by its joints
 ``cartesian``             ``cartesian``: the tool, IK, moves to a tool pose
-``planning``              ``planning``: ``plan``, a path around obstacles
-``scene``                 ``markers``, ``workcell``, ``cell``: what the scene holds
-``parts``                 ``parts``: the gripper, parts, goals, the score
-``cameras``               ``cameras``
+``scene``                 ``markers``, ``workcell``, ``cell``: what the scene holds, and
+                          ``plan``: a path around it
+``parts``                 ``parts``: the gripper, parts, goals, the score; ``cameras``
 ``faults``                ``faults``
 ``queries``               ``queries``: questions, and ``sleep``, ``bye``, ``quit``
 ``observe``               ``observe``: watch, trail, ghost, and record
@@ -20,16 +19,14 @@ The import below is the whole list: importing this package registers every handl
 ``tests/protocol/test_registry.py`` checks that every verb has exactly one).
 """
 
-from . import arm, cameras, cartesian, faults, observe, parts, planning, queries, scene
+from . import arm, cartesian, faults, observe, parts, queries, scene
 
 __all__ = [
     "arm",
-    "cameras",
     "cartesian",
     "faults",
     "observe",
     "parts",
-    "planning",
     "queries",
     "scene",
 ]

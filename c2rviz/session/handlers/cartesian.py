@@ -16,7 +16,7 @@ import numpy as np
 from ...errors import ArmMoved, UnknownMarker
 from ...ik.line import StraightLine, plan_line
 from ...ik.target import PointTarget, Target
-from ...motion.line_play import LinePlay, brake_limits, ramp_limits
+from ...motion.path_play import LinePlay, brake_limits, ramp_limits
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
 from ...protocol.verbs.cartesian import Ik, LinearSpeed, MoveL, MoveTo, PoseValues, Tool

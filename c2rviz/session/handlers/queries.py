@@ -7,11 +7,11 @@ from __future__ import annotations
 import hashlib
 from typing import TYPE_CHECKING
 
+from ... import __version__
 from ...errors import BadArguments
 from ...protocol import replies
 from ...protocol.registry import Reply, handler, usage
 from ...protocol.verbs.queries import Bye, Help, Limits, Names, Pose, Quit, Sleep, Version, Where
-from ...version import __version__
 
 if TYPE_CHECKING:
     from ..session import Session

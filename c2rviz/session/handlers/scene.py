@@ -2,18 +2,33 @@
 (``clear``, ``mark``, ``color``/``rgb``, ``marker``; ``protocol.verbs.markers``), the
 workcell's objects, collisions now and this connection's guard (``object``,
 ``objects``, ``collisions``, ``guard``; ``protocol.verbs.workcell``), and the cell's
-robots (``robot``, ``robots``; ``protocol.verbs.cell``).
+robots (``robot``, ``robots``; ``protocol.verbs.cell``); and ``plan``: a path around
+the obstacles to joint values or a tool pose, and its settings.
+
+The search runs on the worker's plan lane (``guarded.checked_move`` with
+``plan="always"``: the direct edge first, then RRT-Connect and shortening; ``stop``,
+the client closing or a newer move cancel it), the
+path is timed within the joints' limits at the connection's speed and played on
+the world's clock (``motion on``: the reply waits for the arrival; ``follow``: it
+comes as the arm leaves; ``off``: the arm is shown at the goal at once), and the
+guard's watch re-checks it while it runs, whatever the connection's guard.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from ...errors import BadArguments, JointCountError
+from ...ik.target import PointTarget, Target
+from ...planning import MAX_TIMEOUT_S, goal_candidates, time_path
+from ...planning.edge_resolution import RANGES
+from ...planning.errors import checked_setting
 from ...protocol import replies
-from ...protocol.registry import Reply, handler
+from ...protocol.registry import Reply, handler, usage
 from ...protocol.verbs.cell import RobotChoice, RobotsList
 from ...protocol.verbs.markers import Clear, Color, Mark, MarkerShape
-from ...protocol.verbs.workcell import Collisions, Guard, ObjectEdit, Objects
+from ...protocol.verbs.workcell import Collisions, Guard, ObjectEdit, Objects, Plan
+from ..guarded import checked_move, play_checked
 
 if TYPE_CHECKING:
     from ...collision.model import CollisionModel
@@ -104,3 +119,81 @@ def robots(session: Session, command: RobotsList) -> str:
             for name, state in session.world.robots.items()
         )
     )
+
+
+MIN_TIMEOUT_S = 0.001  # [s] shortest search a connection may set
+
+
+@handler(Plan)
+def plan(session: Session, command: Plan) -> Reply:
+    what, values = command.what, command.values
+    if what == "show":  # the path of the last `plan`, or of the last `guard plan` move
+        if session.last_plan is None:
+            return replies.ok("none")
+        return replies.ok(";".join(replies.numbers(session.from_si(q)) for q in session.last_plan))
+    if what == "timeout":
+        if not values:
+            return replies.ok(replies.numbers([session.plan_timeout_s]))
+        session.plan_timeout_s = checked_setting(
+            "plan timeout", values[0], MIN_TIMEOUT_S, MAX_TIMEOUT_S, "s"
+        )
+        return replies.OK
+    if what == "resolution":
+        step_rad, tool_m = session.steps
+        if not values:
+            shown = [step_rad / session.angle_scale, tool_m if tool_m is not None else 0.0]
+            return replies.ok(replies.numbers(shown))
+        _check_steps(session, *values)
+        session.set_steps(values[0] * session.angle_scale, values[1])
+        return replies.OK
+    if what == "joints":
+        n = session.n
+        if len(values) != n:
+            raise JointCountError(n, len(values))
+        return _plan_to(session, [session.to_si(range(n), values)])
+    target: Target = PointTarget.at(values) if len(values) == 3 else session.pose_se3(values)
+    return _plan_pose(session, target)
+
+
+async def _plan_pose(session: Session, target: Target) -> str:
+    state, worker = session.state, session.services.worker
+    solver, near, tool = worker.ik_solver(state), session.now(), state.tool
+    goals = await worker.run(lambda: goal_candidates(solver, target, near, tool), owner=session)
+    return await _plan_to(session, goals)
+
+
+async def _plan_to(session: Session, goals: list) -> str:
+    checked, _ = await checked_move(session, goals, plan="always")
+    session.last_plan = checked.waypoints
+    world, state = session.world, session.state
+    length = checked.planned.length_rad if checked.planned is not None else 0.0
+    count = len(checked.waypoints)
+    if session.motion == "off":
+        limits = world.motion_limits(state.name)
+        timed = time_path(checked.waypoints, limits, 0.0, session.speed / 100.0)
+        world.set_q(checked.goal, state.name, session.source)
+        return _summary(count, length, timed.duration)
+    play, arrival = play_checked(session, checked)
+    reply = _summary(count, length, play.duration)
+    if arrival is not None:
+        await arrival
+    return reply
+
+
+def _check_steps(session: Session, angle: float, tool_m: float) -> None:
+    """Refuse steps outside the ranges, in the connection's units."""
+    scale, unit = session.angle_scale, "deg" if session.degrees else "rad"
+    low, high = RANGES["max_step_rad"]
+    if not low <= angle * scale <= high:
+        problem = (
+            f"a joint step of {angle:g} {unit} is outside {low / scale:.4g}..{high / scale:.4g}"
+        )
+        raise BadArguments("plan", f"{problem} {unit}", usage("plan"))
+    low, high = RANGES["max_tool_step_m"]
+    if not low <= tool_m <= high:
+        problem = f"a tool step of {tool_m:g} m is outside {low:g}..{high:g} m"
+        raise BadArguments("plan", problem, usage("plan"))
+
+
+def _summary(count: int, length_rad: float, duration_s: float) -> str:
+    return replies.ok(f"{count} waypoints {length_rad:.3f} rad {duration_s:.3f} s")

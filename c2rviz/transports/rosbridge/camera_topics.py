@@ -21,8 +21,7 @@ from functools import partial
 
 import pinocchio as pin
 
-from ...observers.camera_feed import CameraFeed
-from ...observers.camera_records import CAMERA_TOPIC, POSE_ARRAY, camera_items, pose_array
+from ...observers.camera_feed import CAMERA_TOPIC, POSE_ARRAY, CameraFeed, camera_items, pose_array
 from ...ros.messages import Msg, tf_message, transforms
 from ...world.camera_sight import sight
 from ...world.cameras import Camera, Seen

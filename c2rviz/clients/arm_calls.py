@@ -1,20 +1,24 @@
-"""The calls of planning, the guard's modes, the gripper and the ghost (pure: arguments
-checked before anything is sent), and the plan's record; the clients' methods that send
-them are in ``aio_verbs`` (and its blocking twin, ``verbs``).
+"""The calls of planning, the guard's modes, the gripper, the ghost and faults
+(docs/faults.md) (pure: arguments checked before anything is sent), and the plan's and
+the faults' records; the clients' methods that send them are in ``aio_verbs`` (and its
+blocking twin, ``verbs``).
 
-Angles are in the connection's unit (radians unless the client chose degrees), lengths
-in metres, times in seconds.
+Angles and a fault's noise are in the connection's unit (radians unless the client chose
+degrees), lengths in metres, times in seconds (of the server's clock), a fault's latency
+in milliseconds.
 """
 
 from __future__ import annotations
 
 from typing import NamedTuple
 
+from ..protocol.verbs.faults import FAULT_KINDS
 from . import arguments as check
 from . import records as read
 from .calls import Call, fixed, parsed, pose_text, with_value
 
-__all__ = ["PlanSummary"]
+__all__ = ["FAULTS", "PlanSummary", "RESET", "clear_faults", "fault", "read_faults"]
+
 
 GUARD_MODES = ("on", "off", "plan")
 
@@ -92,3 +96,36 @@ def ghost(on: object) -> Call[bool]:
 
 
 PLAN = fixed("plan", read_waypoints)
+
+
+def read_faults(reply: str) -> list[str]:
+    """``ok none`` -> []; ``ok estop since 1.500; noise 0.01 at 5.000`` -> each item."""
+    if not reply.startswith("ok "):
+        raise ValueError(reply)
+    body = reply[3:]
+    return [] if body == "none" else body.split("; ")
+
+
+def fault(kind: object, args: tuple[object, ...], at: object, after: object) -> Call[None]:
+    chosen = check.choice("fault", "kind", kind, tuple(FAULT_KINDS))
+    words = ["fault"]
+    if at is not None:
+        words += ["at", repr(check.number("fault", "at", at))]
+    if after is not None:
+        words += ["after", repr(check.number("fault", "after", after))]
+    words.append(chosen)
+    if args:
+        if not any(isinstance(a, str) for a in args):
+            words.append(",".join(repr(check.number("fault", "args", a)) for a in args))
+        else:
+            words.extend(str(a) for a in args)
+    return Call(parsed("fault", "args", " ".join(words)), read.read_ok)
+
+
+def clear_faults(kind: object) -> Call[None]:
+    chosen = check.choice("clear_faults", "kind", kind, (*FAULT_KINDS, "all"))
+    return Call(f"fault clear {chosen}", read.read_ok)
+
+
+FAULTS = fixed("faults", read_faults)
+RESET = fixed("reset", read.read_ok)
