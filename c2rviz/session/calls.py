@@ -26,7 +26,7 @@ from ..planning.cancel import STOPPED
 from ..protocol import replies
 from ..protocol.registry import Reply
 from ..world.grasp import SUCTION_BELOW, is_vacuum
-from .guarded import checker_of, request
+from .guarded import checker_of, request, unstopped
 from .handlers.cartesian import StraightPlan, plan_straight, play_straight, solve
 
 if TYPE_CHECKING:
@@ -80,6 +80,8 @@ async def plan_to(
     if straight:
         line = await plan_straight(session, target, start)
         return Plan(tuple(line.waypoints[-1]), line)
+    if start is None:  # a plan of a move now: refused as the move would be (a stop)
+        return Plan(tuple(await unstopped(session, solve(session, target))))
     return Plan(tuple(await solve(session, target, start)))
 
 

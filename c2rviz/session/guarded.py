@@ -28,8 +28,9 @@ from __future__ import annotations
 
 import asyncio
 import functools
-from collections.abc import Sequence
-from typing import Protocol
+import inspect
+from collections.abc import Awaitable, Sequence
+from typing import Protocol, TypeVar
 
 import numpy as np
 
@@ -62,8 +63,10 @@ __all__ = [
     "play_checked",
     "GuardedSession",
     "request",
+    "unstopped",
 ]
 
+T = TypeVar("T")
 TRIES = 3  # checks of one move while the world keeps changing under it
 DRAWS = 1000  # random configurations a guarded rand draws at most
 RAND_GOALS = 8
@@ -175,9 +178,6 @@ async def checked_move(
         WorldChanged: the world changed under each of ``TRIES`` checks.
     """
     at_once = session.motion == "off" and plan != "always" and path_from is None
-    faults, state = session.world.faults, session.state
-    faults.refuse(state)  # a stop holds the arm: nothing to check
-    stops = faults.of(state.name).stops
     for _ in range(TRIES):
         if not at_once and session.travel.active:  # brake on the checked path first
             session.world.travels.stop(
@@ -186,8 +186,8 @@ async def checked_move(
         start = tuple(session.state.target if session.travel.active else session.state.q)
         if at_once:
             start = session.now()
-        asked, checked = await _check(session, start, goals, path_from, at_once, plan)
-        faults.refuse(state, stops)  # a stop came meanwhile: the move asked before it is over
+        check = _check(session, start, goals, path_from, at_once, plan)
+        asked, checked = await unstopped(session, check)
         if not at_once:
             if session.travel.active and not session.travel.stopping:
                 raise ArmMoved(_TAKEN)  # not our brake: another command took the arm
@@ -199,6 +199,28 @@ async def checked_move(
         if unchanged(session, asked, at_rest=not at_once):
             return checked, at_once
     raise WorldChanged(TRIES)
+
+
+async def unstopped(session: GuardedSession, work: Awaitable[T]) -> T:
+    """``work`` done off the loop for a move of ``session``'s robot (its IK, line or
+    check): refused at once while a stop holds the robot, and when it ends if a stop came
+    meanwhile, lifted or not (a move asked before a stop never plays after its ``reset``).
+
+    Raises:
+        FaultStop: a stop holds the robot (``work`` is closed unawaited).
+        MotionInterrupted: a stop came while ``work`` ran.
+    """
+    faults, state = session.world.faults, session.state
+    try:
+        faults.refuse(state)
+    except C2rvizError:
+        if inspect.iscoroutine(work):
+            work.close()
+        raise
+    stops = faults.of(state.name).stops
+    result = await work
+    faults.refuse(state, stops)
+    return result
 
 
 async def _check(

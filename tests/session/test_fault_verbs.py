@@ -312,24 +312,24 @@ def test_a_stop_refuses_the_gripper_too(c2rviz_server, connect):
     assert client.ask("grip 0") == "ok"
 
 
-@pytest.mark.parametrize("verb", ["joints", "movel"])
-def test_a_move_checked_while_a_stop_came_and_went_never_plays(verb) -> None:
-    """A move asked before an estop whose check (or line) is still off the loop when the
+@pytest.mark.parametrize(
+    ("verb", "guard"),
+    [("joints", "on"), ("movel", "on"), ("movel", "off"), ("moveto", "on"), ("moveto", "off")],
+)
+def test_a_move_checked_while_a_stop_came_and_went_never_plays(verb, guard) -> None:
+    """A move asked before an estop whose check, line or IK is still off the loop when the
     estop is cleared and reset is refused, never played after the reset (a CRCL test saw
     the move asked during the stop arrive after it, under load)."""
 
     async def run() -> None:
         services = Services(World(load_robot("motoman_sia20d")))
         mover, pendant = Session(services, "mover"), Session(services, "pendant")
-        for setting in ("joints " + FAR, "motion on", "guard on"):  # away from the upright
+        for setting in ("joints " + FAR, "motion on", "guard " + guard):  # off the upright
             assert mover.run(setting) == "ok"
         start = mover.state.q
         x, y, z, *rpy = values(str(mover.run("pose")))
-        line = (
-            "joints " + FAR
-            if verb == "joints"
-            else f"movel {x},{y},{z - 0.05},{rpy[0]},{rpy[1]},{rpy[2]}"
-        )
+        pose = f"{x},{y},{z - 0.05},{rpy[0]},{rpy[1]},{rpy[2]}"
+        line = "joints 0.5,0.3,0.2,-0.4,0.1,0.4,0" if verb == "joints" else f"{verb} {pose}"
         asked = asyncio.ensure_future(_awaited(mover.run(line)))
         await asyncio.sleep(0)  # it has asked the worker, which answers on a later turn
         for step in ("fault estop", "fault clear estop", "reset"):

@@ -21,7 +21,7 @@ from ...protocol import replies
 from ...protocol.registry import Reply, handler
 from ...protocol.verbs.cartesian import Ik, LinearSpeed, MoveL, MoveTo, PoseValues, Tool
 from ...robot.frames import in_base, wxyz_se3
-from ..guarded import checked_move
+from ..guarded import checked_move, unstopped
 
 if TYPE_CHECKING:
     from ..session import Session
@@ -50,9 +50,9 @@ async def moveto(session: Session, command: MoveTo) -> str:
             raise UnknownMarker(index, len(markers))
         marker = markers[index - 1]
         target = in_base(session.state.base, wxyz_se3(marker.position, marker.wxyz))
-        q = await solve(session, target)
     else:
-        q = await solve(session, _target(session, command.pose))
+        target = _target(session, command.pose)
+    q = await unstopped(session, solve(session, target))
     return await _reply(session.go(q))
 
 
@@ -89,14 +89,12 @@ async def plan_straight(
     if start is None and session.travel.active:
         raise ArmMoved("movel starts from rest: send wait (or stop) first")
     first, tool_offset = tuple(state.q if start is None else start), state.tool
-    worker, faults = session.services.worker, session.world.faults
+    worker = session.services.worker
     solver = worker.ik_solver(state)
-    stops = faults.of(state.name).stops
-    line = await worker.run(lambda: plan_line(solver, first, goal, tool_offset), owner=session)
+    work = worker.run(lambda: plan_line(solver, first, goal, tool_offset), owner=session)
+    line = await (unstopped(session, work) if start is None else work)
     if start is None and (state.q != first or session.travel.active):
         raise ArmMoved("the arm moved while the line was planned: send movel again")
-    if start is None:
-        faults.refuse(state, stops)  # a stop came while it was planned
     waypoints = [waypoint.q for waypoint in line.waypoints]
     allowed: frozenset[tuple[str, str]] = frozenset()
     if session.guard:  # the whole line, off the loop
