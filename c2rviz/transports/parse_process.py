@@ -69,7 +69,11 @@ START_S: Final = 120.0
 """A child not ready for jobs this long after it started is killed [s] (its imports take
 a few seconds)."""
 _HEADER: Final = struct.Struct("<Q")
-_ROOT: Final = str(Path(__file__).resolve().parents[2])  # where ``c2rviz`` is found
+_ROOT: Final = str(Path(__file__).resolve().parents[2])  # where this ``c2rviz`` is found
+_CHILD: Final = (  # (this c2rviz, whatever the working directory holds)
+    f"import sys; sys.path.insert(0, {_ROOT!r}); "
+    "from c2rviz.transports.parse_process import serve; serve()"
+)
 
 
 class ProcessLost(C2rvizError):
@@ -237,11 +241,8 @@ class ParseProcess:
         if child is not None and child.returncode is None:
             return child
         child = self._child = await asyncio.create_subprocess_exec(
-            sys.executable, "-c", "from c2rviz.transports.parse_process import serve; serve()",
-            stdin=asyncio.subprocess.PIPE, stdout=asyncio.subprocess.PIPE,
-            env={**os.environ, "PYTHONPATH": os.pathsep.join(
-                p for p in (_ROOT, os.environ.get("PYTHONPATH")) if p
-            )},
+            sys.executable, "-c", _CHILD, stdin=asyncio.subprocess.PIPE,
+            stdout=asyncio.subprocess.PIPE,
         )  # fmt: skip
         self.started += 1
         assert child.stdout is not None
