@@ -45,6 +45,7 @@ from ..session.plan_process import _portable, _rebuilt
 __all__ = [
     "DEADLINE_S",
     "LONG",
+    "NICE",
     "START_S",
     "SLICE_ITEMS",
     "UNPACK_TURN_S",
@@ -68,6 +69,9 @@ DEADLINE_S: Final = 60.0
 START_S: Final = 120.0
 """A child not ready for jobs this long after it started is killed [s] (its imports take
 a few seconds)."""
+NICE: Final = 10
+"""How much lower the child's scheduling priority is than the server's (``os.nice``): on
+a busy machine the loop is served first, and the sender of large inputs waits."""
 _HEADER: Final = struct.Struct("<Q")
 _ROOT: Final = str(Path(__file__).resolve().parents[2])  # where this ``c2rviz`` is found
 _CHILD: Final = (  # (this c2rviz, whatever the working directory holds)
@@ -158,6 +162,8 @@ def serve(reader: BinaryIO | None = None, writer: BinaryIO | None = None) -> Non
     reader = reader or sys.stdin.buffer
     with contextlib.suppress(ValueError, OSError):
         signal.signal(signal.SIGINT, signal.SIG_IGN)  # the server's Ctrl-C is the server's
+    with contextlib.suppress(AttributeError, OSError):
+        os.nice(NICE)  # a free core goes to the server's loop first
     writer.write(_HEADER.pack(0))  # ready
     writer.flush()
     while True:
