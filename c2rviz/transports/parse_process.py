@@ -8,7 +8,8 @@ its share. A ``ParseProcess`` runs such a parse in a child process with its own 
 - **Lazy.** The child (``python -c ...serve()``, importing what the parse needs, a
   few seconds) starts on the first job, not with the program.
 - **One job at a time, in the order they came.** Each door has one; its clients' large
-  inputs queue for it in turn (each connection waits for its own before its next).
+  inputs queue for it in turn (each connection waits for its own before its next). It
+  runs niced (``NICE``): on a busy machine the loop gets a free core first.
 - **What crosses back is cheap to take in.** Unpickling 7000 waypoints costs the loop
   about 100 ms, as much as a long turn. So the child cuts every list or tuple longer
   than ``LONG`` into pickles of ``SLICE_ITEMS`` items (``pack``), and the loop unpickles
