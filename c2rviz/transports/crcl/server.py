@@ -24,9 +24,11 @@ status whose ``StateDescription`` says what was wrong):
 
 A long run of documents in one read is worked through ``tcp_rules.TURN_S`` at a time, so one
 client's flood delays the others by no more than that; a document too large to parse
-in that time (over ``PARSE_ON_LOOP_BYTES``) is parsed on the door's one parsing
-thread (lxml lets go of the interpreter's lock while it parses), big documents of
-every client in the order they came, while the loop serves the others.
+in that time (over ``PARSE_ON_LOOP_BYTES``) is parsed in the door's parsing process
+(``parse_process``: it holds no lock of the server's; it starts with the first such
+document), big documents of every client in the order they came, while the loop serves
+the others; the loop takes the parsed commands in a slice at a time. A parsing process
+that dies costs that document an error status; the next starts a new one.
 """
 
 from __future__ import annotations
@@ -34,13 +36,13 @@ from __future__ import annotations
 import asyncio
 import logging
 import time
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Final
 
 from ...protocol.limits import default, default_s
 from ...session.services import Services
 from ...session.session import Session
+from ..parse_process import ParseProcess, ProcessLost
 from ..tcp_rules import TURN_S, close_lingering
 from .actions import ACTIONS
 from .controller import Controller
@@ -72,7 +74,7 @@ SPLIT_BYTES: Final = 16384
 clients served between them."""
 PARSE_ON_LOOP_BYTES: Final = 16384
 """The largest document parsed on the event loop [bytes]: a larger one (a parse runs at
-about 10 MB/s, so past a turn's ``TURN_S``) is parsed on the door's parsing thread
+about 3 MB/s, so past a turn's ``TURN_S``) is parsed in the door's parsing process
 while the other clients go on, and this client's next documents wait for it."""
 INTERNAL_ERROR: Final = "internal error reading the document (see the server log)"
 """The description of a document a bug in c2rviz could not run (the connection goes on)."""
@@ -117,7 +119,7 @@ class CrclServer:
         self._served: set[_Connection] = set()
         self._door = f"crcl {id(self)}"
         self._refusals = _RefusalLog()
-        self._parsing: ThreadPoolExecutor | None = None
+        self._parsing: ParseProcess | None = None
         self.refused = 0
         """Connections turned away (over ``max_connections``, or while stopping)."""
         self.address: tuple[str, int] | None = None
@@ -134,7 +136,7 @@ class CrclServer:
         Raises:
             OSError: the address cannot be listened on.
         """
-        self._parsing = ThreadPoolExecutor(1, thread_name_prefix="c2rviz-crcl-parse")
+        self._parsing = ParseProcess("CRCL parsing")  # (its process: on the first large document)
         self._server = await asyncio.start_server(self._accept, host, port)
         bound = self._server.sockets[0].getsockname()
         self.address = (str(bound[0]), int(bound[1]))
@@ -164,7 +166,7 @@ class CrclServer:
         self._server = None
         self._refusals.flush(final=True)
         if self._parsing is not None:
-            self._parsing.shutdown(wait=False, cancel_futures=True)
+            await self._parsing.close()
             self._parsing = None
 
     async def _accept(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
@@ -209,7 +211,7 @@ class CrclServer:
 
 
 def _parse(doc: bytes) -> CommandInstance | CrclError:
-    """``parse_instance`` on the parsing thread: the document, or why it is refused."""
+    """``parse_instance`` in the parsing process: the document, or why it is refused."""
     try:
         return parse_instance(doc)
     except CrclError as error:
@@ -261,7 +263,7 @@ class _Connection:
         reader: asyncio.StreamReader,
         writer: asyncio.StreamWriter,
         session: Session,
-        parsing: ThreadPoolExecutor | None = None,
+        parsing: ParseProcess | None = None,
     ) -> None:
         self.limits = server.limits
         self.parsing = parsing
@@ -346,8 +348,10 @@ class _Connection:
                 continue
             try:
                 if len(item) > PARSE_ON_LOOP_BYTES and self.parsing is not None:
-                    loop = asyncio.get_running_loop()
-                    parsed = await loop.run_in_executor(self.parsing, _parse, item)
+                    try:
+                        parsed = await self.parsing.run(_parse, item)
+                    except ProcessLost as lost:
+                        parsed = CrclError(f"{lost}: the document was not read")
                     started = time.perf_counter()  # the others had the loop meanwhile
                     if self.closing:
                         return

@@ -89,7 +89,9 @@ class Bridge(Protocol):
         Args:
             source: Who sent it (``rosbridge 127.0.0.1:50412``), for the session's records.
             topic: The absolute topic name.
-            msg: The message as the client sent it, not yet checked against its type.
+            msg: The message as the client sent it, not yet checked against its type;
+                a large one of a type c2rviz reads (``messages.read_ahead``) was read
+                as it was decoded, and comes as a stand-in that its reader takes.
 
         Returns:
             An awaitable that ends once the message is taken (a move started),

@@ -12,10 +12,10 @@ client's own subscription to ``[NS]/c2rviz/reply``; the connection goes on.
 from __future__ import annotations
 
 import asyncio
+import dataclasses
 import logging
 from collections import Counter
 from collections.abc import Callable
-from concurrent.futures import Executor
 from typing import Any, Protocol
 
 from websockets.asyncio.server import ServerConnection
@@ -23,6 +23,7 @@ from websockets.exceptions import ConnectionClosed
 from websockets.frames import CloseCode
 
 from ...errors import C2rvizError
+from ..parse_process import ParseProcess
 from . import messages, protocol, rosapi
 from .bridge import Bridge
 from .command_lines import CommandRefused
@@ -36,8 +37,9 @@ log = logging.getLogger("c2rviz.rosbridge")
 
 DECODE_ON_LOOP_BYTES = 16384
 """The largest frame decoded on the event loop [bytes]; a larger one (a trajectory of
-thousands of points) is decoded and its message read on the server's decoding thread,
-the other clients served meanwhile, this client's next frames after it."""
+thousands of points) is decoded and its message read in the server's decoding process
+(``parse_process``), the other clients served meanwhile, this client's next frames
+after it."""
 REPLY_TOPIC = "/c2rviz/reply"
 """The reply topic's name under each robot's namespace (``[NS]/c2rviz/reply``)."""
 
@@ -49,7 +51,7 @@ class Host(Protocol):
     policy: RosbridgePolicy
     stats: Counter[str]
     sent_probe: Callable[[float], None] | None
-    decoding: Executor | None
+    decoding: ParseProcess | None
 
     def graph(self) -> rosapi.Graph: ...
 
@@ -57,13 +59,16 @@ class Host(Protocol):
 
 
 def _decode(text: str, topics: dict[str, str]) -> tuple[protocol.Op, object]:
-    """Off the loop: the frame's request and, for a publish to a topic whose message
-    c2rviz reads (a trajectory, a joint state), that reading (``messages.read_ahead``)."""
+    """In the decoding process: the frame's request and, for a publish to a topic whose
+    message c2rviz reads (a trajectory, a joint state), that reading
+    (``messages.read_ahead``). The message itself then stays here: its reader is what
+    takes it (``Bridge.publish``), and it would cost the loop as much to take in again."""
     op = protocol.parse_frame(text)
     if isinstance(op, protocol.Publish):
         kind = topics.get(resolve_name(op.topic))
-        if kind is not None:
-            return op, messages.read_ahead(kind, op.msg)
+        reading = None if kind is None else messages.read_ahead(kind, op.msg)
+        if reading is not None:
+            return dataclasses.replace(op, msg={}), reading
     return op, None
 
 
@@ -159,8 +164,7 @@ class Connection:
             decoding = self.server.decoding
             if len(text) > DECODE_ON_LOOP_BYTES and decoding is not None:
                 topics = dict(self.server.graph().topics)
-                loop = asyncio.get_running_loop()
-                decoded, reading = await loop.run_in_executor(decoding, _decode, text, topics)
+                decoded, reading = await decoding.run(_decode, text, topics)
             else:
                 decoded = protocol.parse_frame(text)
             op = decoded

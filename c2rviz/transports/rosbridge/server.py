@@ -32,7 +32,6 @@ import asyncio
 import logging
 from collections import Counter
 from collections.abc import Callable
-from concurrent.futures import Executor, ThreadPoolExecutor
 from http import HTTPStatus
 from typing import Any
 
@@ -40,6 +39,7 @@ from websockets.asyncio.server import Server, ServerConnection, serve
 from websockets.frames import CloseCode
 from websockets.http11 import Request, Response
 
+from ..parse_process import ParseProcess
 from . import protocol, rosapi
 from .bridge import Bridge
 from .connection import Connection
@@ -88,14 +88,15 @@ class RosbridgeServer:
         self._server: Server | None = None
         self._connections: set[Connection] = set()
         self._encoded: dict[str, tuple[dict[str, Any], str]] = {}
-        self.decoding: Executor | None = None
-        """The thread large frames are decoded on (``connection.DECODE_ON_LOOP_BYTES``),
-        one for every client, in the order they came; while the server runs."""
+        self.decoding: ParseProcess | None = None
+        """The process large frames are decoded in (``connection.DECODE_ON_LOOP_BYTES``),
+        one for every client, in the order they came; while the server runs (its process
+        starts with the first large frame)."""
         bridge.hang_up_with(self.hang_up)
 
     async def start(self, host: str = "127.0.0.1", port: int = 9090) -> tuple[str, int]:
         """Listen on ``host:port`` (0: any free port); return the address bound."""
-        self.decoding = ThreadPoolExecutor(1, thread_name_prefix="c2rviz-rosbridge-decode")
+        self.decoding = ParseProcess("rosbridge decoding")
         self._server = await serve(
             self._handle,
             host,
@@ -129,8 +130,8 @@ class RosbridgeServer:
                 await closed
             self._server = None
         if self.decoding is not None:
-            self.decoding.shutdown(wait=False, cancel_futures=True)
-            self.decoding = None
+            decoding, self.decoding = self.decoding, None
+            await decoding.close()
 
     async def __aenter__(self) -> RosbridgeServer:
         return self

@@ -5,13 +5,11 @@ from __future__ import annotations
 
 import logging
 import select
-import threading
 
 import pytest
 from crcl_support import DONE, ERROR, command, move_to
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from support import Client
 
 INIT = command("InitCanon", 1)
 STILL_HERE = command("Message", 3, "<Message>still here</Message>")
@@ -149,42 +147,6 @@ def test_refused_connections_are_logged_as_a_count(start_crcl, crcl_connect, cap
     assert lines[0].startswith("refused CRCL client 127.0.0.1:")
     assert lines[1].startswith("refused 29 more CRCL clients (too many connections)")
     assert server.crcl.refused == 30
-
-
-def test_a_large_document_is_parsed_off_the_loop_and_others_go_on(
-    crcl_server, crcl_connect, monkeypatch
-) -> None:
-    """Issue 35, stall 4: a 1 MiB document was parsed in one go on the event loop. Here
-    the parse of a large document is held until the test lets it go: meanwhile the
-    text port and another CRCL client are answered (with the parse on the loop they
-    would wait for it); the large document's client keeps its order."""
-    from c2rviz.transports.crcl import documents
-    from c2rviz.transports.crcl.server import PARSE_ON_LOOP_BYTES
-
-    gate = threading.Event()
-    parse_xml = documents.parse_xml
-
-    def held(doc: bytes, *args: object, **kwargs: object) -> object:
-        if len(doc) > PARSE_ON_LOOP_BYTES:
-            gate.wait(20)
-        return parse_xml(doc, *args, **kwargs)
-
-    monkeypatch.setattr(documents, "parse_xml", held)
-    big_client, other = crcl_connect(crcl_server), crcl_connect(crcl_server)
-    assert big_client.run(INIT, 1).command_status.state == DONE
-    text = "x" * (4 * PARSE_ON_LOOP_BYTES)
-    big_client.send(command("Message", 2, f"<Message>{text}</Message>") + STILL_HERE)
-    bystander = Client(crcl_server.host, crcl_server.port, timeout=10)
-    try:
-        assert bystander.ask("where").startswith("ok ")  # while the parse is held
-        assert other.run(INIT, 1).command_status.state == DONE
-        assert not gate.is_set()
-    finally:
-        gate.set()
-        bystander.close()
-    assert big_client.until(2).command_status.state == DONE
-    assert big_client.until(3).command_status.state == DONE
-    assert big_client.states(3) == [DONE] and big_client.states(2) == [DONE]
 
 
 _PIECES = st.sampled_from(
