@@ -18,7 +18,8 @@ import asyncio
 import functools
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Awaitable, Sequence
+from typing import TypeVar
 
 import numpy as np
 
@@ -32,7 +33,7 @@ from ..protocol.registry import HANDLERS, VERBS, Reply
 from ..world.moves import Travel
 from ..world.state import RobotState
 from . import calls
-from .guarded import guarded_go
+from .guarded import guarded_go, unstopped
 from .notes import Said, recorded, refused, taken, taken_all
 from .services import Services
 from .settings import Modes
@@ -40,6 +41,7 @@ from .units import UnitEdge, UnitTable
 
 __all__ = ["BATCHED", "Session", "UnitTable"]
 
+T = TypeVar("T")
 _CADENCE_S = 0.02  # a pause this soon after the previous one's end continues its cadence
 BATCHED = tuple(f"{name} " for name in (VERBS["joints"].name, *VERBS["joints"].aliases))
 """How the lines ``Session.set_joints_batch`` may answer as one begin (a controller
@@ -248,6 +250,16 @@ class Session(UnitEdge, Modes):
         ``checked`` (``check_trajectory`` checked it, off the loop, just before)."""
         play = functools.partial(calls.play_trajectory, self, trajectory, checked)
         return recorded(self, said, play)
+
+    async def unstopped(self, work: Awaitable[T]) -> T:
+        """A door's ``work`` off the loop for a move of this robot (its plan, its check):
+        refused at once while a stop holds the robot, and when it ends if a stop came
+        meanwhile (``guarded.unstopped``: a move asked before a stop never plays after it).
+
+        Raises:
+            FaultStop, MotionInterrupted: the stop.
+        """
+        return await unstopped(self, work)
 
     async def check_trajectory(self, trajectory: PlannedTrajectory) -> None:
         """With the guard, check ``trajectory`` for collisions as ``play_trajectory`` would,

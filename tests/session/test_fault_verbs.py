@@ -15,6 +15,8 @@ from c2rviz.errors import MotionInterrupted
 from c2rviz.session import Session
 from c2rviz.session.services import Services
 from c2rviz.testing.server import TestServer
+from c2rviz.transports.rosbridge.joint_inputs import joint_trajectory
+from c2rviz.transports.rosbridge.messages import JointTrajectory, TrajectoryPoint
 from c2rviz.world.world import World
 
 FAR = "1,0.5,0.3,-0.5,0.2,0.5,0.1"  # radians, motoman_sia20d
@@ -334,7 +336,7 @@ def test_a_move_checked_while_a_stop_came_and_went_never_plays(verb, guard) -> N
         await asyncio.sleep(0)  # it has asked the worker, which answers on a later turn
         for step in ("fault estop", "fault clear estop", "reset"):
             assert pendant.run(step) == "ok", step
-        with pytest.raises(MotionInterrupted, match=r"a stop \(estop at t=0\.\d{3}\) came while"):
+        with pytest.raises(MotionInterrupted, match=r"a stop \(estop at t=\d+\.\d{3}\) came while"):
             await asyncio.wait_for(asked, 100.0)
         assert mover.state.q == start and not mover.travel.active
         assert await _awaited(mover.run(line)) == "ok"  # asked after the reset: it plays
@@ -345,3 +347,29 @@ def test_a_move_checked_while_a_stop_came_and_went_never_plays(verb, guard) -> N
 
 async def _awaited(reply: object) -> object:
     return await reply if inspect.isawaitable(reply) else reply
+
+
+@pytest.mark.parametrize("guard", ["on", "off"])
+def test_a_rosbridge_trajectory_planned_while_a_stop_came_and_went_never_plays(guard) -> None:
+    """The rosbridge door's trajectory, planned and checked off the loop, meets the same
+    rule through ``Session.unstopped``."""
+
+    async def run() -> None:
+        services = Services(World(load_robot("motoman_sia20d")))
+        mover, pendant = Session(services, "mover"), Session(services, "pendant")
+        assert mover.run("guard " + guard) == "ok"
+        names = mover.robot.joint_names[:2]
+        points = tuple(TrajectoryPoint((0.2 * t, -0.1 * t), float(t)) for t in (1, 2))
+        trajectory = JointTrajectory(tuple(names), points)
+        asked = asyncio.ensure_future(joint_trajectory(mover, trajectory))
+        await asyncio.sleep(0)  # it has asked the worker, which answers on a later turn
+        for step in ("fault estop", "fault clear estop", "reset"):
+            assert pendant.run(step) == "ok", step
+        with pytest.raises(MotionInterrupted, match=r"a stop \(estop at t=\d+\.\d{3}\) came while"):
+            await asyncio.wait_for(asked, 100.0)
+        assert not mover.travel.active and mover.state.q == (0.0,) * 7
+        await joint_trajectory(mover, trajectory)  # asked after the reset: it plays
+        assert mover.travel.active
+        services.close()
+
+    asyncio.run(run())

@@ -112,8 +112,7 @@ async def joint_trajectory(session: Session, trajectory: JointTrajectory) -> Non
         f"/joint_trajectory {len(points)} points, {points[-1].time_from_start_s:g} s"
     )
     try:
-        start, planned = await _plan(session, trajectory)
-        await session.check_trajectory(planned)
+        start, planned = await session.unstopped(_checked(session, trajectory))
         _at_rest(session, start)  # (another door may have moved it meanwhile)
     except C2rvizError as error:
         said.refuse(error)
@@ -127,6 +126,15 @@ def _at_rest(session: Session, start: np.ndarray | None = None) -> None:
         raise ArmMoved(
             "a trajectory starts from rest and the arm is moving: send stop (or wait) first"
         )
+
+
+async def _checked(
+    session: Session, trajectory: JointTrajectory
+) -> tuple[np.ndarray, PlannedTrajectory]:
+    """``_plan``, then the guard's check of what it planned."""
+    start, planned = await _plan(session, trajectory)
+    await session.check_trajectory(planned)
+    return start, planned
 
 
 async def _plan(
