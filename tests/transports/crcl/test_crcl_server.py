@@ -154,6 +154,7 @@ def test_joint_speed_caps_the_joint_on_the_clock(crcl_server, crcl_connect) -> N
     assert fastest[1] <= 0.5 * 1.02  # finite differences of sampled positions
 
 
+@pytest.mark.wall_clock  # it acts while the move runs: on virtual time the move may end first
 def test_a_new_move_takes_over_and_the_old_is_reported(crcl_server, crcl_connect) -> None:
     client = started(crcl_connect(crcl_server))
     client.send(move_to(2, REACH))
@@ -169,6 +170,7 @@ def test_a_new_move_takes_over_and_the_old_is_reported(crcl_server, crcl_connect
     np.testing.assert_allclose(tool_point(crcl_server), OTHER, atol=1e-6)
 
 
+@pytest.mark.wall_clock  # it acts while the move runs: on virtual time the move may end first
 def test_a_straight_move_brakes_the_one_under_way_first(crcl_server, crcl_connect) -> None:
     client = started(crcl_connect(crcl_server))
     assert client.run(move_to(2, REACH), 2).command_status.state == DONE
@@ -181,6 +183,7 @@ def test_a_straight_move_brakes_the_one_under_way_first(crcl_server, crcl_connec
     np.testing.assert_allclose(tool_point(crcl_server), OTHER, atol=1e-6)
 
 
+@pytest.mark.wall_clock  # it acts while the move runs: on virtual time the move may end first
 def test_stop_motion_brakes_and_reports_both(crcl_server, crcl_connect) -> None:
     client = started(crcl_connect(crcl_server))
     client.send(actuate(2, {1: 2.5}))
@@ -209,6 +212,7 @@ def test_stop_from_the_text_port_is_an_error_naming_it(crcl_server, crcl_connect
     assert "stopped by tcp 127.0.0.1:" in stopped.description
 
 
+@pytest.mark.wall_clock  # it acts while the move runs: on virtual time the move may end first
 def test_get_status_is_answered_while_the_arm_moves(crcl_server, crcl_connect) -> None:
     client = started(crcl_connect(crcl_server))
     client.send(actuate(2, {1: 2.5}))
