@@ -31,6 +31,11 @@ VIEWPORT = {"width": 1000, "height": 700}
 SCENE = (slice(160, 700), slice(320, 660))
 JOINTS = ("joint_s", "joint_l", "joint_e", "joint_u", "joint_r", "joint_b", "joint_t")
 DEADLINE_S = 180.0  # for any one wait; a healthy run takes a second or two per step
+PLAIN = ("--viewer-lighting", "plain")
+"""The program's flags for a page lit without viser's environment map and shadows: in
+software WebGL its first drawing of the robot takes a third of the CPU (docs/testing.md).
+Every browser test's program takes them, but one that keeps the default lighting
+(test_browser.py, the object and the red collision)."""
 
 # viser's end-to-end hooks (App.tsx puts them on window for Playwright): the one place
 # this file reads the page's internals. Robot links nest as the URDF's tree,
@@ -287,10 +292,10 @@ def open_page(browser: Any, url: str) -> Any:
 def program_page(
     browser: Any, c2rviz_process: Callable[..., Any], *args: str
 ) -> Iterator[tuple[Any, Any, Tcp]]:
-    """The program (``ARGS``, its viewer on a free port), a page with the robot drawn, and a
-    controller on its command port (closed after)."""
+    """The program (``ARGS``, its viewer on a free port, lit plainly), a page with the robot
+    drawn, and a controller on its command port (closed after)."""
     ARTIFACTS.mkdir(exist_ok=True)
-    proc = c2rviz_process("--viser-port", "0", *args)
+    proc = c2rviz_process("--viser-port", "0", *PLAIN, *args)
     page = open_page(browser, proc.viewer_url)
     wait_for_robot(page)
     tcp = Tcp(proc.port)

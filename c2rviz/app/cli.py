@@ -16,7 +16,7 @@ from pathlib import Path
 from ..collision.geometry import read_srdf
 from ..errors import C2rvizError
 from ..robot.catalogue import catalogue, listing
-from .config import MOTION_FLAGS, find_ini, load_settings, read_robots
+from .config import LIGHTINGS, MOTION_FLAGS, find_ini, load_settings, read_robots
 from .members import members
 from .program import serve
 
@@ -111,6 +111,12 @@ def build_parser() -> argparse.ArgumentParser:
         "default: none on loopback, else one generated at start)",
     )
     add("--max-viewers", type=int, metavar="N", help="viewer tabs at once (default 16)")
+    add(
+        "--viewer-lighting",
+        choices=LIGHTINGS,
+        help="studio (the default: an environment map and shadows) or plain (lights only: "
+        "nearly the same look, a third of the CPU in a browser without a GPU; docs/page.md)",
+    )
     add(
         "--rosbridge-port",
         type=int,

@@ -28,6 +28,7 @@ from ..world.clocks import parse_clock
 
 __all__ = [
     "INI_NAME",
+    "LIGHTINGS",
     "MOTION_FLAGS",
     "ROBOT_KEYS",
     "ServerLimits",
@@ -99,6 +100,10 @@ class Settings:
     """The token the page needs (``?token=``); None: none, unless bound beyond loopback."""
     max_viewers: int = default("page", "max_clients")
     """Viewer tabs connected at once."""
+    viewer_lighting: str = "studio"
+    """How the page lights its scene (``--viewer-lighting``, ini ``viewer_lighting``):
+    ``studio`` (viser's environment map and shadows) or ``plain`` (lights only, for a
+    computer without a GPU; ``view.adapter.LIGHTINGS``)."""
     page_process: bool = False
     """Serve the page from a process of its own (``--page-process``, ini ``page_process =
     on``; docs/page.md)."""
@@ -188,12 +193,16 @@ _TEXT_OPTIONS = (
     "viewer_origins",
     "clock",
     "page_process",
+    "viewer_lighting",
 )
 _CHOICES = {
     "motion": ("off", "on", "follow"),
     "guard": ("off", "on", "plan"),
     "page_process": ("off", "on"),
+    "viewer_lighting": ("studio", "plain"),
 }
+LIGHTINGS = _CHOICES["viewer_lighting"]
+"""How the page may light its scene (``--viewer-lighting``; ``view.adapter.LIGHTINGS``)."""
 MOTION_FLAGS = ("max_velocity", "max_acceleration", "max_jerk")
 """Motion limits a flag may give every robot (over the ini's)."""
 _EXTRA_KEYS = ["tool", "gripper", *MOTION_FLAGS]

@@ -107,6 +107,7 @@ def _open_scene(
         policy=policy,
         title=title,
         port_named=settings.viewer_port_named,
+        lighting=settings.viewer_lighting,
     )
 
 

@@ -52,6 +52,7 @@ from .ws_guard import Door, GrabCallback, GuardedConnection, HandleCallback, Inp
 
 __all__ = [  # the view's one way to viser's internals
     "INTERNALS",
+    "LIGHTINGS",
     "PoseBatch",
     "WRITTEN_FOR",
     "ViserInternalsError",
@@ -74,20 +75,36 @@ log = logging.getLogger("c2rviz.view")
 
 _VISER_SERVE_MODULE = "viser.infra._infra"  # where viser's websocket handler is defined
 
+LIGHTINGS = ("studio", "plain")
+"""How a page lights its scene (``start``'s ``lighting``): ``studio`` is viser's own, an
+HDRI environment map, two directional lights and shadows; ``plain`` keeps the lights
+without shadows and puts a white hemisphere light in place of the map. The look is nearly
+the same; in software WebGL (no GPU) the map's prefiltering costs a new page about 5 s of
+CPU and the shadows double each frame's cost (docs/page.md, "Lighting")."""
+
 _doors: weakref.WeakKeyDictionary[Any, Door] = weakref.WeakKeyDictionary()
 _start_lock = threading.Lock()
 
 
 def start(
-    host: str, port: int, *, label: str | None = None, policy: DoorPolicy | None = None
+    host: str,
+    port: int,
+    *,
+    label: str | None = None,
+    policy: DoorPolicy | None = None,
+    lighting: str = "studio",
 ) -> viser.ViserServer:
-    """Start a viser server on ``host:port`` (0: a free port) behind a door.
+    """Start a viser server on ``host:port`` (0: a free port) behind a door, its scene lit
+    as ``lighting`` says (one of ``LIGHTINGS``).
 
     Nothing goes to stdout (viser's banner is logged at debug level).
 
     Raises:
+        ValueError: ``lighting`` is not one of ``LIGHTINGS``.
         ViserInternalsError: The installed viser lacks what the adapter uses.
     """
+    if lighting not in LIGHTINGS:
+        raise ValueError(f"lighting {lighting!r} is not one of {', '.join(LIGHTINGS)}")
     check()
     the_door = Door(policy or DoorPolicy(), host, f"viser-v{viser.__version__}")
     with _start_lock, _serve_through(the_door) as calls, _quiet():
@@ -100,6 +117,10 @@ def start(
         raise ViserInternalsError(missing)
     the_door.identify = functools.partial(_client_id, server._websock_server)
     _doors[server] = the_door
+    if lighting == "plain":  # intensity 2: the robots' colours as the default map gives them
+        server.scene.configure_environment_map(hdri=None)
+        server.scene.configure_default_lights(enabled=True, cast_shadow=False)
+        server.scene.add_light_hemisphere("/lighting", intensity=2.0)
     return server
 
 

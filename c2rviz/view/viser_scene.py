@@ -97,6 +97,7 @@ class ViserScene(SceneSends, Scene):
         title: str | None = None,
         port_named: bool = False,
         page_session: Callable[[Services, str], Session] | None = None,
+        lighting: str = "studio",
     ) -> None:
         """Start the viser server on ``host:port`` (0 picks a free port) and draw the world.
 
@@ -113,6 +114,7 @@ class ViserScene(SceneSends, Scene):
                 taken the page does not move to another (``doors.open_port``'s rule).
             page_session: Makes the page's session of a robot (default: a ``Session``
                 of source ``page``; the page process's hands its lines on).
+            lighting: How the page lights the scene (``adapter.LIGHTINGS``).
 
         Raises:
             OSError: ``host`` cannot be listened on, or a named ``port`` is taken.
@@ -123,7 +125,9 @@ class ViserScene(SceneSends, Scene):
         self.world = world = services.world
         self.policy = policy if policy is not None else DoorPolicy()
         self.title = f"c2rviz — {title or ', '.join(world.robots)}"
-        self.server = adapter.start(host, port, label=self.title, policy=self.policy)
+        self.server = adapter.start(
+            host, port, label=self.title, policy=self.policy, lighting=lighting
+        )
         adapter.door(self.server).page_title = self.title
         self.port = self.server.get_port()
         if port_named and port not in (0, self.port):

@@ -240,6 +240,18 @@ def test_the_viewers_door_settings_come_from_the_ini_and_the_flags(tmp_path):
         load_settings(ini, {"urdf": tmp_path / "x.urdf"})
 
 
+def test_the_pages_lighting_comes_from_the_ini_and_the_flag(tmp_path):
+    ini = tmp_path / "light.ini"
+    ini.write_text("[options]\nviewer_lighting = plain\n")
+    urdf = {"urdf": tmp_path / "x.urdf"}
+    assert load_settings(None, urdf).viewer_lighting == "studio"
+    assert load_settings(ini, urdf).viewer_lighting == "plain"
+    assert load_settings(ini, {**urdf, "viewer_lighting": "studio"}).viewer_lighting == "studio"
+    ini.write_text("[options]\nviewer_lighting = dim\n")
+    with pytest.raises(ConfigError, match=r"viewer_lighting = 'dim' is not one.*studio, plain"):
+        load_settings(ini, urdf)
+
+
 @pytest.mark.parametrize(
     ("argv", "message"),
     [

@@ -12,6 +12,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from support import ROOT
+from viewer_tabs import Tab
 
 README = (ROOT / "README.md").read_text()
 CLI = Path(sys.executable).with_name("c2rviz-cli")
@@ -42,6 +43,23 @@ def test_the_start_up_lines_are_the_programs(c2rviz_process) -> None:
         pattern = re.escape(line).replace(r"\ \.\.\.", ".*")
         pattern = re.sub(r"31000|64444|9090|8080", r"\\d+", pattern)
         assert re.search(pattern, printed), f"README: {line!r}\nprinted:\n{printed}"
+
+
+def test_the_plain_lighting_line_starts_a_page_lit_plainly(c2rviz_process) -> None:
+    """The page's first message of lighting turns viser's environment map off (with the
+    default lighting, studio, none is sent)."""
+    (line,) = block_after("draws the\nrobot with a third of the CPU")
+    program, *args = line.split()
+    assert program == ".venv/bin/c2rviz", line
+    proc = c2rviz_process(*args, "--viser-port", "0")
+    tab = Tab(proc.viewer_url)
+    try:
+        kinds = ("EnvironmentMapMessage",)
+        tab.wait(lambda: any(m["type"] in kinds for m in tab.received), "the lighting")
+        (lighting,) = [m for m in tab.received if m["type"] in kinds]
+        assert lighting["hdri_data"] is None
+    finally:
+        tab.close()
 
 
 def test_the_piped_client_prints_the_replies_shown(c2rviz_process) -> None:

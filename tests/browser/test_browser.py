@@ -11,6 +11,7 @@ import pytest
 from browser_support import (
     ARTIFACTS,
     DEADLINE_S,
+    PLAIN,
     VIEWPORT,
     Tcp,
     changed,
@@ -33,7 +34,7 @@ def test_the_page_follows_commands_and_commands_the_robot(
     browser: Any, c2rviz_process: Callable[..., Any]
 ) -> None:
     ARTIFACTS.mkdir(exist_ok=True)
-    proc = c2rviz_process("--viser-port", "0")
+    proc = c2rviz_process("--viser-port", "0", *PLAIN)
     assert proc.viewer_url is not None and proc.viewer_url.startswith("http://127.0.0.1:")
     page = open_page(browser, proc.viewer_url)
     # viser draws its share-link button as this icon (present by default); it is off.
@@ -140,7 +141,7 @@ def test_a_page_from_another_origin_cannot_reach_the_viewer(
     The viewer's own page, titled by the robot, still connects and works."""
     import viser
 
-    proc = c2rviz_process("--viser-port", "0")
+    proc = c2rviz_process("--viser-port", "0", *PLAIN)
     socket_url = proc.viewer_url.replace("http://", "ws://") + "/"
     protocol = f"viser-v{viser.__version__}"
     elsewhere = browser.new_page()
@@ -167,7 +168,7 @@ def test_long_joint_names_stay_on_one_line(
 ) -> None:
     """ur5's joints are named like shoulder_pan_joint: each label fits on one line."""
     ARTIFACTS.mkdir(exist_ok=True)
-    proc = c2rviz_process("--robot", "ur5", "--viser-port", "0")
+    proc = c2rviz_process("--robot", "ur5", "--viser-port", "0", *PLAIN)
     page = browser.new_page(viewport=VIEWPORT)
     page.goto(proc.viewer_url + "/?fixedDpr=1")
     page.get_by_text("Speed %").first.wait_for(timeout=DEADLINE_S * 1000)
@@ -189,7 +190,7 @@ def test_an_object_is_drawn_and_a_link_in_it_turns_red(
     browser: Any, c2rviz_process: Callable[..., Any]
 ) -> None:
     ARTIFACTS.mkdir(exist_ok=True)
-    proc = c2rviz_process("--viser-port", "0")
+    proc = c2rviz_process("--viser-port", "0")  # studio: the default lighting
     page = open_page(browser, proc.viewer_url)
     wait_for_robot(page)
     home = settle(page, "objects-1-home")

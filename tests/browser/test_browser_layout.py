@@ -9,7 +9,7 @@ from collections.abc import Callable
 from typing import Any
 
 import pytest
-from browser_support import ARTIFACTS, DEADLINE_S, wait_until
+from browser_support import ARTIFACTS, DEADLINE_S, PLAIN, wait_until
 
 pytestmark = pytest.mark.browser
 
@@ -31,7 +31,7 @@ CHART_IN_PANEL = """() => {
 def test_the_joint_chart_is_in_view_at_1400_by_900(
     robot: str, browser: Any, c2rviz_process: Callable[..., Any]
 ) -> None:
-    proc = c2rviz_process("--viser-port", "0", "--robot", robot)
+    proc = c2rviz_process("--viser-port", "0", "--robot", robot, *PLAIN)
     page = browser.new_page(viewport={"width": 1400, "height": 900})
     try:
         page.goto(proc.viewer_url + "/?fixedDpr=1")

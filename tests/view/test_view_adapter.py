@@ -29,6 +29,7 @@ from viewer_tabs import bad_messages, gui_update, never_reading_tab
 from websockets.exceptions import ConnectionClosed, InvalidStatus
 from websockets.sync.client import ClientConnection, connect
 
+from c2rviz.app.config import LIGHTINGS
 from c2rviz.view import adapter
 from c2rviz.view.policy import DoorPolicy, DoorPolicyError, normalize_origin
 from c2rviz.view.ratelog import RateLimitedLog
@@ -57,8 +58,8 @@ def messages_in(frame: bytes | str) -> list[dict[str, Any]]:
 class Served:
     """A viser server started by the adapter, with inputs that record page values."""
 
-    def __init__(self, policy: DoorPolicy | None = None) -> None:
-        self.server = adapter.start("127.0.0.1", 0, label="test", policy=policy)
+    def __init__(self, policy: DoorPolicy | None = None, lighting: str = "studio") -> None:
+        self.server = adapter.start("127.0.0.1", 0, label="test", policy=policy, lighting=lighting)
         self.port = self.server.get_port()
         self.door = adapter.door(self.server)
         gui = self.server.gui
@@ -137,8 +138,8 @@ def read_until(ws: ClientConnection, name: str) -> list[dict[str, Any]]:
 def served() -> Iterator[Callable[..., Served]]:
     made: list[Served] = []
 
-    def make(policy: DoorPolicy | None = None) -> Served:
-        made.append(Served(policy))
+    def make(policy: DoorPolicy | None = None, lighting: str = "studio") -> Served:
+        made.append(Served(policy, lighting))
         return made[-1]
 
     yield make
@@ -544,6 +545,35 @@ def test_stop_frees_the_port_and_prints_nothing(capsys: pytest.CaptureFixture[st
     assert capsys.readouterr().out == ""
 
 
+@pytest.mark.parametrize("lighting", adapter.LIGHTINGS)
+def test_a_tab_is_sent_the_lighting_chosen(served: Callable[..., Served], lighting: str) -> None:
+    """studio sends nothing (viser's page then shows its own environment map, lights and
+    shadows); plain turns the map and the shadows off and adds a white hemisphere light."""
+    s = served(lighting=lighting)
+    with s.connect() as ws:
+        seen = read_until(ws, s.sentinel())
+    lights = [
+        (m["type"], m.get("hdri_data", m.get("cast_shadow", m.get("props"))))
+        for m in seen
+        if m["type"] in ("EnvironmentMapMessage", "EnableLightsMessage", "HemisphereLightMessage")
+    ]
+    plain = [
+        ("EnvironmentMapMessage", None),
+        ("EnableLightsMessage", False),
+        (
+            "HemisphereLightMessage",
+            {"sky_color": [255] * 3, "ground_color": [255] * 3, "intensity": 2.0},
+        ),
+    ]
+    assert lights == (plain if lighting == "plain" else [])
+
+
+def test_an_unknown_lighting_is_refused_before_viser_starts() -> None:
+    with pytest.raises(ValueError, match="lighting 'dim' is not one of studio, plain"):
+        adapter.start("127.0.0.1", 0, lighting="dim")
+    assert LIGHTINGS == adapter.LIGHTINGS  # the flag's choices are the adapter's
+
+
 # 7. fast sends
 
 
@@ -652,7 +682,7 @@ def test_the_real_page_gets_through_with_its_token(
 ) -> None:
     """viser's own page, opened at the printed URL: it connects, nothing it says is
     dropped, and a click on the button reaches the callback."""
-    s = served(DoorPolicy(token="s3cret"))
+    s = served(DoorPolicy(token="s3cret"), lighting="plain")  # the door, not the look
     page = browser.new_page()
     page.goto(s.door.policy.page_url(f"http://127.0.0.1:{s.port}"))
     # viser counts a tab once its first camera update got through the door.
