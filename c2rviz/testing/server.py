@@ -355,4 +355,5 @@ class TestServer:
             settings.hz,
             policy=policy,
             title=self.cell,
+            lighting=settings.viewer_lighting,
         )
