@@ -7,6 +7,7 @@
 # tests marked `xdist_group("default_ports")` (they use 31000/64444/9090/8080) on one
 # worker, one at a time. `C2RVIZ_TEST_WORKERS=1` runs it in one process.
 # A run that collects no test fails (pytest's status 5), e.g. a `-k` that matches nothing.
+# The 30 slowest tests are listed at the end: where the suite's minutes go.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -45,7 +46,7 @@ if [ "${C2RVIZ_COVERAGE:-0}" = "1" ]; then
 fi
 
 status=0
-.venv/bin/python -m pytest "${workers[@]}" "${cov[@]}" "${args[@]}" || status=$?
+.venv/bin/python -m pytest "${workers[@]}" --durations=30 "${cov[@]}" "${args[@]}" || status=$?
 if [ "$status" -eq 5 ]; then
     echo "scripts/test.sh: pytest collected no test: that is a failure, not a pass" >&2
 fi
