@@ -195,8 +195,9 @@ class PageProcess:
             scene.on_clear_markers(event[1])
         elif kind == "clients":
             scene.on_clients(event[1])
-        elif kind == "command":
-            scene.on_command(event[1], event[2], event[3])
+        elif kind == "commands":  # the newest first, as many as the readout keeps
+            for line, accepted in reversed(event[1]):
+                scene.on_command("", line, accepted)
         elif kind == "tool":
             tool = pin.SE3(np.array(event[2], dtype=float).reshape(4, 4))
             world.robots[event[1]].tool = tool

@@ -120,6 +120,24 @@ def test_every_joint_sample_reaches_the_plots(both: Both) -> None:
     assert history.at(history.end)[0] == pytest.approx(0.0698131700797732)  # 4 degrees
 
 
+def test_a_flood_of_lines_sends_the_page_only_the_last_commands_it_shows(both: Both) -> None:
+    """Every line is noted, but a frame carries only the newest the readout keeps (8 here),
+    once, not one event per line: a pipelined client's 1,000 lines cost the page nothing."""
+    for k in range(1000):
+        assert both.session.run(f"joints {k % 10},0,0,0,0,0,0") == "ok"
+    both.link._publish()
+    [frame] = both.to_page.take()
+    said = [event for event in frame[3] if event[0] in ("command", "commands")]
+    newest = [[f"joints {k % 10},0,0,0,0,0,0", True] for k in range(999, 991, -1)]
+    assert said == [["commands", newest]]
+    both.page.apply(frame)
+    assert list(both.page.scene._commands)[:8] == list(both.link.commands)
+    assert both.session.run("where") == "ok 9,0,0,0,0,0,0"
+    both.frame()
+    assert list(both.page.scene._commands)[:8] == list(both.link.commands)
+    assert both.page.scene._commands[0] == ("where", True)
+
+
 def test_a_page_line_runs_on_the_page_session_in_the_program(both: Both) -> None:
     page = both.page.scene.sessions[ROBOT]
     assert isinstance(page, ForwardingSession)
