@@ -116,6 +116,7 @@ class PageProcess:
         kind = message[0]
         if kind == "frame":
             self.apply_frame(message[1], message[2], message[3])
+            self.send(["applied"])  # the program's next frame waits for this word
         elif kind == "state":
             self.apply_state(pickle.loads(message[1]), fresh=False)
         elif kind == "stop":
