@@ -44,8 +44,10 @@ SCHEDULING = getattr(os, "SCHED_BATCH", None)
 of a CPU, but waking (a frame arrived, viser's thread has bytes to send) it never
 preempts the task that runs, so on a CPU it shares with the command process it takes its
 turns when the command loop waits or its slice ends instead of cutting into a reply.
-Measured with ``many_robots.py --robots 64 --page-process`` (load 9-10): the page 9 ->
-12-13 frames/s, a bystander's p99 19-21 -> 11 ms (docs/page.md)."""
+In five alternated pairs of ``many_robots.py --robots 64 --page-process`` at load 8-11
+a bystander's p99 was lower with it in four (medians 19.4 -> 11.7 ms), the page's frames
+the same within the noise; ``run.py --tab --page-process``'s rows did not move beyond
+theirs (docs/page.md)."""
 
 
 class PageProcessHandle(Protocol):
