@@ -12,9 +12,10 @@ driver connection keeps every robot moving at speed 100 (``motion follow``, a ne
 target for each robot every half second, switching robots with ``robot NAME``); a
 bystander process does ``where`` request/reply on the first robot's port meanwhile.
 
-Figures, printed beside their goals (issue 30): the server's CPU [share of one core],
-frames/s reaching the page per robot (the lowest and the median), the bystander's p50
-and p99 [ms]. The server is pinned to one CPU and the clients to the other, as in
+Figures, printed beside their goals (issue 30; with ``--page-process`` issue 40's: the
+command process <= 0.5 core, a bystander's p99 <= 2 ms): the server's CPU [share of one
+core], frames/s reaching the page per robot (the lowest and the median), the bystander's
+p50 and p99 [ms]. The server is pinned to one CPU and the clients to the other, as in
 ``run.py``. ``--page-process`` runs the program with ``--page-process`` (docs/page.md):
 the page process shares the server's CPU (it inherits the pin; ``--page-anywhere`` lets
 it run on every CPU, where it competes with the page client's decoding) and its CPU is a
@@ -43,6 +44,8 @@ from processes import HOST, Launched, free_port, launch, pin_cpus
 from report import machine
 
 GOALS = {"cpu": 1.0, "fps": 30.0, "p99_ms": 5.0}
+PAGE_PROCESS_GOALS = {"cpu": 0.5, "fps": 30.0, "p99_ms": 2.0}
+"""Issue 40's, with ``--page-process``: the command process's CPU alone, a tighter p99."""
 FAR = ("90,45,-30,-30,0,60,0", "-90,-45,30,30,0,-60,0")  # degrees: two far targets
 
 
@@ -245,13 +248,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     how = f"; the page in its own process (on {where})" if args.page_process else ""
     print(f"{count} motoman_sia20d moving, a page open; {pin_cpus(not args.no_pin)}{how}")
     got = measure(count, seconds, args.page_process, args.page_anywhere)
+    goals = PAGE_PROCESS_GOALS if args.page_process else GOALS
     rows = [
-        ("server CPU [cores]", got["cpu"], "<=", GOALS["cpu"]),
+        ("server CPU [cores]", got["cpu"], "<=", goals["cpu"]),
         *([("page process CPU [cores]", got["page_cpu"], "", None)] if args.page_process else []),
-        ("page frames/s, lowest robot", got["fps_min"], ">=", GOALS["fps"]),
-        ("page frames/s, median robot", got["fps_median"], ">=", GOALS["fps"]),
+        ("page frames/s, lowest robot", got["fps_min"], ">=", goals["fps"]),
+        ("page frames/s, median robot", got["fps_median"], ">=", goals["fps"]),
         ("bystander where p50 [ms]", got["p50_ms"], "", None),
-        ("bystander where p99 [ms]", got["p99_ms"], "<=", GOALS["p99_ms"]),
+        ("bystander where p99 [ms]", got["p99_ms"], "<=", goals["p99_ms"]),
     ]
     print("| figure | value | goal | met |")
     print("|---|---|---|---|")

@@ -4,13 +4,16 @@ the ``frame`` message made of them (``--page-process``; ``page_link`` sends it).
 ``FrameNotes`` is the scene the world tells (``Scene``): each effect is noted in O(1)
 (a joint sample, a robot changed, an event in order, parts, goals or cameras changed, a
 robot's faults changed) and asks for a frame (``request``). ``frame`` then makes one
-message: each changed robot's samples and state, then the events, then the parts, goals,
+message: each changed robot's samples and state, then the events, then the newest lines
+said since the last frame (as many as the 'last commands' readout keeps: every line is
+counted, but a flood of them is not a flood of events), then the parts, goals,
 cameras and fault banners as rows (``page_cell``) when they changed, the ghost's path
 when it changed, and the trails when one was turned on or off or cleared.
 """
 
 from __future__ import annotations
 
+import itertools
 import pickle
 from collections import deque
 from collections.abc import Callable, Sequence
@@ -61,6 +64,7 @@ class FrameNotes(Scene):
         self._dirty: set[str] = set()
         self._events: list[list[Any]] = []
         self.commands: deque[tuple[str, bool]] = deque(maxlen=keep)
+        self._said = 0  # commands told since the last frame (the newest ``keep`` go)
         self._trails: list[list[Any]] = []
         self._paths: dict[str, object] = {}  # the path each robot's ghost was last sent
         self._parts = self._goals = self._cameras = False  # changed since the last frame
@@ -80,6 +84,7 @@ class FrameNotes(Scene):
             samples.clear()
         self._dirty.clear()
         self._events.clear()
+        self._said = 0
         self._parts = self._goals = self._cameras = False
         self._faults.clear()
 
@@ -115,7 +120,9 @@ class FrameNotes(Scene):
 
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         self.commands.appendleft((line, accepted))
-        self._event(["command", source, line, accepted])
+        if self.on_air:  # one count per line: the frame says the newest ``keep`` of them
+            self._said += 1
+            self.request()
 
     def on_tool(self, robot: str, tool: pin.SE3) -> None:
         self._event(["tool", robot, tool.homogeneous.ravel().tolist()])
@@ -190,6 +197,10 @@ class FrameNotes(Scene):
                 self._events.append(["path", name, path_rows(path, world.clock.now())])
         self._dirty.clear()
         events, self._events = self._events, []
+        if self._said:
+            said = itertools.islice(self.commands, min(self._said, len(self.commands)))
+            events.append(["commands", [[line, accepted] for line, accepted in said]])
+            self._said = 0
         if self._parts:
             events.append(["parts", part_rows(world.parts.parts.all()), world.clock.now()])
         if self._goals:

@@ -18,7 +18,8 @@ runs on the page's ``Session`` of that robot, like any other door's lines. When 
 page process exits or crashes, the link logs it and starts another on the same port
 (tabs reconnect by themselves) with a fresh snapshot; commands go on meanwhile. While
 the page falls behind (its socket's buffer past ``BACKLOG``) frames are dropped and a
-snapshot follows once it catches up.
+snapshot follows once it catches up. At most ``IN_FLIGHT`` frames go unapplied: a page
+process short of CPU says ``applied`` less often and gets fewer, fuller frames.
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ from .page_snapshot import Hello, PageConfig, snapshot
 from .page_start import PageProcessHandle, Spawned, spawn
 from .ratelog import RateLimitedLog
 
-__all__ = ["BACKLOG", "SAMPLES_KEPT", "PageLink"]
+__all__ = ["BACKLOG", "IN_FLIGHT", "SAMPLES_KEPT", "PageLink"]
 
 log = logging.getLogger("c2rviz.view")
 
@@ -53,6 +54,10 @@ START_TIMEOUT_S = 60.0
 """Longest wait for the page process to serve the page [s]."""
 STOP_TIMEOUT_S = 2.0
 """Longest wait for the page process to stop before it is killed [s]."""
+IN_FLIGHT = 2
+"""Frames written that the page process has not yet said it applied, past which the next
+waits for its word (the notes gather meanwhile, so a page short of CPU gets fewer, fuller
+frames instead of a queue of old ones at ``hz``)."""
 RESTART_S = (0.2, 1.0, 5.0)
 """Pauses before starting the page process again after quick successive crashes [s]."""
 
@@ -91,6 +96,8 @@ class PageLink(FrameNotes):
         self.request = self._request
         self._writer: asyncio.StreamWriter | None = None
         self._behind = False  # frames were dropped: a snapshot is due
+        self._unapplied = 0  # frames written, not yet applied by the page process
+        self._held = False  # a frame waits for the page process to apply one
         self._loop: asyncio.AbstractEventLoop | None = None
         self._flush: asyncio.TimerHandle | None = None
         self._last_flush = 0.0
@@ -199,22 +206,32 @@ class PageLink(FrameNotes):
         writer.write(encode(["hello", pickle.dumps(hello)]))
         self.fresh()
         self._behind = False
+        self._unapplied, self._held = 0, False
         self._writer = writer
 
     async def _read(self, reader: asyncio.StreamReader) -> None:
         frames = FrameReader()
         while data := await reader.read(1 << 16):
             for message in frames.feed(data):
-                kind = message[0]
-                if kind == "line" and len(message) == 3:
-                    self._line(str(message[1]), str(message[2]))
-                elif kind == "ready":
-                    self.port, self.url = int(message[1]), str(message[2])
-                    if self._ready is not None and not self._ready.done():
-                        self._ready.set_result(self.url)
-                elif kind == "error":
-                    self._fail(OSError(int(message[1]), str(message[2])))
-                    self._stopping = True
+                self._heard(message)
+
+    def _heard(self, message: list[Any]) -> None:
+        """One message from the page process."""
+        kind = message[0]
+        if kind == "applied":
+            self._unapplied = max(self._unapplied - 1, 0)
+            if self._held:
+                self._held = False
+                self._request()
+        elif kind == "line" and len(message) == 3:
+            self._line(str(message[1]), str(message[2]))
+        elif kind == "ready":
+            self.port, self.url = int(message[1]), str(message[2])
+            if self._ready is not None and not self._ready.done():
+                self._ready.set_result(self.url)
+        elif kind == "error":
+            self._fail(OSError(int(message[1]), str(message[2])))
+            self._stopping = True
 
     def _fail(self, exc: OSError) -> None:
         if self._ready is not None and not self._ready.done():
@@ -263,6 +280,9 @@ class PageLink(FrameNotes):
         writer = self._writer
         if writer is None or writer.is_closing():
             return
+        if self._unapplied >= IN_FLIGHT:  # the page process is busy: gather for it
+            self._held = True
+            return
         if writer.transport.get_write_buffer_size() > BACKLOG:
             self._behind = True  # the page is stuck: drop, and send it all when it is not
             self.drop()
@@ -275,6 +295,7 @@ class PageLink(FrameNotes):
             self.fresh()  # the snapshot has it all: nothing twice (a marker)
         try:
             writer.write(encode(self.frame()))
+            self._unapplied += 1
         except ChannelError as exc:  # a frame too big to send: the page gets a snapshot
             self._log.warning("frame", f"a page frame was dropped: {exc}")
             self._behind = True

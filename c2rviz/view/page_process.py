@@ -116,6 +116,7 @@ class PageProcess:
         kind = message[0]
         if kind == "frame":
             self.apply_frame(message[1], message[2], message[3])
+            self.send(["applied"])  # the program's next frame waits for this word
         elif kind == "state":
             self.apply_state(pickle.loads(message[1]), fresh=False)
         elif kind == "stop":
@@ -195,8 +196,9 @@ class PageProcess:
             scene.on_clear_markers(event[1])
         elif kind == "clients":
             scene.on_clients(event[1])
-        elif kind == "command":
-            scene.on_command(event[1], event[2], event[3])
+        elif kind == "commands":  # the newest first, as many as the readout keeps
+            for line, accepted in reversed(event[1]):
+                scene.on_command("", line, accepted)
         elif kind == "tool":
             tool = pin.SE3(np.array(event[2], dtype=float).reshape(4, 4))
             world.robots[event[1]].tool = tool

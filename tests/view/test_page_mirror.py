@@ -18,7 +18,7 @@ from c2rviz.session.services import Services
 from c2rviz.session.session import Session
 from c2rviz.session.settings import SessionDefaults
 from c2rviz.view.page_channel import FrameReader
-from c2rviz.view.page_link import PageLink
+from c2rviz.view.page_link import IN_FLIGHT, PageLink
 from c2rviz.view.page_process import ForwardingSession, PageProcess
 from c2rviz.view.page_snapshot import Hello, PageConfig, snapshot
 from c2rviz.world.world import World
@@ -71,7 +71,7 @@ class Both:
         for message in self.to_page.take():
             self.page.apply(message)
         for message in self.to_program.take():
-            self.link._line(message[1], message[2])
+            self.link._heard(message)
 
     @property
     def mirror(self) -> Any:
@@ -118,6 +118,50 @@ def test_every_joint_sample_reaches_the_plots(both: Both) -> None:
     both.frame()
     history = both.page.scene.instruments.histories[ROBOT]
     assert history.at(history.end)[0] == pytest.approx(0.0698131700797732)  # 4 degrees
+
+
+def test_a_flood_of_lines_sends_the_page_only_the_last_commands_it_shows(both: Both) -> None:
+    """Every line is noted, but a frame carries only the newest the readout keeps (8 here),
+    once, not one event per line: a pipelined client's 1,000 lines cost the page nothing."""
+    for k in range(1000):
+        assert both.session.run(f"joints {k % 10},0,0,0,0,0,0") == "ok"
+    both.link._publish()
+    [frame] = both.to_page.take()
+    said = [event for event in frame[3] if event[0] in ("command", "commands")]
+    newest = [[f"joints {k % 10},0,0,0,0,0,0", True] for k in range(999, 991, -1)]
+    assert said == [["commands", newest]]
+    both.page.apply(frame)
+    assert list(both.page.scene._commands)[:8] == list(both.link.commands)
+    assert both.session.run("where") == "ok 9,0,0,0,0,0,0"
+    both.frame()
+    assert list(both.page.scene._commands)[:8] == list(both.link.commands)
+    assert both.page.scene._commands[0] == ("where", True)
+
+
+def test_a_page_process_that_has_not_applied_its_frames_gets_fewer_fuller_ones(
+    both: Both,
+) -> None:
+    """Past ``IN_FLIGHT`` frames unapplied the next waits, gathering; ``applied`` lets it go."""
+    for k in range(IN_FLIGHT):
+        assert both.session.run(f"move 0 {k}") == "ok"
+        both.link._publish()
+    sent = both.to_page.take()
+    assert len(sent) == IN_FLIGHT
+    for k in (10, 11, 12):
+        assert both.session.run(f"move 0 {k}") == "ok"
+    both.link._publish()
+    assert both.to_page.take() == []  # held: the page process is busy
+    for frame in sent:
+        both.page.apply(frame)
+    said = both.to_program.take()
+    assert [m[0] for m in said] == ["applied"] * IN_FLIGHT
+    both.link._heard(said[0])  # one applied: one more may go
+    both.link._publish()
+    [frame] = both.to_page.take()
+    [robot] = frame[2]
+    assert [round(math.degrees(s[1])) for s in robot[1]] == [10, 11, 12]  # every sample
+    both.page.apply(frame)
+    assert both.mirror.q[0] == pytest.approx(math.radians(12))
 
 
 def test_a_page_line_runs_on_the_page_session_in_the_program(both: Both) -> None:

@@ -112,6 +112,11 @@ class Tcp:
         self.sock.close()
 
 
+def policies(pid: int) -> set[int]:
+    """The scheduling policies of the threads of process ``pid``."""
+    return {os.sched_getscheduler(int(tid)) for tid in os.listdir(f"/proc/{pid}/task")}
+
+
 def read_until(proc: Any, text: str) -> list[str]:
     """The program's output lines up to the first that holds ``text``."""
     seen = []
@@ -141,6 +146,7 @@ def test_a_killed_page_process_comes_back_and_commands_go_on(
 ) -> None:
     proc = c2rviz_process("--viser-port", "0", "--page-process")
     first = page_process(proc.popen.pid)
+    assert policies(first) == {os.SCHED_BATCH}  # the page's threads never preempt commands
     mover, bystander = Tcp(proc.port), Tcp(proc.port)
     try:
         for line in ("degrees", "motion on", "speed 5", "marker cube", "mark"):
@@ -173,6 +179,7 @@ def test_a_killed_page_process_comes_back_and_commands_go_on(
         assert "move 0 90" in values["Last commands"]
         names = node_names(messages)
         assert any(n.startswith("/robots/motoman_sia20d/links/") for n in names)
+        assert policies(second) == {os.SCHED_BATCH}  # spawned, not forked: the same
     finally:
         mover.close()
         bystander.close()
