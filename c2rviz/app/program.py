@@ -93,6 +93,7 @@ def _open_scene(
             settings.trail_points,
             logging.getLogger().getEffectiveLevel(),
             RECENT_COMMANDS,
+            settings.viewer_lighting,
         )
         return PageLink(services, config, spawned)
     from ..view.policy import DoorPolicy

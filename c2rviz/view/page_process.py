@@ -100,6 +100,7 @@ class PageProcess:
             policy=policy,
             title=config.title,
             page_session=lambda services, robot: ForwardingSession(services, robot, self.send),
+            lighting=config.lighting,
         )
         self.scene.scheduler.rest_per_work = REST_PER_WORK
         world.add_observers([self.scene])

@@ -46,6 +46,7 @@ class PageConfig:
         trail_points: Points a trail keeps at most.
         log_level: The program's logging level (the page process logs alike).
         recent_commands: Lines the 'last commands' readout keeps.
+        lighting: How the page lights its scene (``adapter.LIGHTINGS``).
     """
 
     host: str
@@ -59,6 +60,7 @@ class PageConfig:
     trail_points: int
     log_level: int
     recent_commands: int
+    lighting: str = "studio"
 
     @property
     def frame_s(self) -> float:

@@ -17,6 +17,7 @@ from support import load_robot
 from c2rviz.session.services import Services
 from c2rviz.session.session import Session
 from c2rviz.session.settings import SessionDefaults
+from c2rviz.view import adapter
 from c2rviz.view.page_channel import FrameReader
 from c2rviz.view.page_link import IN_FLIGHT, PageLink
 from c2rviz.view.page_process import ForwardingSession, PageProcess
@@ -276,3 +277,29 @@ def test_a_trail_clear_clears_the_pages_trail(both: Both) -> None:
     both.frame()
     assert len(keeper.points(ROBOT)) == 1  # from where the arm is now
     np.testing.assert_allclose(keeper.points(ROBOT), kept.points(ROBOT))
+
+
+def test_the_page_process_lights_its_page_as_the_program_says(monkeypatch) -> None:
+    """``--viewer-lighting`` reaches the page process (its PageConfig), as it does the page
+    served in the program's own process."""
+    asked: list[str] = []
+    start = adapter.start
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        asked.append(kwargs["lighting"])
+        return start(*args, **kwargs)
+
+    monkeypatch.setattr(adapter, "start", spy)
+    world = World({ROBOT: load_robot()})
+    services = Services(world)
+    config = PageConfig(
+        "127.0.0.1", 0, 100.0, (), None, 4, None, SessionDefaults(), 100, 30, 8, "plain"
+    )
+    link = PageLink(services, config)
+    hello = Hello(config, snapshot(services, link.sessions, []))
+    page = PageProcess(pickle.loads(pickle.dumps(hello)), Pipe())  # type: ignore[arg-type]
+    try:
+        assert asked == ["plain"]
+    finally:
+        page.scene.stop()
+        services.close()
