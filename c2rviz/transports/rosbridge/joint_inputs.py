@@ -149,22 +149,26 @@ async def _plan(
     zeros = np.zeros(robot.n)
     limits = world.motion_limits(state.name)
 
-    def chain(values: Sequence[float], base: np.ndarray) -> np.ndarray:
-        full = base.copy()
-        full[indices] = values
+    def chain(rows: Sequence[Sequence[float]], base: np.ndarray) -> np.ndarray:
+        full = np.tile(base, (len(rows), 1))
+        full[:, indices] = rows
         return full
 
-    def given(values: Sequence[float] | None) -> np.ndarray | None:
-        return None if values is None else chain(values, zeros)
+    def given(rows: list[Sequence[float] | None]) -> list[np.ndarray | None]:
+        if rows.count(None) == len(rows):
+            return [None] * len(rows)
+        present = chain([row for row in rows if row is not None], zeros)
+        each = iter(present)
+        return [None if row is None else next(each) for row in rows]
 
-    def plan() -> PlannedTrajectory:
+    def plan() -> PlannedTrajectory:  # arrays built whole: few Python steps per point
         points = trajectory.points
         return plan_trajectory(
             start,
             [p.time_from_start_s for p in points],
-            [chain(p.positions, start) for p in points],
-            [given(p.velocities) for p in points],
-            [given(p.accelerations) for p in points],
+            chain([p.positions for p in points], start),
+            given([p.velocities for p in points]),
+            given([p.accelerations for p in points]),
             limits,
             robot.joint_names,
             _units(robot),
