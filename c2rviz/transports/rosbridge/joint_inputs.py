@@ -33,10 +33,14 @@ from ...session.session import Session
 from ...tolerance import within_limit
 from .messages import JointPositions, JointTrajectory
 
-__all__ = ["MAX_GUARD_SAMPLES", "UnknownJointName", "joint_command", "joint_trajectory"]
+__all__ = ["MAX_GUARD_SAMPLES", "ROWS", "UnknownJointName", "joint_command", "joint_trajectory"]
 
 MAX_GUARD_SAMPLES = MAX_TRAJECTORY_CHECKS
 """Most instants of a trajectory checked for collisions (one per frame, or fewer)."""
+ROWS = 500
+"""Points' numbers turned into an array in one call at most: numpy holds the interpreter's
+lock through it (some 0.3 ms a slice), and the worker thread hands the lock to the event
+loop only between calls."""
 
 
 class UnknownJointName(C2rvizError):
@@ -151,7 +155,8 @@ async def _plan(
 
     def chain(rows: Sequence[Sequence[float]], base: np.ndarray) -> np.ndarray:
         full = np.tile(base, (len(rows), 1))
-        full[:, indices] = rows
+        for first in range(0, len(rows), ROWS):  # (the loop may take the lock between)
+            full[first : first + ROWS, indices] = rows[first : first + ROWS]
         return full
 
     def given(rows: list[Sequence[float] | None]) -> list[np.ndarray | None]:
