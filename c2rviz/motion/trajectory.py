@@ -30,9 +30,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import C2rvizError
-from ..tolerance import within_limit
 from .limits import MotionLimits
+from .trajectory_check import (
+    LIMIT_SLACK,
+    SAMPLES_PER_SEGMENT,
+    TrajectoryError,
+    check_limits,
+    evaluate,
+)
 
 __all__ = [
     "LIMIT_SLACK",
@@ -44,17 +49,8 @@ __all__ = [
     "plan_trajectory",
 ]
 
-LIMIT_SLACK = 1e-3
-"""Relative slack over a velocity or acceleration limit (0.1 %): a trajectory timed
-exactly at a limit by another planner passes despite rounding in its numbers."""
-SAMPLES_PER_SEGMENT = 32
-"""Instants checked inside each segment besides its two knots."""
 START_TOLERANCE = 1e-3
 """How far [rad or m] a point at time 0 may be from where the arm is."""
-
-
-class TrajectoryError(C2rvizError):
-    """A trajectory refused whole: the message names the point, the joint and the limit."""
 
 
 @dataclass(frozen=True)
@@ -95,19 +91,7 @@ class PlannedTrajectory:
         k = min(int(np.searchsorted(times, s, side="right")) - 1, len(times) - 2)
         tau = s - float(times[k])
         c = self.coefficients[k]
-        return _evaluate(c, np.array([tau]), order)[0]
-
-
-def _evaluate(c: np.ndarray, tau: np.ndarray, order: int) -> np.ndarray:
-    """Derivative ``order`` of the polynomial with coefficients ``c`` (6, joints) at ``tau``."""
-    powers = np.arange(6)
-    out = np.zeros((len(tau), c.shape[1]))
-    for i in range(order, 6):
-        factor = 1.0
-        for j in range(order):
-            factor *= i - j
-        out += factor * np.outer(tau ** (powers[i] - order), c[i])
-    return out
+        return evaluate(c, np.array([tau]), order)[0]
 
 
 def _pchip_velocities(times: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -126,26 +110,40 @@ def _pchip_velocities(times: np.ndarray, q: np.ndarray) -> np.ndarray:
 
 
 def _coefficients(
-    h: float,
+    h: np.ndarray,
     p0: np.ndarray,
     v0: np.ndarray,
-    a0: np.ndarray | None,
+    a0: np.ndarray,
     p1: np.ndarray,
     v1: np.ndarray,
-    a1: np.ndarray | None,
+    a1: np.ndarray,
+    quintic: np.ndarray,
 ) -> np.ndarray:
-    c = np.zeros((6, len(p0)))
-    c[0], c[1] = p0, v0
+    """Every segment's coefficients at once, shape (segments, 6, joints): ``h`` (segments, 1)
+    the durations, the others (segments, joints); ``quintic`` (segments,) where both knots
+    carry accelerations (positions, velocities and accelerations met), else cubic Hermite
+    (positions and velocities met)."""
+    c = np.zeros((len(h), 6, p0.shape[1]))
+    c[:, 0], c[:, 1] = p0, v0
     dp = p1 - p0
-    if a0 is not None and a1 is not None:  # quintic: positions, velocities, accelerations
-        c[2] = a0 / 2
-        c[3] = (20 * dp - (8 * v1 + 12 * v0) * h - (3 * a0 - a1) * h**2) / (2 * h**3)
-        c[4] = (-30 * dp + (14 * v1 + 16 * v0) * h + (3 * a0 - 2 * a1) * h**2) / (2 * h**4)
-        c[5] = (12 * dp - 6 * (v1 + v0) * h - (a0 - a1) * h**2) / (2 * h**5)
-    else:  # cubic Hermite: positions and velocities
-        c[2] = (3 * dp / h - 2 * v0 - v1) / h
-        c[3] = (-2 * dp / h + v0 + v1) / h**2
+    c[:, 2] = (3 * dp / h - 2 * v0 - v1) / h
+    c[:, 3] = (-2 * dp / h + v0 + v1) / h**2
+    if quintic.any():
+        h, dp, v0, v1, a0, a1 = (x[quintic] for x in (h, dp, v0, v1, a0, a1))
+        c[quintic, 2] = a0 / 2
+        c[quintic, 3] = (20 * dp - (8 * v1 + 12 * v0) * h - (3 * a0 - a1) * h**2) / (2 * h**3)
+        c[quintic, 4] = (-30 * dp + (14 * v1 + 16 * v0) * h + (3 * a0 - 2 * a1) * h**2) / (2 * h**4)
+        c[quintic, 5] = (12 * dp - 6 * (v1 + v0) * h - (a0 - a1) * h**2) / (2 * h**5)
     return c
+
+
+def _rows(values: Sequence[Values | None], n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Points' optional values as one array (0 where left out) and where they were given."""
+    out = np.zeros((len(values), n))
+    given = np.fromiter((x is not None for x in values), bool, len(values))
+    if given.any():
+        out[given] = np.asarray([x for x in values if x is not None], dtype=float)
+    return out, given
 
 
 Values = Sequence[float] | np.ndarray
@@ -155,7 +153,7 @@ Values = Sequence[float] | np.ndarray
 def plan_trajectory(
     start: Values,
     times: Sequence[float],
-    positions: Sequence[Values],
+    positions: Sequence[Values] | np.ndarray,
     velocities: Sequence[Values | None],
     accelerations: Sequence[Values | None],
     limits: MotionLimits,
@@ -168,7 +166,7 @@ def plan_trajectory(
     Args:
         start: The chain where the arm is [rad or m].
         times: Each point's time from the start [s], each >= 0, strictly increasing.
-        positions: Each point's whole chain [rad or m].
+        positions: Each point's whole chain [rad or m] (a row each).
         velocities: Each point's chain velocities [rad/s or m/s], or None to estimate.
         accelerations: Each point's chain accelerations [rad/s^2 or m/s^2], or None.
         limits: Position, velocity and acceleration limits of the chain.
@@ -183,120 +181,79 @@ def plan_trajectory(
         TrajectoryError: A point at time 0 away from the start, a last point not at
             rest, or a position, velocity or acceleration past a limit anywhere.
     """
-    names = list(point_names or [f"points[{i}]" for i in range(len(times))])
+
+    def name(i: int) -> str:  # made only for a message: thousands of points cost nothing
+        return f"points[{i}]" if point_names is None else point_names[i]
+
     q_start = np.asarray(start, dtype=float)
-    t = [float(x) for x in times]
-    q = [np.asarray(p, dtype=float) for p in positions]
-    v: list[np.ndarray | None] = [None if x is None else np.asarray(x, float) for x in velocities]
-    a: list[np.ndarray | None] = [
-        None if x is None else np.asarray(x, float) for x in accelerations
-    ]
-    if t and t[0] == 0.0:
+    n = len(q_start)
+    t = np.asarray(times, dtype=float)
+    q = np.asarray(positions, dtype=float).reshape(len(t), n)
+    v, v_given = _rows(velocities, n)
+    a, a_given = _rows(accelerations, n)
+    if len(t) and t[0] == 0.0:
         far = np.abs(q[0] - q_start)
         j = int(np.argmax(far))
         if far[j] > START_TOLERANCE:
             raise TrajectoryError(
-                f"{names[0]} is at time 0 but {joint_names[j]} is {far[j]:.6g} away from where "
+                f"{name(0)} is at time 0 but {joint_names[j]} is {far[j]:.6g} away from where "
                 f"the arm is (at most {START_TOLERANCE:g}): a point at time 0 is the start"
             )
-        t, q, v, a, names = t[1:], q[1:], v[1:], a[1:], names[1:]
-        if not t:
-            return _plan([0.0, 1e-9], [q_start, q_start], [None, None], [None, None], limits)
-    for what, last in (("velocities", v[-1]), ("accelerations", a[-1])):
-        if last is not None and np.any(np.abs(last) > 1e-9):
+        t, q, v, v_given, a, a_given = (x[1:] for x in (t, q, v, v_given, a, a_given))
+        if not len(t):
+            at_rest = np.zeros((2, n))
+            none = np.zeros(2, bool)
+            return _plan(np.array([0.0, 1e-9]), np.vstack([q_start, q_start]), at_rest, none,
+                         at_rest, none, limits)  # fmt: skip
+    for what, last, given in (
+        ("velocities", v[-1], v_given[-1]),
+        ("accelerations", a[-1], a_given[-1]),
+    ):
+        if given and np.any(np.abs(last) > 1e-9):
             j = int(np.argmax(np.abs(last)))
             raise TrajectoryError(
-                f"{names[-1]}.{what} are not 0 ({joint_names[j]}: {last[j]:.6g}): "
+                f"{name(len(times) - 1)}.{what} are not 0 ({joint_names[j]}: {last[j]:.6g}): "
                 "a trajectory ends at rest"
             )
-    planned = _plan([0.0, *t], [q_start, *q], [np.zeros_like(q_start), *v], [None, *a], limits)
-    _check(planned, limits, joint_names, names, units or ["rad"] * len(q_start))
+    rest, yes = np.zeros((1, n)), np.ones(1, bool)
+    planned = _plan(
+        np.concatenate([[0.0], t]),
+        np.vstack([q_start, q]),
+        np.vstack([rest, v]),
+        np.concatenate([yes, v_given]),
+        np.vstack([rest, a]),
+        np.concatenate([yes, a_given]),
+        limits,
+    )
+    planned.peak_rate[:] = check_limits(
+        planned.times, planned.knots, planned.coefficients, limits, joint_names,
+        lambda k: name(k + len(times) - len(t)),
+        units or ["rad"] * n,
+    )  # fmt: skip
     return planned
 
 
 def _plan(
-    times: Sequence[float],
-    q: Sequence[np.ndarray],
-    v: Sequence[np.ndarray | None],
-    a: Sequence[np.ndarray | None],
+    knots: np.ndarray,
+    qs: np.ndarray,
+    v: np.ndarray,
+    v_given: np.ndarray,
+    a: np.ndarray,
+    a_given: np.ndarray,
     limits: MotionLimits,
 ) -> PlannedTrajectory:
-    knots = np.asarray(times, dtype=float)
-    qs = np.vstack(q)
-    estimated = _pchip_velocities(knots, qs)  # 0 at both ends
-    velocities = [estimated[k] if given is None else given for k, given in enumerate(v)]
-    accelerations = list(a)
-    accelerations[0] = np.zeros(qs.shape[1])  # the start is at rest
-    coefficients = np.stack(
-        [
-            _coefficients(
-                float(knots[k + 1] - knots[k]),
-                qs[k],
-                velocities[k],
-                accelerations[k],
-                qs[k + 1],
-                velocities[k + 1],
-                accelerations[k + 1],
-            )
-            for k in range(len(knots) - 1)
-        ]
+    """The knots' polynomials: velocities left out estimated (PCHIP), the start at rest."""
+    velocities = np.where(v_given[:, None], v, _pchip_velocities(knots, qs))  # 0 at both ends
+    a_given = a_given.copy()
+    a_given[0] = True  # the start is at rest (its row is 0)
+    coefficients = _coefficients(
+        np.diff(knots)[:, None],
+        qs[:-1],
+        velocities[:-1],
+        a[:-1],
+        qs[1:],
+        velocities[1:],
+        a[1:],
+        a_given[:-1] & a_given[1:],
     )
     return PlannedTrajectory(knots, qs, coefficients, np.zeros(qs.shape[1]), limits)
-
-
-def _check(
-    planned: PlannedTrajectory,
-    limits: MotionLimits,
-    joint_names: Sequence[str],
-    point_names: Sequence[str],
-    units: Sequence[str],
-) -> None:
-    """Refuse the first segment that leaves a limit, naming its worst value."""
-    lower, upper = np.asarray(limits.lower), np.asarray(limits.upper)
-    bounds = (
-        ("velocity", 1, np.asarray(limits.velocity), "/s"),
-        ("acceleration", 2, np.asarray(limits.acceleration), "/s^2"),
-    )
-    knots = planned.knots  # the first is where the arm is
-    for k in range(1, len(knots)):
-        for j, value in enumerate(knots[k].tolist()):
-            if not within_limit(value, float(lower[j]), float(upper[j])):
-                raise TrajectoryError(
-                    f"{point_names[k - 1]}.positions: {joint_names[j]} = {value:.6g} {units[j]} "
-                    f"is outside its limits {lower[j]:.6g}..{upper[j]:.6g} {units[j]}"
-                )
-    peak = np.zeros(len(lower))
-    fractions = np.linspace(0.0, 1.0, SAMPLES_PER_SEGMENT + 2)
-    for k, c in enumerate(planned.coefficients):
-        tau = fractions * float(planned.times[k + 1] - planned.times[k])
-        where = f"on the way to {point_names[k]}"
-        positions = _evaluate(c, tau, 0)
-        beyond = np.maximum(positions - upper, lower - positions)
-        i, j = _worst(beyond)
-        value = float(positions[i, j])
-        if not within_limit(value, float(lower[j]), float(upper[j])):
-            raise TrajectoryError(
-                f"{where}: {joint_names[j]} reaches {value:.6g} {units[j]} at "
-                f"{planned.times[k] + tau[i]:.6g} s, outside its limits "
-                f"{lower[j]:.6g}..{upper[j]:.6g} {units[j]} (the path between points overshoots)"
-            )
-        for what, order, bound, per in bounds:
-            values = np.abs(_evaluate(c, tau, order))
-            if order == 1:
-                peak = np.maximum(peak, values.max(axis=0))
-            ratio = values / bound
-            i, j = _worst(ratio)
-            if ratio[i, j] > 1 + LIMIT_SLACK:
-                unit = units[j] + per
-                raise TrajectoryError(
-                    f"{where}: {joint_names[j]} {what} reaches {values[i, j]:.6g} {unit} at "
-                    f"{planned.times[k] + tau[i]:.6g} s, over its limit {bound[j]:.6g} {unit} "
-                    "(give the points more time)"
-                )
-    planned.peak_rate[:] = peak
-
-
-def _worst(values: np.ndarray) -> tuple[int, int]:
-    """(sample, joint) of the largest of ``values`` (samples x joints)."""
-    i, j = np.unravel_index(int(np.argmax(values)), values.shape)
-    return int(i), int(j)

@@ -9,7 +9,8 @@ from hypothesis import strategies as st
 
 from c2rviz.motion.limits import MotionLimits
 from c2rviz.motion.path_play import TrajectoryPlay
-from c2rviz.motion.trajectory import START_TOLERANCE, TrajectoryError, _evaluate, plan_trajectory
+from c2rviz.motion.trajectory import START_TOLERANCE, TrajectoryError, plan_trajectory
+from c2rviz.motion.trajectory_check import evaluate
 
 LIMITS = MotionLimits((2.0, 1.0), (4.0, 2.0), (40.0, 20.0), (-3.0, -0.5), (3.0, 2.0))
 NAMES = ("shoulder", "slide")
@@ -54,7 +55,7 @@ def test_velocities_are_continuous_at_the_points() -> None:
         before = planned.coefficients[int(knot) - 1]
         after = planned.coefficients[int(knot)]
         tau = np.array([1.0])
-        assert _evaluate(before, tau, 1)[0] == pytest.approx(after[1], abs=1e-12)
+        assert evaluate(before, tau, 1)[0] == pytest.approx(after[1], abs=1e-12)
 
 
 def test_given_velocities_and_accelerations_are_met() -> None:

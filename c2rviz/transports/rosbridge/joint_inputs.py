@@ -33,10 +33,14 @@ from ...session.session import Session
 from ...tolerance import within_limit
 from .messages import JointPositions, JointTrajectory
 
-__all__ = ["MAX_GUARD_SAMPLES", "UnknownJointName", "joint_command", "joint_trajectory"]
+__all__ = ["MAX_GUARD_SAMPLES", "ROWS", "UnknownJointName", "joint_command", "joint_trajectory"]
 
 MAX_GUARD_SAMPLES = MAX_TRAJECTORY_CHECKS
 """Most instants of a trajectory checked for collisions (one per frame, or fewer)."""
+ROWS = 500
+"""Points' numbers turned into an array in one call at most: numpy holds the interpreter's
+lock through it (some 0.3 ms a slice), and the worker thread hands the lock to the event
+loop only between calls."""
 
 
 class UnknownJointName(C2rvizError):
@@ -149,22 +153,27 @@ async def _plan(
     zeros = np.zeros(robot.n)
     limits = world.motion_limits(state.name)
 
-    def chain(values: Sequence[float], base: np.ndarray) -> np.ndarray:
-        full = base.copy()
-        full[indices] = values
+    def chain(rows: Sequence[Sequence[float]], base: np.ndarray) -> np.ndarray:
+        full = np.tile(base, (len(rows), 1))
+        for first in range(0, len(rows), ROWS):  # (the loop may take the lock between)
+            full[first : first + ROWS, indices] = rows[first : first + ROWS]
         return full
 
-    def given(values: Sequence[float] | None) -> np.ndarray | None:
-        return None if values is None else chain(values, zeros)
+    def given(rows: list[Sequence[float] | None]) -> list[np.ndarray | None]:
+        if rows.count(None) == len(rows):
+            return [None] * len(rows)
+        present = chain([row for row in rows if row is not None], zeros)
+        each = iter(present)
+        return [None if row is None else next(each) for row in rows]
 
-    def plan() -> PlannedTrajectory:
+    def plan() -> PlannedTrajectory:  # arrays built whole: few Python steps per point
         points = trajectory.points
         return plan_trajectory(
             start,
             [p.time_from_start_s for p in points],
-            [chain(p.positions, start) for p in points],
-            [given(p.velocities) for p in points],
-            [given(p.accelerations) for p in points],
+            chain([p.positions for p in points], start),
+            given([p.velocities for p in points]),
+            given([p.accelerations for p in points]),
             limits,
             robot.joint_names,
             _units(robot),
