@@ -12,7 +12,6 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -27,10 +26,7 @@ from ..protocol import replies
 from ..protocol.registry import Reply
 from ..world.grasp import SUCTION_BELOW, is_vacuum
 from .guarded import checker_of, request, unstopped
-from .handlers.cartesian import StraightPlan, plan_straight, play_straight, solve
-
-if TYPE_CHECKING:
-    from .session import Session
+from .straight import MoveSession, StraightPlan, plan_straight, play_straight, solve
 
 __all__ = [
     "MAX_TRAJECTORY_CHECKS",
@@ -70,7 +66,7 @@ class WaypointError(C2rvizError):
 
 
 async def plan_to(
-    session: Session,
+    session: MoveSession,
     target: Target,
     *,
     straight: bool = False,
@@ -86,7 +82,7 @@ async def plan_to(
 
 
 async def plan_through(
-    session: Session, targets: Sequence[Target], *, straight: bool = False
+    session: MoveSession, targets: Sequence[Target], *, straight: bool = False
 ) -> list[Plan]:
     """``Session.plan_through``: see there."""
     plans: list[Plan] = []
@@ -112,7 +108,7 @@ async def plan_through(
     return plans
 
 
-def play(session: Session, plan: Plan, speed: float | None) -> Reply:
+def play(session: MoveSession, plan: Plan, speed: float | None) -> Reply:
     """``Session.play``: see there."""
     line = plan.straight
     if line is None:
@@ -122,7 +118,9 @@ def play(session: Session, plan: Plan, speed: float | None) -> Reply:
     return play_straight(session, line, speed)
 
 
-def play_trajectory(session: Session, planned: PlannedTrajectory, checked: bool = False) -> Reply:
+def play_trajectory(
+    session: MoveSession, planned: PlannedTrajectory, checked: bool = False
+) -> Reply:
     """``Session.play_trajectory``: see there."""
     world, state = session.world, session.state
     if session.guard and not checked:
@@ -131,14 +129,14 @@ def play_trajectory(session: Session, planned: PlannedTrajectory, checked: bool 
     return replies.OK
 
 
-async def check_trajectory(session: Session, planned: PlannedTrajectory) -> None:
+async def check_trajectory(session: MoveSession, planned: PlannedTrajectory) -> None:
     """``Session.check_trajectory``: see there."""
     if session.guard:
         await session.services.worker.run(_trajectory_check(session, planned), owner=session)
 
 
 def _trajectory_check(
-    session: Session, planned: PlannedTrajectory, checker: MoveChecker | None = None
+    session: MoveSession, planned: PlannedTrajectory, checker: MoveChecker | None = None
 ) -> Callable[[], None]:
     """The guard's check of ``planned`` against the cell now: at most
     ``MAX_TRAJECTORY_CHECKS`` instants and every knot, sampled where it runs (``checker``
@@ -159,13 +157,15 @@ def _trajectory_check(
     return check
 
 
-def check_path(session: Session, q: Sequence[float], path: Sequence[Sequence[float]] = ()) -> None:
+def check_path(
+    session: MoveSession, q: Sequence[float], path: Sequence[Sequence[float]] = ()
+) -> None:
     """``Session.check_path``, here on the event loop: see there."""
     _path_check(session, q, path, MoveChecker())()
 
 
 def _path_check(
-    session: Session,
+    session: MoveSession,
     q: Sequence[float],
     path: Sequence[Sequence[float]],
     checker: MoveChecker | None = None,
@@ -198,7 +198,7 @@ def _check(
         raise PathCollides(first, second, fraction, at_target, target=q)
 
 
-def grip(session: Session, opening: float) -> Reply:
+def grip(session: MoveSession, opening: float) -> Reply:
     """``Session.grip``: see there. Closing on a part takes it by the grasp rule
     (``world/grasp.py``, docs/parts.md): the fingers stop where they touch it and the reply
     says that opening (``ok 0.433``); opening them lets go of what they hold. A vacuum
@@ -232,7 +232,7 @@ def grip(session: Session, opening: float) -> Reply:
     return reply if arrival is None else arrival
 
 
-def brake(session: Session, fingers: bool) -> Reply:
+def brake(session: MoveSession, fingers: bool) -> Reply:
     """``Session.stop``: see there. A plan this session is searching stops too."""
     session.services.worker.cancel(session, STOPPED)
     if fingers:
