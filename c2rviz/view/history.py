@@ -36,6 +36,7 @@ from collections import deque
 from collections.abc import Sequence
 
 import numpy as np
+import pinocchio as pin
 
 from ..collision.workcell import WorkcellObject
 from ..world.state import MAX_MARKERS, Marker, RobotState
@@ -107,6 +108,7 @@ class RobotHistory:
         self._count = 0
         self._fk_count = 0  # samples whose tool point is computed (the oldest ones)
         self._fk_tool = state.tool  # the tool the samples from _fk_count on were taken with
+        self._data = state.robot.model.createData()  # its own: computed between others' FKs
         self._due = -np.inf
         self._pending: tuple[tuple[float, ...], float] | None = None
         self._resting = False  # the arm stays at the latest state until the next one
@@ -227,12 +229,19 @@ class RobotHistory:
         self._fold_older(t - HISTORY_S)
 
     def _compute_tool(self, count: int) -> None:
-        """Compute the tool points of the first ``count`` samples that are not yet."""
-        robot, tool = self.state.robot, self._fk_tool
-        placement = robot.base_placement
+        """Compute the tool points of the first ``count`` samples that are not yet: one
+        Pinocchio FK each, the tool point placed from the end effector's parent joint
+        (``oMi * (frame placement * tool)``, the tool's offset worked out once)."""
+        if count <= self._fk_count:
+            return
+        robot = self.state.robot
+        model, data = robot.model, self._data
+        frame = model.frames[robot.ee_frame]
+        joint, offset = frame.parentJoint, (frame.placement * self._fk_tool).translation
         for k in range(self._fk_count, count):
-            self._tool[k] = (placement * robot.ee_pose(self._qs[k]) * tool).translation
-        self._fk_count = max(self._fk_count, count)
+            pin.forwardKinematics(model, data, robot.configuration(self._qs[k]))
+            self._tool[k] = data.oMi[joint].act(offset)
+        self._fk_count = count
 
     def _take_pending(self) -> None:
         if self._pending is not None:
