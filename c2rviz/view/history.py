@@ -21,6 +21,12 @@ rest (``add(..., resting=True)``): the next change, more than two periods later,
 kept as a step, the arm held where it rested until that time and then where it went
 (two samples at one time), not as a ramp from the last sample. An instant move after
 a minute at rest plots as a step.
+
+The tool point of a sample (a forward kinematics) is worked out when a window is read,
+not when the sample comes (most samples of most robots are never plotted): ``_append``
+stores the chain's values, ``window`` computes the tool points it has not computed yet,
+with the tool the robot had when each sample came (a change of tool first computes the
+samples taken with the old one).
 """
 
 from __future__ import annotations
@@ -30,6 +36,7 @@ from collections import deque
 from collections.abc import Sequence
 
 import numpy as np
+import pinocchio as pin
 
 from ..collision.workcell import WorkcellObject
 from ..world.state import MAX_MARKERS, Marker, RobotState
@@ -99,6 +106,9 @@ class RobotHistory:
         self._qs = np.empty((size, n))
         self._tool = np.empty((size, 3))
         self._count = 0
+        self._fk_count = 0  # samples whose tool point is computed (the oldest ones)
+        self._fk_tool = state.tool  # the tool the samples from _fk_count on were taken with
+        self._data = state.robot.model.createData()  # its own: computed between others' FKs
         self._due = -np.inf
         self._pending: tuple[tuple[float, ...], float] | None = None
         self._resting = False  # the arm stays at the latest state until the next one
@@ -167,6 +177,7 @@ class RobotHistory:
         lo = max(int(np.searchsorted(times, t0, side="right")) - 1, 0)
         lo = max(lo, int(np.searchsorted(times, self.start, side="left")))
         hi = int(np.searchsorted(times, t1, side="right"))
+        self._compute_tool(hi)
         return Window(times[lo:hi].copy(), self._qs[lo:hi].copy(), self._tool[lo:hi].copy())
 
     def at(self, t: float) -> tuple[float, ...]:
@@ -206,15 +217,31 @@ class RobotHistory:
             self._times[: self._cap] = self._times[keep]
             self._qs[: self._cap] = self._qs[keep]
             self._tool[: self._cap] = self._tool[keep]
+            self._fk_count = max(self._fk_count - (self._count - self._cap), 0)
             self._count = self._cap
-        state = self.state
-        robot = state.robot
+        if self.state.tool is not self._fk_tool:  # the samples so far keep the old tool
+            self._compute_tool(self._count)
+            self._fk_tool = self.state.tool
         k = self._count
         self._times[k] = t
         self._qs[k] = q
-        self._tool[k] = (robot.base_placement * robot.ee_pose(q) * state.tool).translation
         self._count = k + 1
         self._fold_older(t - HISTORY_S)
+
+    def _compute_tool(self, count: int) -> None:
+        """Compute the tool points of the first ``count`` samples that are not yet: one
+        Pinocchio FK each, the tool point placed from the end effector's parent joint
+        (``oMi * (frame placement * tool)``, the tool's offset worked out once)."""
+        if count <= self._fk_count:
+            return
+        robot = self.state.robot
+        model, data = robot.model, self._data
+        frame = model.frames[robot.ee_frame]
+        joint, offset = frame.parentJoint, (frame.placement * self._fk_tool).translation
+        for k in range(self._fk_count, count):
+            pin.forwardKinematics(model, data, robot.configuration(self._qs[k]))
+            self._tool[k] = data.oMi[joint].act(offset)
+        self._fk_count = count
 
     def _take_pending(self) -> None:
         if self._pending is not None:

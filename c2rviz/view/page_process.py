@@ -40,7 +40,7 @@ from .page_snapshot import Hello, Snapshot
 from .policy import DoorPolicy
 from .viser_scene import ViserScene
 
-__all__ = ["REST_PER_WORK", "ForwardingSession", "MirrorWorld", "PageProcess", "main"]
+__all__ = ["REST_PER_WORK", "SLICE_S", "ForwardingSession", "MirrorWorld", "PageProcess", "main"]
 
 log = logging.getLogger("c2rviz.view")
 
@@ -48,6 +48,10 @@ REST_PER_WORK = 0.25
 """The page's sends leave its loop this much time per second of work (the program's
 page leaves 1.0, ``scheduler.REST_PER_WORK``, for its clients' lines): here the loop
 serves no client, only the channel, whose frames wait in the socket meanwhile."""
+SLICE_S = 0.03
+"""The longest slice of a send here [s] (the program's page: ``scene_send.SLICE_S``):
+a frame of 64 robots in one or two atomic batches, not a dozen (each batch's end wakes
+viser's thread, which takes the GIL to encode a window of the batch)."""
 
 
 class ForwardingSession(Session):
@@ -103,6 +107,7 @@ class PageProcess:
             lighting=config.lighting,
         )
         self.scene.scheduler.rest_per_work = REST_PER_WORK
+        self.scene.slice_s = SLICE_S
         world.add_observers([self.scene])
         self.apply_state(snap, fresh=True)
 

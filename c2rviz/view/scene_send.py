@@ -37,7 +37,9 @@ __all__ = ["SLICE_S", "SceneSends"]
 
 SLICE_S = 0.002
 """Longest run of drawing robots before the loop gets a turn [s] (a send of many robots
-comes in slices, so a client's line never waits behind a whole frame)."""
+comes in slices, so a client's line never waits behind a whole frame). A scene's
+``slice_s`` is this unless set (the page process, whose loop serves no client, sets a
+longer one: fewer atomic batches, each of which wakes viser's thread once)."""
 
 
 class SceneSends:
@@ -57,6 +59,7 @@ class SceneSends:
     page_input: PageInput
     instruments: Instruments
     state_panel: StatePanel
+    slice_s: float
     _stopped: bool
     _dirty: set[str]
     _drawing: list[str] | None
@@ -72,7 +75,7 @@ class SceneSends:
     def _send(self) -> bool:
         """Draw whatever changed since the last send, in one atomic batch per slice.
 
-        A send draws each robot changed at its start once; after ``SLICE_S`` of drawing
+        A send draws each robot changed at its start once; after ``slice_s`` of drawing
         robots it returns True, the robots left for its next slice (the scheduler runs
         it at the loop's next turn). The last slice draws the rest: markers, workcells,
         instruments, the state panel.
@@ -91,9 +94,9 @@ class SceneSends:
                         self._dirty.update(world.robots)
                     self._drawing, self._dirty = list(self._dirty), set()
                 drew = bool(self._drawing)
-                if self._draw_robots(began + SLICE_S):
+                if self._draw_robots(began + self.slice_s):
                     return True  # robots left for the next slice
-                if drew and time.perf_counter() > began + SLICE_S / 2:
+                if drew and time.perf_counter() > began + self.slice_s / 2:
                     self._drawing = []  # all drawn: the rest gets a slice of its own
                     return True
                 self.markers.draw()
@@ -106,7 +109,7 @@ class SceneSends:
                 if name in world.robots:
                     self.handles.draw(world.robots[name])
             self._draw_workcells(shown is None)
-            instruments.draw(shown, time.perf_counter() + SLICE_S)
+            instruments.draw(shown, time.perf_counter() + self.slice_s)
             if self._state_dirty:
                 self._state_dirty = False
                 self.state_panel.show(self._client_count, self._commands)

@@ -42,7 +42,7 @@ from ..world.cameras import Camera
 from ..world.effects import Marker, Scene
 from ..world.goals import Goal
 from ..world.parts import Part
-from . import adapter
+from . import adapter, scene_send
 from .camera_layer import CameraLayer
 from .handle import ToolHandles
 from .instruments import Instruments
@@ -142,6 +142,7 @@ class ViserScene(SceneSends, Scene):
         shown_host = f"[{shown_host}]" if ":" in shown_host else shown_host
         self.url = self.policy.page_url(f"http://{shown_host}:{self.port}")
         self._stopped = False
+        self.slice_s = scene_send.SLICE_S  # read now: a test may set it
         self._loop: asyncio.AbstractEventLoop | None = None
         self._dirty: set[str] = set(world.robots)
         self._drawing: list[str] | None = None  # the robots the send under way has left

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from support import load_robot
 
@@ -116,3 +117,28 @@ def test_thinning_keeps_the_corners_of_a_rest() -> None:
     picked = thin(len(times), 200, times)
     assert len(picked) <= 200 and picked[0] == 0 and picked[-1] == len(times) - 1
     assert {999, 1000, 1001} <= set(picked.tolist())  # the rest's end, the hold, the step
+
+
+def _tool_point(state: RobotState, q: np.ndarray, tool: pin.SE3) -> np.ndarray:
+    robot = state.robot
+    return (robot.base_placement * robot.ee_pose(q) * tool).translation
+
+
+def test_tool_points_are_those_of_the_tool_each_sample_was_taken_with() -> None:
+    """The tool points are computed when a window is read, each with the tool the robot
+    had when its sample came, also across a change of tool and the buffer's compaction."""
+    h = history()
+    state, old, new = h.state, h.state.tool, pin.SE3(np.eye(3), np.array([0.0, 0.0, 0.3]))
+    count = MAX_SAMPLES + MAX_SAMPLES // 4 + 10  # past the compaction
+    for k in range(1, count):
+        h.add((np.sin(k * 1e-3),) * 7, k * 0.01)
+        if k == count - 200:
+            h.window(0.0, (count - 300) * 0.01)  # some computed before the change, some not
+            state.tool = new
+        if k == count - 100:
+            h.window(0.0, (count - 150) * 0.01)
+    window = h.window(-np.inf, np.inf)
+    for row in (0, len(window) - 201, len(window) - 199, len(window) - 1):
+        tool = old if window.times[row] < (count - 200 + 0.5) * 0.01 else new
+        expected = _tool_point(state, window.qs[row], tool)
+        assert window.tool[row] == pytest.approx(expected, abs=1e-12), row
