@@ -7,11 +7,12 @@ path because the root ``conftest.py`` lives there.
 
 from __future__ import annotations
 
+import contextlib
 import socket
 import subprocess
 import sys
 import threading
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from functools import cache
 from pathlib import Path
@@ -136,6 +137,19 @@ class Client:
     def close(self) -> None:
         self.file.close()
         self.sock.close()
+
+
+@contextlib.contextmanager
+def program_server(ini: Path) -> Iterator[TestServer]:
+    """What ``c2rviz --config INI --no-viewer`` serves, in this process: the plugin's
+    ``TestServer`` wires settings, robots and world as the program does, on the real clock
+    as the program has it. For a test of what the ini puts in the world, not of the
+    process (a subprocess costs 3-5 s of start-up on a busy machine)."""
+    server = TestServer({"ini": str(ini), "clock": "real"}).start()
+    try:
+        yield server
+    finally:
+        server.stop()
 
 
 @dataclass

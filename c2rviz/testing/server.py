@@ -31,6 +31,7 @@ import numpy as np
 
 from .. import CommandServer  # the package's lazy name follows the text door's home
 from ..app.doors import Opened, close_doors, open_doors
+from ..app.ini_world import ini_cameras, place_cameras
 from ..app.members import furnish
 from ..app.program import write_page
 from ..observers.recorder import Recorded
@@ -290,6 +291,7 @@ class TestServer:
         )
         for member in self.members:
             furnish(world, member)
+        place_cameras(world, self.services.rng, ini_cameras(settings.ini))  # as the program
         for line in self.options.get("faults", ()):  # `fault` lines on the first robot, at start
             Session(self.services, "test", self.members[0].name).run(f"fault {line}")
         servers = self._servers

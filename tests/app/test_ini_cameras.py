@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from support import ROOT, Client
+from support import ROOT, Client, program_server
 
 from c2rviz.app.cli import main
 
@@ -34,20 +34,20 @@ def ini(tmp_path: Path) -> Path:
     return path
 
 
-def test_the_ini_puts_its_cameras_in_the_world(ini: Path, c2rviz_process):
-    proc = c2rviz_process("--config", str(ini), "--no-viewer")
-    client = Client("127.0.0.1", proc.port)
-    try:
-        assert client.ask("degrees") == "ok"
-        assert client.ask("cameras") == (
-            "ok top:0.45,0,1.2,0,90,0:60,45,2:10;side:0.45,-1,0.03,0,0,90:50,40,2.5:5"
-        )
-        assert client.ask("camera top") == "ok p1:block:1.17,0,0,0,-90,0"
-        assert client.ask("camera side") == "ok p1:block:1,0,0,0,0,-90"
-        assert client.ask("quit") == "ok"
-        assert proc.wait() == 0
-    finally:
-        client.close()
+def test_the_ini_puts_its_cameras_in_the_world(ini: Path):
+    with program_server(ini) as server:
+        client = Client("127.0.0.1", server.port)
+        try:
+            assert client.ask("degrees") == "ok"
+            assert client.ask("cameras") == (
+                "ok top:0.45,0,1.2,0,90,0:60,45,2:10;side:0.45,-1,0.03,0,0,90:50,40,2.5:5"
+            )
+            assert client.ask("camera top") == "ok p1:block:1.17,0,0,0,-90,0"
+            assert client.ask("camera side") == "ok p1:block:1,0,0,0,0,-90"
+            assert client.ask("quit") == "ok"
+            assert server.quit_requested.wait(60)  # quit ends the program
+        finally:
+            client.close()
 
 
 @pytest.mark.parametrize(

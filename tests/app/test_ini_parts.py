@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from support import ROOT, Client
+from support import ROOT, Client, program_server
 
 from c2rviz.app.cli import main
 
@@ -34,18 +34,19 @@ def ini(tmp_path: Path) -> Path:
     return path
 
 
-def test_the_ini_puts_its_parts_in_the_world(ini: Path, c2rviz_process):
-    proc = c2rviz_process("--config", str(ini), "--no-viewer")
-    client = Client("127.0.0.1", proc.port)
-    try:
-        client.ask("degrees")
-        assert client.ask("parts") == (
-            "ok p1:0.45,0,0.23,0,0,90:resting on table;ball:0.45,0.2,0.22,0,0,0:resting on table"
-        )
-        assert client.ask("quit") == "ok"
-        assert proc.wait() == 0
-    finally:
-        client.close()
+def test_the_ini_puts_its_parts_in_the_world(ini: Path):
+    with program_server(ini) as server:
+        client = Client("127.0.0.1", server.port)
+        try:
+            client.ask("degrees")
+            assert client.ask("parts") == (
+                "ok p1:0.45,0,0.23,0,0,90:resting on table;"
+                "ball:0.45,0.2,0.22,0,0,0:resting on table"
+            )
+            assert client.ask("quit") == "ok"
+            assert server.quit_requested.wait(60)  # quit ends the program
+        finally:
+            client.close()
 
 
 @pytest.mark.parametrize(

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 import trimesh
-from support import ROOT, Client
+from support import ROOT, Client, program_server
 
 from c2rviz.app.cli import main
 
@@ -37,24 +37,24 @@ def ini(tmp_path: Path) -> Path:
     return path
 
 
-def test_the_ini_gives_the_robot_its_tool_limits_and_objects(ini: Path, c2rviz_process):
-    proc = c2rviz_process("--config", str(ini), "--no-viewer")
-    client = Client("127.0.0.1", proc.port)
-    try:
-        assert client.ask("tool") == "ok 0,0,0.1,0,0,0"
-        assert client.ask("pose").startswith("ok 0,0,1.6,")  # link_t at 1.5 m, plus the tool
-        first = client.ask("limits all")[3:].split(",")
-        assert " v=1.5 a=3 j=20" in first[0] and first[6].endswith(" j=30")
-        assert client.ask("objects") == "ok table,post,fixture"
-        client.ask("degrees")
-        client.ask("j 90,60,0,0,0,0,0")  # the wrist into the post
-        assert "~post" in client.ask("collisions")
-        client.ask("j -90,60,0,0,0,0,0")  # ... and the other way, into the mesh
-        assert "~fixture" in client.ask("collisions")
-        assert client.ask("quit") == "ok"
-        assert proc.wait() == 0
-    finally:
-        client.close()
+def test_the_ini_gives_the_robot_its_tool_limits_and_objects(ini: Path):
+    with program_server(ini) as server:
+        client = Client("127.0.0.1", server.port)
+        try:
+            assert client.ask("tool") == "ok 0,0,0.1,0,0,0"
+            assert client.ask("pose").startswith("ok 0,0,1.6,")  # link_t at 1.5 m, plus the tool
+            first = client.ask("limits all")[3:].split(",")
+            assert " v=1.5 a=3 j=20" in first[0] and first[6].endswith(" j=30")
+            assert client.ask("objects") == "ok table,post,fixture"
+            client.ask("degrees")
+            client.ask("j 90,60,0,0,0,0,0")  # the wrist into the post
+            assert "~post" in client.ask("collisions")
+            client.ask("j -90,60,0,0,0,0,0")  # ... and the other way, into the mesh
+            assert "~fixture" in client.ask("collisions")
+            assert client.ask("quit") == "ok"
+            assert server.quit_requested.wait(60)  # quit ends the program
+        finally:
+            client.close()
 
 
 @pytest.mark.parametrize(

@@ -342,8 +342,11 @@ def test_pipelined_play_matches_replies_to_lines(server, connect, tmp_path, caps
 
 
 def test_the_player_plays_motoman_txt_with_motion_on(c2rviz_process, capsys):
-    # The real program, its arm given 20 rad/s so that the seven moves take a few seconds.
-    proc = c2rviz_process("--no-viewer", "--speed", "100", "--max-velocity", "20")
+    # The real program, its arm given 20 rad/s, on virtual time: each move's reply still
+    # waits for its arrival (the status below), by the program's clock, not seconds of wall.
+    proc = c2rviz_process(
+        "--no-viewer", "--speed", "100", "--max-velocity", "20", "--clock", "virtual"
+    )
     args = [MOTOMAN, "--port", str(proc.port), "--speed", "1000", "--motion", "on"]
     assert player.main(args) == 0
     out = capsys.readouterr().out

@@ -23,11 +23,16 @@ SCRIPTS = [code for code in PYTHON if "def test_" not in code]
 ENV = {**os.environ, "PYTHONPATH": str(ROOT), "PYTHONUNBUFFERED": "1"}
 
 
+AS_THE_PROGRAM = pytest.mark.c2rviz(clock="real", record=False)
+"""The examples' server: what ``c2rviz --no-viewer`` serves (the plugin's, in this process:
+the program's wiring on its real clock, without a subprocess's seconds of start-up)."""
+
+
+@AS_THE_PROGRAM
 @pytest.mark.parametrize("code", SCRIPTS, ids=[f"example-{i}" for i in range(len(SCRIPTS))])
-def test_each_client_example_runs_against_a_server(code, c2rviz_process, tmp_path):
-    process = c2rviz_process("--no-viewer")
+def test_each_client_example_runs_against_a_server(code, c2rviz_server, tmp_path):
     script = tmp_path / "example.py"
-    script.write_text(code.replace("port=31000", f"port={process.port}"))
+    script.write_text(code.replace("port=31000", f"port={c2rviz_server.port}"))
     done = subprocess.run(
         [sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=ENV
     )
@@ -35,10 +40,10 @@ def test_each_client_example_runs_against_a_server(code, c2rviz_process, tmp_pat
     assert done.stdout.strip()  # it printed what it says it prints
 
 
-def test_the_first_example_prints_what_its_comments_say(c2rviz_process, tmp_path):
-    process = c2rviz_process("--no-viewer")
+@AS_THE_PROGRAM
+def test_the_first_example_prints_what_its_comments_say(c2rviz_server, tmp_path):
     script = tmp_path / "example.py"
-    script.write_text(SCRIPTS[0].replace("port=31000", f"port={process.port}"))
+    script.write_text(SCRIPTS[0].replace("port=31000", f"port={c2rviz_server.port}"))
     done = subprocess.run(
         [sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=ENV
     )
