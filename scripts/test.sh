@@ -26,6 +26,9 @@ python3 -m venv .venv
 .venv/bin/python -m ruff format --check .
 .venv/bin/python -m mypy
 .venv/bin/lint-imports --no-cache
+# The programs the tests start (about a hundred) would each compile c2rviz again where
+# PYTHONDONTWRITEBYTECODE is set: compiled once here, each start is ~0.26 s quicker.
+.venv/bin/python -m compileall -q c2rviz
 workers=(-n "${C2RVIZ_TEST_WORKERS:-auto}" --dist loadgroup)
 if [ "${C2RVIZ_TEST_WORKERS:-auto}" = "1" ]; then workers=(-p no:xdist); fi
 

@@ -10,7 +10,7 @@ from typing import Any
 
 import pinocchio as pin
 
-from ..app.config import Settings, find_ini, load_settings
+from ..app.config import MOTION_FLAGS, Settings, find_ini, load_settings
 from ..app.members import Member, members
 from ..motion.planner import motion_limits
 from ..robot.model import Robot
@@ -52,7 +52,10 @@ def settings_for(options: Mapping[str, Any], read_ini: bool = True) -> Settings:
     doors = bool(options.get("doors"))
     ports = {name: 0 for name in Settings.__dataclass_fields__ if name.endswith("port")}
     overrides: dict[str, Any] = {**ports, "viewer": False, "crcl": doors, "rosbridge": doors}
+    motion = {k: given.pop(k) for k in MOTION_FLAGS if k in given}  # the flags' own text
     overrides.update(given)
+    if motion:
+        overrides["motion_flags"] = tuple((k, str(v)) for k, v in motion.items())
     overrides["robot_flag"] = "robot" in given
     overrides["urdf_flag"] = "urdf" in given
     ini = find_ini(options.get("ini")) if read_ini or "ini" in options else None

@@ -14,6 +14,8 @@ from pathlib import Path
 import pytest
 from support import ROOT
 
+from c2rviz.testing.server import TestServer
+
 SAMPLE = """
 import math
 
@@ -284,3 +286,17 @@ def test_the_pytest_extra_brings_what_the_docs_say():
         "pip install -e '.[pytest]'" in page
         and "installs c2rviz with pytest and pytest-xdist" in page
     )
+
+
+def test_the_motion_limit_flags_are_options_too():
+    """``max_velocity`` and its kin are flags like the others (the program's text for
+    them: one number, or one per joint)."""
+    server = TestServer(
+        {"max_velocity": "0.5", "max_acceleration": "1,2,3,4,5,6,7", "record": False}
+    ).start()
+    try:
+        limits = server.call(lambda: server.world.motion_limits(server.world.default))
+        assert list(limits.velocity) == [0.5] * 7
+        assert list(limits.acceleration) == [1, 2, 3, 4, 5, 6, 7]
+    finally:
+        server.stop()
