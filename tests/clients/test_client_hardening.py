@@ -260,6 +260,7 @@ def _peak_rss_mb(args: list[str]) -> tuple[int, float]:
 
 
 @pytest.mark.wall_clock
+@pytest.mark.timeout(600)  # 1.3 M lines parsed thrice: past 120 s at load 12 with coverage
 def test_the_player_checks_and_streams_a_long_recording_in_flat_memory(server, tmp_path):
     """A 59 MB recording once took 347 MB to play; now memory does not grow with the file."""
     line = "joints 0.1234567890123,0.1,0.2,0.3,0.4,0.5,0.6\n"
