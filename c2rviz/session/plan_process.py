@@ -46,6 +46,8 @@ __all__ = [
     "in_child",
     "plan_checked",
     "plan_job",
+    "portable_error",
+    "rebuilt_error",
     "run_forked",
 ]
 
@@ -143,9 +145,9 @@ def run_forked(
     finally:
         os.close(read_fd)
         _reap(pid)
-    answer: tuple[str, Any] = pickle.loads(data) if data else ("error", _portable(_lost()))
+    answer: tuple[str, Any] = pickle.loads(data) if data else ("error", portable_error(_lost()))
     if answer[0] == "error":
-        raise _rebuilt(answer[1])
+        raise rebuilt_error(answer[1])
     result: T = answer[1]
     return result
 
@@ -166,11 +168,11 @@ def _answer(fn: Callable[[], Any]) -> bytes:
     try:
         answer: tuple[str, Any] = ("ok", fn())
     except BaseException as exc:
-        answer = ("error", _portable(exc))
+        answer = ("error", portable_error(exc))
     try:
         return pickle.dumps(answer)
     except Exception as exc:  # an answer that does not pickle: say so
-        return pickle.dumps(("error", _portable(RuntimeError(f"plan answer: {exc!r}"))))
+        return pickle.dumps(("error", portable_error(RuntimeError(f"plan answer: {exc!r}"))))
 
 
 def _read(fd: int, pid: int, cancel: Cancel | None, deadline: float) -> bytes:
@@ -199,7 +201,9 @@ def _lost() -> RuntimeError:
     return RuntimeError("the plan's process ended without an answer (see the server log)")
 
 
-def _portable(exc: BaseException) -> tuple[type[BaseException], tuple[Any, ...], dict[str, Any]]:
+def portable_error(
+    exc: BaseException,
+) -> tuple[type[BaseException], tuple[Any, ...], dict[str, Any]]:
     """An exception as its class, args and attributes (our errors' constructors take
     their fields, not their message, so pickle's own way would not rebuild them)."""
     try:
@@ -210,7 +214,10 @@ def _portable(exc: BaseException) -> tuple[type[BaseException], tuple[Any, ...],
     return type(exc), exc.args, fields
 
 
-def _rebuilt(value: tuple[type[BaseException], tuple[Any, ...], dict[str, Any]]) -> BaseException:
+def rebuilt_error(
+    value: tuple[type[BaseException], tuple[Any, ...], dict[str, Any]],
+) -> BaseException:
+    """The exception ``portable_error`` took apart, raised again in this process."""
     cls, args, fields = value
     exc = cls.__new__(cls)
     exc.args = args

@@ -41,7 +41,7 @@ from pathlib import Path
 from typing import Any, BinaryIO, Final
 
 from ..errors import C2rvizError
-from ..session.plan_process import _portable, _rebuilt
+from ..session.plan_process import portable_error, rebuilt_error
 
 __all__ = [
     "DEADLINE_S",
@@ -112,7 +112,7 @@ class _Packer(pickle.Pickler):
 
     def reducer_override(self, obj: Any) -> Any:
         if isinstance(obj, BaseException):
-            return _rebuilt, (_portable(obj),)
+            return rebuilt_error, (portable_error(obj),)
         return NotImplemented
 
 
