@@ -21,7 +21,7 @@ import numpy as np
 from ..collision.geometry import read_srdf
 from ..errors import C2rvizError, ConfigError
 from ..observers.recorder import Recorded
-from ..protocol.verbs.observe import Record
+from ..protocol.verbs.scene import Record
 from ..session.services import Services
 from ..transports.tcp_server import CommandServer
 from ..world.clock import Clock

@@ -16,8 +16,6 @@ from __future__ import annotations
 from collections.abc import Iterator
 from dataclasses import dataclass
 
-__all__ = ["DOORS", "LIMITS", "Limit", "below_floor", "bounds", "default", "default_s", "rows"]
-
 DOORS = ("text", "crcl", "rosbridge", "page")
 """The doors, by the names the table uses."""
 

@@ -53,7 +53,7 @@ class Session(UnitEdge, Modes):
 
     Attributes:
         source: Who speaks (``tcp 127.0.0.1:5123``, ``page``), for notes and errors.
-        motion: ``off``, ``on`` or ``follow`` (``protocol.verbs.motion.MOTION_MODES``).
+        motion: ``off``, ``on`` or ``follow`` (``protocol.verbs.arm.MOTION_MODES``).
         speed: Moves at this % of the joints' limits.
         guard: Refuse commands whose target or path collides.
         plan_around: With the guard, plan joint-space moves around what their straight

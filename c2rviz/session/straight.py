@@ -1,5 +1,5 @@
 """A move's IK and the tool's straight line, planned off the loop and played: what the
-Cartesian verbs (``handlers.cartesian``) and the typed calls (``calls``: ``plan_to``,
+Cartesian verbs (``handlers.arm``) and the typed calls (``calls``: ``plan_to``,
 ``play``) share.
 
 Typed on ``MoveSession`` (what of ``Session`` they use), so the typed calls reach them

@@ -14,8 +14,15 @@ import numpy as np
 from ...errors import NoGripper
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
-from ...protocol.verbs.cameras import CameraEdit, CamerasQuery
-from ...protocol.verbs.parts import GoalEdit, Grip, PartEdit, PartsQuery, Score
+from ...protocol.verbs.parts import (
+    CameraEdit,
+    CamerasQuery,
+    GoalEdit,
+    Grip,
+    PartEdit,
+    PartsQuery,
+    Score,
+)
 from ...world.camera_sight import seen_text, sight
 from ...world.cameras import DEFAULT_FOV_RAD, DEFAULT_RANGE_M, Camera, CameraError
 from ...world.goals import DEFAULT_TOL_M, DEFAULT_TOL_RAD, Goal
