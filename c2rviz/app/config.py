@@ -24,7 +24,7 @@ from ..protocol.limits import bounds, default
 from ..robot.catalogue import catalogue, find_robot
 from ..robot.sources import split_package_path
 from ..session.settings import ServerLimits, SessionDefaults
-from ..world.clocks import parse_clock
+from ..world.virtual_clock import parse_clock
 
 __all__ = [
     "INI_NAME",

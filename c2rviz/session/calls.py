@@ -24,23 +24,9 @@ from ..planning import MoveChecker, MoveRequest, first_blocked, path_points
 from ..planning.cancel import STOPPED
 from ..protocol import replies
 from ..protocol.registry import Reply
-from ..world.grasp import SUCTION_BELOW, is_vacuum
+from ..world.part_rules import SUCTION_BELOW, is_vacuum
 from .guarded import checker_of, request, unstopped
 from .straight import MoveSession, StraightPlan, plan_straight, play_straight, solve
-
-__all__ = [
-    "MAX_TRAJECTORY_CHECKS",
-    "brake",
-    "grip",
-    "Plan",
-    "WaypointError",
-    "check_path",
-    "check_trajectory",
-    "plan_through",
-    "plan_to",
-    "play",
-    "play_trajectory",
-]
 
 MAX_TRAJECTORY_CHECKS = 2000
 """Most instants of a timed trajectory checked for collisions (one per frame, or fewer)."""
@@ -200,7 +186,7 @@ def _check(
 
 def grip(session: MoveSession, opening: float) -> Reply:
     """``Session.grip``: see there. Closing on a part takes it by the grasp rule
-    (``world/grasp.py``, docs/parts.md): the fingers stop where they touch it and the reply
+    (``world/part_rules.py``, docs/parts.md): the fingers stop where they touch it and the reply
     says that opening (``ok 0.433``); opening them lets go of what they hold. A vacuum
     gripper's suction turns on below ``SUCTION_BELOW`` (taking a part at the cup replies
     ``ok held``) and off from it, letting go."""

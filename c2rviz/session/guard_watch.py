@@ -34,11 +34,10 @@ from ..collision.other_robots import first_hit_between
 from ..motion.path_play import PathPlay
 from ..planning import EdgeResolution, MoveChecker, MoveRequest, first_blocked
 from ..world.clock import Hold
-from ..world.effects import Observer
+from ..world.observer import Observer
 from ..world.world import World
-from .worker import Superseded, Worker, WorkerBusy
-
-__all__ = ["DT", "GuardWatch", "Run"]
+from .lanes import Superseded, WorkerBusy
+from .worker import Worker
 
 log = logging.getLogger("c2rviz")
 

@@ -54,18 +54,6 @@ from .plan_process import plan_job
 from .services import Services
 from .worker import Worker
 
-__all__ = [
-    "TRIES",
-    "WorldChanged",
-    "checked_move",
-    "guarded_go",
-    "guarded_rand",
-    "play_checked",
-    "GuardedSession",
-    "request",
-    "unstopped",
-]
-
 T = TypeVar("T")
 TRIES = 3  # checks of one move while the world keeps changing under it
 DRAWS = 1000  # random configurations a guarded rand draws at most

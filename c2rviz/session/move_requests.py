@@ -19,8 +19,6 @@ from ..planning.cancel import Cancel
 from ..planning.guarded_move import OtherAt
 from ..world.world import World
 
-__all__ = ["world_request"]
-
 
 def world_request(
     world: World,

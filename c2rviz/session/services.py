@@ -24,8 +24,6 @@ from .move_requests import world_request
 from .settings import ServerLimits, SessionDefaults
 from .worker import Worker
 
-__all__ = ["Services"]
-
 
 @dataclass(eq=False)
 class Services:

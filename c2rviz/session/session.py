@@ -39,8 +39,6 @@ from .services import Services
 from .settings import Modes
 from .units import UnitEdge, UnitTable
 
-__all__ = ["BATCHED", "Session", "UnitTable"]
-
 T = TypeVar("T")
 _CADENCE_S = 0.02  # a pause this soon after the previous one's end continues its cadence
 BATCHED = tuple(f"{name} " for name in (VERBS["joints"].name, *VERBS["joints"].aliases))

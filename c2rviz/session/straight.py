@@ -23,8 +23,6 @@ from ..protocol.registry import Reply
 from ..robot.model import Robot
 from .guarded import GuardedSession, checked_move, unstopped
 
-__all__ = ["MoveSession", "StraightPlan", "plan_straight", "play_straight", "solve"]
-
 
 class MoveSession(GuardedSession, Protocol):
     """What a planned move needs of its session (``session.Session``), beyond a guarded

@@ -23,9 +23,9 @@ from ...protocol.verbs.parts import (
     PartsQuery,
     Score,
 )
-from ...world.camera_sight import seen_text, sight
 from ...world.cameras import DEFAULT_FOV_RAD, DEFAULT_RANGE_M, Camera, CameraError
-from ...world.goals import DEFAULT_TOL_M, DEFAULT_TOL_RAD, Goal
+from ...world.part_rules import DEFAULT_TOL_M, DEFAULT_TOL_RAD, Goal
+from ...world.world import seen_text, sight
 
 if TYPE_CHECKING:
     import pinocchio as pin
