@@ -49,7 +49,7 @@ from ..protocol import replies
 from ..world.moves import Travel
 from ..world.state import RobotState
 from ..world.world import World
-from .move_requests import world_request
+from .guard_watch import world_request
 from .plan_process import plan_job
 from .services import Services
 from .worker import Worker

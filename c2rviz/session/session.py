@@ -35,8 +35,7 @@ from ..world.state import RobotState
 from . import calls
 from .guarded import guarded_go, unstopped
 from .notes import Said, recorded, refused, taken, taken_all
-from .services import Services
-from .settings import Modes
+from .services import Modes, Services
 from .units import UnitEdge, UnitTable
 
 T = TypeVar("T")

@@ -30,8 +30,8 @@ from ...protocol.verbs.arm import (
     Wait,
 )
 from ...robot.frames import in_base, wxyz_se3
+from ..calls import plan_straight, play_straight, solve
 from ..guarded import unstopped
-from ..straight import plan_straight, play_straight, solve
 
 if TYPE_CHECKING:
     from ..session import Session
