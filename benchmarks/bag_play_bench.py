@@ -39,7 +39,7 @@ from bag_bench import load, long_bag  # noqa: E402
 
 from c2rviz.session import Services  # noqa: E402
 from c2rviz.transports.tcp_server import CommandServer  # noqa: E402
-from c2rviz.world.effects import Observer  # noqa: E402
+from c2rviz.world.observer import Observer  # noqa: E402
 from c2rviz.world.world import World  # noqa: E402
 
 __all__ = ["main"]

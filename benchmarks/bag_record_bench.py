@@ -38,7 +38,7 @@ sys.path.insert(0, str(ROOT))
 
 from c2rviz.observers.recordings import Recordings  # noqa: E402
 from c2rviz.robot import Robot  # noqa: E402
-from c2rviz.world.effects import Observer  # noqa: E402
+from c2rviz.world.observer import Observer  # noqa: E402
 from c2rviz.world.world import World  # noqa: E402
 
 __all__ = ["main"]

@@ -40,7 +40,7 @@ from c2rviz.robot.model import Robot  # noqa: E402
 from c2rviz.session import Services  # noqa: E402
 from c2rviz.view import adapter  # noqa: E402
 from c2rviz.view.viser_scene import ViserScene  # noqa: E402
-from c2rviz.world.effects import Marker  # noqa: E402
+from c2rviz.world.observer import Marker  # noqa: E402
 from c2rviz.world.world import World  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent

@@ -59,10 +59,10 @@ __version__ = "0.2.0"
 _HOME = {
     "C2rvizError": "errors",
     "CommandServer": "transports.tcp_server",
-    "Marker": "world.effects",
-    "RecordingScene": "world.effects",
+    "Marker": "world.observer",
+    "RecordingScene": "world.observer",
     "Robot": "robot.model",
-    "Scene": "world.effects",
+    "Scene": "world.observer",
     "Session": "session.session",
     "World": "world.world",
     "parse_line": "protocol.grammar",

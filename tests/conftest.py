@@ -23,7 +23,7 @@ from hypothesis import settings
 from support import ARGS, CHROMIUM, ROOT, Client, Process, ServerThread, load_robot
 
 from c2rviz.session import ServerLimits
-from c2rviz.world.clocks import VirtualClock
+from c2rviz.world.virtual_clock import VirtualClock
 
 
 def pytest_configure(config: pytest.Config) -> None:

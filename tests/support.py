@@ -21,8 +21,8 @@ from typing import Any
 from c2rviz.robot.model import Robot
 from c2rviz.session import ServerLimits
 from c2rviz.testing.server import TestServer
-from c2rviz.world.clocks import VirtualClock
-from c2rviz.world.effects import RecordingScene
+from c2rviz.world.observer import RecordingScene
+from c2rviz.world.virtual_clock import VirtualClock
 
 ROOT = Path(__file__).resolve().parent.parent
 CTRL_C_ABLE = [

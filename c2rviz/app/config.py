@@ -23,8 +23,8 @@ from ..ini import INI_NAME, PROJECT_DIR, find_ini, number, read_ini
 from ..protocol.limits import bounds, default
 from ..robot.catalogue import catalogue, find_robot
 from ..robot.sources import split_package_path
-from ..session.settings import ServerLimits, SessionDefaults
-from ..world.clocks import parse_clock
+from ..session.services import ServerLimits, SessionDefaults
+from ..world.virtual_clock import parse_clock
 
 __all__ = [
     "INI_NAME",

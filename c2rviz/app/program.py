@@ -21,13 +21,13 @@ import numpy as np
 from ..collision.geometry import read_srdf
 from ..errors import C2rvizError, ConfigError
 from ..observers.recorder import Recorded
-from ..protocol.verbs.observe import Record
+from ..protocol.verbs.scene import Record
 from ..session.services import Services
 from ..transports.tcp_server import CommandServer
 from ..world.clock import Clock
-from ..world.clocks import parse_clock
-from ..world.effects import NullScene, Scene
+from ..world.observer import NullScene, Scene
 from ..world.state import RobotState
+from ..world.virtual_clock import parse_clock
 from ..world.world import World
 from . import crcl_door  # noqa: F401 (its opener joins doors.OPENERS)
 from .config import Settings, replaced_bundled

@@ -32,7 +32,7 @@ from ..errors import C2rvizError, ConfigError
 from ..motion.planner import MotionLimits, motion_limits
 from ..robot.gripper import Gripper, make_gripper
 from ..robot.model import Robot
-from ..world.grasp import make_vacuum
+from ..world.part_rules import make_vacuum
 
 __all__ = [
     "IniObject",

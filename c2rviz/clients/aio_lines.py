@@ -19,8 +19,8 @@ from collections import deque
 from collections.abc import AsyncIterator
 
 from ..protocol.framing import Line, LineFramer
-from ..protocol.verbs.cell import RobotChoice
-from ..protocol.verbs.joints import Units
+from ..protocol.verbs.arm import RobotChoice
+from ..protocol.verbs.seed import Units
 from .connect import ServerUnavailable
 from .errors import CommandError, ConnectionLost, ReplyTimeout, ReplyTooLong
 from .line_state import MAX_REPLY_BYTES, LineState

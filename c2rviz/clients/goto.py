@@ -20,7 +20,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ..errors import C2rvizError, JointCountError, JointLimitError
-from ..protocol.verbs.motion import MOTION_MODES
+from ..protocol.verbs.arm import MOTION_MODES
 from ..tolerance import within_limit
 from .client import Client
 

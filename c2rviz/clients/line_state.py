@@ -9,8 +9,8 @@ robot). No I/O.
 
 from __future__ import annotations
 
-from ..protocol.verbs.cell import RobotChoice
-from ..protocol.verbs.joints import Units
+from ..protocol.verbs.arm import RobotChoice
+from ..protocol.verbs.seed import Units
 from .errors import CommandError, UnexpectedReply
 
 __all__ = ["MAX_REPLY_BYTES", "LineState"]

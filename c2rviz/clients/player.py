@@ -37,8 +37,8 @@ from pathlib import Path
 from typing import TextIO
 
 from ..errors import C2rvizError
-from ..protocol.verbs.motion import MOTION_MODES, MotionMode
-from ..protocol.verbs.queries import Sleep
+from ..protocol.verbs.arm import MOTION_MODES, MotionMode
+from ..protocol.verbs.seed import Sleep
 from .bag_play import add_bag_args, is_bag
 from .bag_play import run as play_bag
 from .client import (

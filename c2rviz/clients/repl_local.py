@@ -16,9 +16,8 @@ from typing import TextIO
 
 from ..errors import BadArguments, C2rvizError
 from ..protocol.grammar import parse_line
-from ..protocol.verbs.joints import Joints
-from ..protocol.verbs.observe import Watch
-from ..protocol.verbs.queries import Sleep
+from ..protocol.verbs.scene import Watch
+from ..protocol.verbs.seed import Joints, Sleep
 from .bag_play import is_bag, play_in_repl
 from .client import Client, ConnectionLost, find_script
 from .display import shown

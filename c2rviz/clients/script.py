@@ -20,11 +20,8 @@ from pathlib import Path
 
 from ..errors import C2rvizError, JointCountError, JointIndexError
 from ..protocol.grammar import Command, parse_line
-from ..protocol.verbs.cartesian import MoveL, MoveTo
-from ..protocol.verbs.joints import Home, Joints, Move, Rand
-from ..protocol.verbs.markers import Clear
-from ..protocol.verbs.motion import MotionMode, Stop, Wait
-from ..protocol.verbs.queries import Bye, Quit
+from ..protocol.verbs.arm import MotionMode, MoveL, MoveTo, Stop, Wait
+from ..protocol.verbs.seed import Bye, Clear, Home, Joints, Move, Quit, Rand
 
 __all__ = [
     "MAX_LINE_BYTES",

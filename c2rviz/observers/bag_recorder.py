@@ -50,7 +50,7 @@ from ..ros.bag_writer import BagWriter
 from ..ros.messages import INT32, Msg, tf_message, transforms
 from ..ros.robot_bag import BagRobot
 from ..world.cameras import Camera, Seen
-from ..world.effects import Observer
+from ..world.observer import Observer
 from ..world.parts import Part
 from ..world.state import MAX_MARKERS, Marker, RobotState
 from ..world.world import World

@@ -30,9 +30,9 @@ import pinocchio as pin
 
 from ..robot.frames import se3_pose
 from ..ros.messages import Msg, header
-from ..world.camera_sight import sight
 from ..world.cameras import Camera, Seen
 from ..world.clock import Timer
+from ..world.world import sight
 from .bag_parts import xyz_xyzw
 
 if TYPE_CHECKING:

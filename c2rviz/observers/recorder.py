@@ -43,7 +43,7 @@ from ..collision.workcell import WorkcellObject
 from ..protocol import replies
 from ..robot.frames import in_base, se3_pose, wxyz_se3
 from ..world.cameras import Camera
-from ..world.effects import Marker, Observer
+from ..world.observer import Marker, Observer
 from ..world.parts import Part
 from ..world.world import World
 from .camera_feed import CameraSignature, camera_changes, camera_signature

@@ -30,7 +30,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ..errors import C2rvizError
-from ..world.effects import Observer
+from ..world.observer import Observer
 from ..world.state import RobotState
 from ..world.world import World
 from .record_files import RecordFiles, existing, is_bag_folder, links

@@ -25,7 +25,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..world.effects import Observer
+from ..world.observer import Observer
 from ..world.state import RobotState
 from ..world.world import World
 

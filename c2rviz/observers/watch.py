@@ -47,12 +47,11 @@ from typing import Protocol
 from ..errors import C2rvizError
 from ..protocol import replies
 from ..robot.frames import in_base, se3_pose, wxyz_se3
-from ..world.camera_sight import seen_text
 from ..world.cameras import Camera, Seen
 from ..world.clock import Timer
-from ..world.effects import Marker, Observer
+from ..world.observer import Marker, Observer
 from ..world.state import RobotState
-from ..world.world import World
+from ..world.world import World, seen_text
 from .camera_feed import CameraFeed
 
 __all__ = [

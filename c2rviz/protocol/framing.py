@@ -19,8 +19,6 @@ from collections.abc import Sequence
 from ..errors import C2rvizError, LineError, LineTooLong
 from . import replies
 
-__all__ = ["BATCH_BYTES", "Line", "LineFramer"]
-
 Line = str | C2rvizError
 """A decoded line (without its ``\\n``), or why it could not be one."""
 

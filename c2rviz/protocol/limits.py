@@ -1,7 +1,7 @@
 """What one client of each door may cost: one table, the source of every door's limits object.
 
 Each door has one limits object, built from its rows here: the text port's
-``session.settings.ServerLimits``, CRCL's ``transports.crcl.server.CrclLimits``, rosbridge's
+``session.services.ServerLimits``, CRCL's ``transports.crcl.server.CrclLimits``, rosbridge's
 ``transports.rosbridge.policy.RosbridgePolicy`` and the page's ``view.policy.DoorPolicy``.
 A row gives a limit's default and the lowest (and, where the ini and flags set it, the
 highest) value allowed; the objects take their defaults with ``default`` and those that
@@ -15,8 +15,6 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
-
-__all__ = ["DOORS", "LIMITS", "Limit", "below_floor", "bounds", "default", "default_s", "rows"]
 
 DOORS = ("text", "crcl", "rosbridge", "page")
 """The doors, by the names the table uses."""

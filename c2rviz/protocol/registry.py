@@ -27,21 +27,6 @@ from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from typing import Any, TypeVar
 
-__all__ = [
-    "HANDLERS",
-    "LOOKUP",
-    "VERBS",
-    "Handler",
-    "Reply",
-    "Verb",
-    "handler",
-    "help_text",
-    "readme_table",
-    "usage",
-    "usages",
-    "verb",
-]
-
 Reply = str | Awaitable[str]
 """What a handler returns: the reply line now, or an awaitable of it (the reply waits,
 and so do the connection's later lines; other connections go on)."""
@@ -61,6 +46,8 @@ class Verb:
         command: The frozen dataclass the parser returns.
         parse: ``parse(verb, words) -> command``; raises ``BadArguments``.
         aliases: Other spellings of the verb.
+        page: The docs page that tells of it (``help VERB`` names it), from the
+            project's root.
     """
 
     name: str
@@ -69,6 +56,7 @@ class Verb:
     command: type
     parse: Callable[[str, list[str]], Any]
     aliases: tuple[str, ...] = ()
+    page: str = "docs/commands.md"
 
     @property
     def usage(self) -> str:
@@ -93,16 +81,18 @@ def verb(
     *,
     aliases: tuple[str, ...] = (),
     parse: Callable[[str, list[str]], Any] | None = None,
+    page: str = "docs/commands.md",
 ) -> Callable[[C], C]:
     """Register the decorated command class as verb ``name`` (stackable).
 
     ``parse`` defaults to the class's own ``parse``; a class with no fields and
-    no ``parse`` takes no arguments.
+    no ``parse`` takes no arguments. ``page`` is the docs page that tells of the verb
+    (docs/commands.md, which lists every verb, unless a page of its own does).
     """
 
     def register(cls: C) -> C:
         chosen = parse or getattr(cls, "parse", None) or _no_args(cls)
-        entry = Verb(name, args, summary, cls, chosen, aliases)
+        entry = Verb(name, args, summary, cls, chosen, aliases, page)
         for word in (name, *aliases):
             if word in LOOKUP:
                 raise ValueError(f"verb {word!r} is registered twice")

@@ -11,21 +11,6 @@ from collections.abc import Iterable
 from ..tolerance import limit_text
 from .registry import help_text
 
-__all__ = [
-    "BYE",
-    "OK",
-    "SHUTTING_DOWN",
-    "error",
-    "help_reply",
-    "incomplete_line",
-    "limit",
-    "not_http",
-    "numbers",
-    "ok",
-    "too_many_clients",
-    "unread_replies",
-]
-
 OK = "ok"
 BYE = "ok bye"
 SHUTTING_DOWN = "error: server is shutting down"

@@ -4,8 +4,7 @@ Importing the package wires every handler into the registry.
 """
 
 from . import handlers  # noqa: F401  (wires every verb's handler into the registry)
-from .services import Services
+from .services import ServerLimits, Services, SessionDefaults
 from .session import Session, UnitTable
-from .settings import ServerLimits, SessionDefaults
 
 __all__ = ["ServerLimits", "Services", "Session", "SessionDefaults", "UnitTable"]

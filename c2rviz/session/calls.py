@@ -1,7 +1,12 @@
-"""The work of ``Session``'s typed calls: moves planned before they move, checks, grips.
+"""The work of ``Session``'s typed calls: moves planned before they move, checks, grips;
+and a move's IK and the tool's straight line, planned off the loop and played, which
+the Cartesian verbs (``handlers.arm``) share with them.
 
-A ``Plan`` is a move solved (a straight line also planned and checked) with
-nothing moved yet; ``play`` moves it. ``plan_through`` plans several, each from
+First the straight line: typed on ``MoveSession`` (what of ``Session`` it uses), so the
+typed calls and the verbs reach it without a cycle through the session module.
+
+Then the calls. A ``Plan`` is a move solved (a straight line also planned and checked)
+with nothing moved yet; ``play`` moves it. ``plan_through`` plans several, each from
 the end of the one before, and with the guard checks every joint-space leg after
 the first off the event loop, on the session's worker, one leg per job (the first
 is checked as it starts); an error names the waypoint (1-based, as CRCL counts).
@@ -12,35 +17,113 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
 from ..collision.model import segment
 from ..errors import ArmMoved, C2rvizError, NoGripper, PathCollides
+from ..ik.line import StraightLine, plan_line
 from ..ik.target import Target
-from ..motion.path_play import TrajectoryPlay
+from ..motion.path_play import LinePlay, TrajectoryPlay, brake_limits, ramp_limits
 from ..motion.trajectory import PlannedTrajectory
 from ..planning import MoveChecker, MoveRequest, first_blocked, path_points
 from ..planning.cancel import STOPPED
 from ..protocol import replies
 from ..protocol.registry import Reply
-from ..world.grasp import SUCTION_BELOW, is_vacuum
-from .guarded import checker_of, request, unstopped
-from .straight import MoveSession, StraightPlan, plan_straight, play_straight, solve
+from ..robot.model import Robot
+from ..world.part_rules import SUCTION_BELOW, is_vacuum
+from .guarded import GuardedSession, checked_move, checker_of, request, unstopped
 
-__all__ = [
-    "MAX_TRAJECTORY_CHECKS",
-    "brake",
-    "grip",
-    "Plan",
-    "WaypointError",
-    "check_path",
-    "check_trajectory",
-    "plan_through",
-    "plan_to",
-    "play",
-    "play_trajectory",
-]
+
+class MoveSession(GuardedSession, Protocol):
+    """What a planned move needs of its session (``session.Session``), beyond a guarded
+    move's."""
+
+    robot: Robot
+    guard: bool
+    lspeed: float
+
+    def go(self, q: Sequence[float], speed: float | None = None) -> Reply: ...
+
+
+@dataclass(frozen=True)
+class StraightPlan:
+    """A straight tool line planned from the arm at rest at ``start`` [rad or m]."""
+
+    start: tuple[float, ...]
+    waypoints: list[tuple[float, ...]]
+    line: StraightLine
+    allowed: frozenset[tuple[str, str]] = frozenset()
+    """Pairs touching at the start that the line may leave (the guard's)."""
+
+
+async def plan_straight(
+    session: MoveSession, goal: Target, start: Sequence[float] | None = None
+) -> StraightPlan:
+    """Plan the tool's straight line from where the arm rests (or from ``start`` [rad or
+    m], the end of a line planned before) to ``goal`` (base frame, SI; a point alone leaves
+    the orientation free), checked off the loop by the guard when it is on; nothing moves
+    yet (``play_straight`` moves).
+
+    Raises:
+        ArmMoved: the arm moves (or moved while the line was planned).
+        C2rvizError: the line leaves the reach, or (guarded) collides.
+    """
+    state = session.state
+    if start is None and session.travel.active:
+        raise ArmMoved("movel starts from rest: send wait (or stop) first")
+    first, tool_offset = tuple(state.q if start is None else start), state.tool
+    worker = session.services.worker
+    solver = worker.ik_solver(state)
+    work = worker.run(lambda: plan_line(solver, first, goal, tool_offset), owner=session)
+    line = await (unstopped(session, work) if start is None else work)
+    if start is None and (state.q != first or session.travel.active):
+        raise ArmMoved("the arm moved while the line was planned: send movel again")
+    waypoints = [waypoint.q for waypoint in line.waypoints]
+    allowed: frozenset[tuple[str, str]] = frozenset()
+    if session.guard:  # the whole line, off the loop
+        checked, _ = await checked_move(session, [waypoints[-1]], path_from=np.array(waypoints))
+        allowed = checked.allowed
+    return StraightPlan(first, waypoints, line, allowed)
+
+
+def play_straight(session: MoveSession, plan: StraightPlan, speed: float | None = None) -> Reply:
+    """Move along a planned line as ``motion`` says (at once, or travelling at ``lspeed``
+    within ``speed`` % of the joints' limits; None: the session's)."""
+    state, world = session.state, session.world
+    if session.motion == "off":
+        world.set_q(plan.waypoints[-1], state.name, session.source)
+        return replies.OK
+    fraction = (session.speed if speed is None else speed) / 100.0
+    limits = session.travel.motion.limits
+    times = plan.line.timestamps(session.lspeed, [v * fraction for v in limits.velocity])
+    ramp = ramp_limits(limits, fraction)
+    brake = brake_limits(limits, fraction)
+    play = LinePlay(world.clock.now(), times, np.array(plan.waypoints), *ramp, brake=brake)
+    arrival = world.travels.play(state, play, session.source, session.motion == "on")
+    if session.guard:
+        session.services.guards.watch(
+            state.name, play, plan.allowed, session.source, session.resolution
+        )
+    return replies.OK if arrival is None else arrival
+
+
+async def solve(
+    session: MoveSession, target: Target, seed: Sequence[float] | None = None
+) -> Sequence[float]:
+    """The joints [rad or m] that put the tool point at ``target`` (base frame, SI; a point
+    alone: any orientation), from
+    ``seed`` (default: the arm's joints now), on the worker's thread.
+
+    Raises:
+        C2rvizError: the pose is out of reach (naming how far).
+    """
+    state, worker = session.state, session.services.worker
+    first, tool_offset = (session.now() if seed is None else seed), state.tool
+    solver = worker.ik_solver(state)
+    return await worker.run(lambda: solver.solve(target, first, tool_offset), owner=session)
+
 
 MAX_TRAJECTORY_CHECKS = 2000
 """Most instants of a timed trajectory checked for collisions (one per frame, or fewer)."""
@@ -200,7 +283,7 @@ def _check(
 
 def grip(session: MoveSession, opening: float) -> Reply:
     """``Session.grip``: see there. Closing on a part takes it by the grasp rule
-    (``world/grasp.py``, docs/parts.md): the fingers stop where they touch it and the reply
+    (``world/part_rules.py``, docs/parts.md): the fingers stop where they touch it and the reply
     says that opening (``ok 0.433``); opening them lets go of what they hold. A vacuum
     gripper's suction turns on below ``SUCTION_BELOW`` (taking a part at the cup replies
     ``ok held``) and off from it, letting go."""

@@ -14,6 +14,13 @@ hears ``stopped: link_e would hit wall (the workcell changed)``.
 
 The arm keeps moving while the check runs (milliseconds), so it stops before the
 contact when the contact is at least that and the braking distance ahead.
+
+What a move is checked against, taken on the event loop, is ``world_request`` (at the
+start of this module; a guarded move's first check takes it too): a
+``planning.MoveRequest`` holds a robot's collision checks as they are now, the other
+robots' shapes where they are now (``still_only``: only those standing still, when the
+moving ones are checked in time), and the move's start, goals and settings; the
+worker's thread checks it while the loop goes on.
 """
 
 from __future__ import annotations
@@ -29,16 +36,66 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from ..collision.batch import PlacedShape
 from ..collision.model import CollisionModel, Pair
-from ..collision.other_robots import first_hit_between
+from ..collision.other_robots import first_hit_between, placed_shapes
 from ..motion.path_play import PathPlay
 from ..planning import EdgeResolution, MoveChecker, MoveRequest, first_blocked
+from ..planning.cancel import Cancel
+from ..planning.guarded_move import OtherAt
 from ..world.clock import Hold
-from ..world.effects import Observer
+from ..world.observer import Observer
 from ..world.world import World
-from .worker import Superseded, Worker, WorkerBusy
+from .lanes import Superseded, WorkerBusy
+from .worker import Worker
 
-__all__ = ["DT", "GuardWatch", "Run"]
+
+def world_request(
+    world: World,
+    robot: str,
+    resolution: EdgeResolution,
+    start: Sequence[float],
+    goals: Sequence[Sequence[float]],
+    *,
+    path: np.ndarray | None = None,
+    target_only: bool = False,
+    plan: str = "never",
+    timeout_s: float = 1.0,
+    seed: int | None = None,
+    still_only: bool = False,
+    cancel: Cancel | None = None,
+) -> MoveRequest:
+    """What a move of ``robot`` is checked against now (on the loop): its checks, and the
+    other robots where they are (``still_only``: only those standing still); ``cancel``
+    stops its plan, if it plans."""
+    state = world.state(robot)
+    model = world.collision_model(robot)
+    shapes: list[PlacedShape] = []
+    key: list[OtherAt] = []
+    for name, other in world.robots.items():
+        moving = world.moving(name)
+        if name == robot or (moving and still_only):
+            continue
+        q = tuple(world.now(name))
+        shapes += placed_shapes(name, world.collision_model(name), q, other.origin)
+        key.append((name, None if moving else q, other.origin.homogeneous.tobytes()))
+    return MoveRequest(
+        model,
+        model.check_geometry(),
+        tuple(shapes),
+        tuple(key),
+        state.origin,
+        resolution,
+        tuple(float(x) for x in start),
+        tuple(tuple(float(x) for x in goal) for goal in goals),
+        path,
+        target_only,
+        plan,
+        timeout_s,
+        seed,
+        cancel,
+    )
+
 
 log = logging.getLogger("c2rviz")
 

@@ -49,22 +49,10 @@ from ..protocol import replies
 from ..world.moves import Travel
 from ..world.state import RobotState
 from ..world.world import World
-from .move_requests import world_request
+from .guard_watch import world_request
 from .plan_process import plan_job
 from .services import Services
 from .worker import Worker
-
-__all__ = [
-    "TRIES",
-    "WorldChanged",
-    "checked_move",
-    "guarded_go",
-    "guarded_rand",
-    "play_checked",
-    "GuardedSession",
-    "request",
-    "unstopped",
-]
 
 T = TypeVar("T")
 TRIES = 3  # checks of one move while the world keeps changing under it

@@ -27,8 +27,6 @@ from typing import Any
 from ..errors import C2rvizError, MotionInterrupted
 from ..planning.cancel import SUPERSEDED, WENT_AWAY, Cancel, PlanCancelled
 
-__all__ = ["Job", "Lane", "Superseded", "WorkerBusy"]
-
 
 class WorkerBusy(C2rvizError):
     """A lane's queue is full (in all, or this connection's): refused, nothing changed."""

@@ -24,8 +24,6 @@ from ..protocol.registry import Reply
 from ..world.state import RobotState
 from ..world.world import World
 
-__all__ = ["INTERNAL", "Said", "late", "recorded", "refused", "taken", "taken_all"]
-
 
 class Session(Protocol):
     """What the notes need of the session whose command they tell (``session.Session``)."""

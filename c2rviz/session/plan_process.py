@@ -38,19 +38,6 @@ from ..planning.errors import NoPathFound, NoWayAround
 from ..planning.guarded_move import CheckedMove, MoveChecker, MoveRequest
 from ..planning.ompl_planner import fork_lock
 
-__all__ = [
-    "GRACE_S",
-    "POLL_S",
-    "THREAD_S",
-    "ParentGone",
-    "in_child",
-    "plan_checked",
-    "plan_job",
-    "portable_error",
-    "rebuilt_error",
-    "run_forked",
-]
-
 T = TypeVar("T")
 
 POLL_S = 0.01  # [s] how often a waiting parent looks at the plan's cancel flag

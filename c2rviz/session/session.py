@@ -35,11 +35,8 @@ from ..world.state import RobotState
 from . import calls
 from .guarded import guarded_go, unstopped
 from .notes import Said, recorded, refused, taken, taken_all
-from .services import Services
-from .settings import Modes
+from .services import Modes, Services
 from .units import UnitEdge, UnitTable
-
-__all__ = ["BATCHED", "Session", "UnitTable"]
 
 T = TypeVar("T")
 _CADENCE_S = 0.02  # a pause this soon after the previous one's end continues its cadence
@@ -53,7 +50,7 @@ class Session(UnitEdge, Modes):
 
     Attributes:
         source: Who speaks (``tcp 127.0.0.1:5123``, ``page``), for notes and errors.
-        motion: ``off``, ``on`` or ``follow`` (``protocol.verbs.motion.MOTION_MODES``).
+        motion: ``off``, ``on`` or ``follow`` (``protocol.verbs.arm.MOTION_MODES``).
         speed: Moves at this % of the joints' limits.
         guard: Refuse commands whose target or path collides.
         plan_around: With the guard, plan joint-space moves around what their straight

@@ -26,17 +26,6 @@ from ..robot.frames import pose_se3, se3_pose
 from ..robot.model import Robot
 from ..tolerance import within_limit
 
-__all__ = [
-    "DEGREE_RAD",
-    "FOOT_M",
-    "INCH_M",
-    "MILLIMETER_M",
-    "POUND_FORCE_N",
-    "UnitEdge",
-    "UnitTable",
-    "joint_scale",
-]
-
 DEGREE_RAD: Final = math.pi / 180.0
 """Radians in a degree."""
 MILLIMETER_M: Final = 1e-3

@@ -45,17 +45,7 @@ from typing import Any, TypeVar
 from ..ik.solver import IkSolver
 from ..planning.cancel import Cancel, PlanCancelled
 from ..world.state import RobotState
-from .lanes import Job, Lane, Superseded, WorkerBusy
-
-__all__ = [
-    "MAX_PER_OWNER",
-    "MAX_QUEUE",
-    "PLAN_THREADS",
-    "SWITCH_S",
-    "Superseded",
-    "Worker",
-    "WorkerBusy",
-]
+from .lanes import Job, Lane
 
 T = TypeVar("T")
 

@@ -39,9 +39,9 @@ from ..robot.model import Robot
 from ..session.services import Services
 from ..session.session import Session
 from ..world.clock import Clock, Hold
-from ..world.clocks import parse_clock
-from ..world.effects import NullScene, Observer, Scene
+from ..world.observer import NullScene, Observer, Scene
 from ..world.state import RobotState
+from ..world.virtual_clock import parse_clock
 from ..world.world import World
 from .options import RUNTIME_OPTIONS, give_back, given_members, settings_for, take_members
 

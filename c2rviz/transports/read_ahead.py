@@ -20,7 +20,7 @@ from ..planning.cancel import STOPPED
 from ..protocol import replies
 from ..protocol.framing import Line, LineFramer
 from ..protocol.grammar import parse_line
-from ..protocol.verbs.motion import Stop
+from ..protocol.verbs.arm import Stop
 from ..session.session import Session
 
 __all__ = [

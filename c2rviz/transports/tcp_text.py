@@ -27,9 +27,8 @@ from ..planning.cancel import WENT_AWAY
 from ..protocol import replies
 from ..protocol.framing import Line, LineFramer
 from ..protocol.grammar import ForeignProtocol
-from ..session.services import Services
+from ..session.services import ServerLimits, Services
 from ..session.session import BATCHED, Session
-from ..session.settings import ServerLimits
 from .read_ahead import StopScan, is_command, is_stop, pace_reading, stop_plans, waited_reply
 from .tcp_rules import TURN_S, close_lingering
 

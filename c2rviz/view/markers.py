@@ -19,7 +19,7 @@ import numpy as np
 import viser
 
 from ..protocol.grammar import MARKER_SHAPES
-from ..world.effects import MAX_MARKERS, Marker
+from ..world.observer import MAX_MARKERS, Marker
 from . import adapter
 from .marker_meshes import marker_mesh
 from .robot_view import node_name

@@ -26,7 +26,7 @@ import pinocchio as pin
 from ..collision.workcell import WorkcellObject
 from ..errors import EmergencyStop
 from ..world.cameras import Camera, Cameras
-from ..world.goals import Goal
+from ..world.part_rules import Goal
 from ..world.parts import Part, Parts
 from ..world.world import World
 
@@ -114,7 +114,7 @@ def fault_banners(world: World) -> dict[str, str]:
 
 class _Objects:
     """A robot's workcell objects in the mirror, where its collision model would be (what
-    ``camera_sight.occluders`` reads: a camera's label counts what hides a part)."""
+    ``world.occluders`` reads: a camera's label counts what hides a part)."""
 
     def __init__(self, objects: Sequence[WorkcellObject]) -> None:
         self.objects = list(objects)

@@ -27,8 +27,8 @@ from ..errors import C2rvizError, PathCollides
 from ..session.services import Services
 from ..session.session import Session
 from ..world.cameras import Camera
-from ..world.effects import Marker, Scene
-from ..world.goals import Goal
+from ..world.observer import Marker, Scene
+from ..world.part_rules import Goal
 from ..world.parts import Part
 from .page_cell import camera_rows, fault_banner, goal_rows, part_rows
 

@@ -19,9 +19,8 @@ import pinocchio as pin
 from ..collision.workcell import WorkcellObject
 from ..motion.limits import MotionLimits
 from ..robot.model import Robot
-from ..session.services import Services
+from ..session.services import Services, SessionDefaults
 from ..session.session import Session
-from ..session.settings import SessionDefaults
 from ..world.state import Marker
 from .page_cell import camera_rows, fault_banners, goal_rows, part_rows
 from .page_frame import trail_state

@@ -26,7 +26,7 @@ import viser
 
 from ..robot.frames import se3_pose
 from ..tolerance import limit_text
-from ..world.effects import Marker
+from ..world.observer import Marker
 from ..world.world import RobotState
 from . import adapter
 

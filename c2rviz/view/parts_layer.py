@@ -16,7 +16,7 @@ from typing import Any
 import pinocchio as pin
 import viser
 
-from ..world.goals import Goal
+from ..world.part_rules import Goal
 from ..world.parts import Part
 from .robot_view import node_name, wxyz
 

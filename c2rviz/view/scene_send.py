@@ -13,10 +13,10 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from ..collision.workcell import WorkcellObject
-from ..world.camera_sight import sight
 from ..world.cameras import Camera
-from ..world.goals import Goal
+from ..world.part_rules import Goal
 from ..world.parts import Part
+from ..world.world import sight
 
 if TYPE_CHECKING:
     import viser

@@ -39,8 +39,8 @@ from ..robot.visuals import LinkGeometry, load_link_geometry
 from ..session.services import Services
 from ..session.session import Session
 from ..world.cameras import Camera
-from ..world.effects import Marker, Scene
-from ..world.goals import Goal
+from ..world.observer import Marker, Scene
+from ..world.part_rules import Goal
 from ..world.parts import Part
 from . import adapter, scene_send
 from .camera_layer import CameraLayer

@@ -26,26 +26,6 @@ import pinocchio as pin
 
 from ..errors import C2rvizError, shown
 
-__all__ = [
-    "DEFAULT_FOV_RAD",
-    "DEFAULT_RANGE_M",
-    "DEFAULT_RATE_HZ",
-    "MAX_CAMERAS",
-    "MAX_RATE_HZ",
-    "Camera",
-    "CameraError",
-    "Cameras",
-    "Occluder",
-    "PartLike",
-    "Seen",
-    "TooManyCameras",
-    "UnknownCamera",
-    "hidden",
-    "hidden_by",
-    "in_frustum",
-    "see",
-]
-
 MAX_CAMERAS = 16
 """Cameras in a world at once."""
 DEFAULT_FOV_RAD = (math.radians(60.0), math.radians(45.0))

@@ -5,7 +5,7 @@ alike: a move from any door reaches ``World.set_q`` or ``Travels.go``/``play``, 
 ``refuse``; a moving arm's samples pass through ``follow`` and its arrival through
 ``arrival_error``. What a door reports of the joints passes through ``sensed``; a
 session's replies pass through ``delayed`` (ok and error alike: ``session/notes``) and a
-CRCL connection's statuses through ``late_sends`` (``latency.py`` makes them wait on the
+CRCL connection's statuses through ``late_sends`` (``clock.py``'s latency makes them wait on the
 clock). A fault that begins, ends or is lifted is told to every observer
 (``Observer.on_fault``: ``watch`` streams, rosbridge's ``/diagnostics``, the page) and
 listener (the text and CRCL doors and rosbridge's bridge, for ``disconnect``). A ``drop``
@@ -26,9 +26,8 @@ import numpy as np
 
 from ..errors import BadArguments, C2rvizError, MotionInterrupted, shown
 from ..protocol.registry import usage
-from .clock import Clock, Timer
+from .clock import Clock, LateSends, Timer, late
 from .faults import Fault, RobotFaults, Scheduled
-from .latency import LateSends, late
 from .moves import Travels
 from .state import MoveRules, RobotState
 
@@ -36,7 +35,6 @@ if TYPE_CHECKING:
     from .cameras import Cameras
     from .part_world import WorldParts
 
-__all__ = ["FaultRules"]
 
 T = TypeVar("T")
 

@@ -30,19 +30,6 @@ from ..protocol import replies
 from ..protocol.registry import usage
 from ..protocol.verbs.faults import FaultSpec
 
-__all__ = [
-    "to_fault",
-    "at_once",
-    "INSTANT",
-    "MAX_SCHEDULED",
-    "replay_line",
-    "STALL_TOLERANCE",
-    "Fault",
-    "RobotFaults",
-    "Scheduled",
-    "TooManyScheduled",
-]
-
 MAX_SCHEDULED = 100
 """Faults scheduled at once per robot (``fault at``/``after``); past it one is refused."""
 INSTANT = frozenset({"disconnect", "drop"})

@@ -20,8 +20,6 @@ from ..protocol import replies
 from .clock import Clock, Timer
 from .state import MoveRules, RobotState
 
-__all__ = ["Grip", "Grips"]
-
 
 @dataclass(eq=False)
 class Grip:

@@ -20,10 +20,8 @@ from ..collision.model import CollisionModel, Pair
 from ..collision.other_robots import pairs_between
 from ..collision.workcell import MAX_OBJECTS
 from .clock import Clock, Timer
-from .effects import Observer
+from .observer import Observer
 from .state import RobotState
-
-__all__ = ["Contacts"]
 
 
 class Contacts(Observer):

@@ -22,8 +22,6 @@ from ..protocol import replies
 from .clock import Clock, Timer
 from .state import MoveRules, RobotState
 
-__all__ = ["TICK_ROBOTS", "MoveRules", "Travel", "Travels"]
-
 TICK_ROBOTS = 8  # robots sampled in one turn of the loop (64 robots: ~0.6 ms a turn)
 
 

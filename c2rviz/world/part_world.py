@@ -2,7 +2,7 @@
 
 ``WorldParts`` belongs to the ``World`` and is one of its observers: a robot's new joints
 move the parts it holds. The session checks a command's words; this applies the rules
-(``grasp.py``: what closing fingers take) and tells every observer ``on_parts`` (the parts
+(``part_rules.py``: what closing fingers take) and tells every observer ``on_parts`` (the parts
 now, poses in the world frame) and ``on_part_event`` (``grasped NAME``, ``released NAME``,
 ``resting NAME on WHAT``). Every robot's collision model gets the parts as they change.
 
@@ -22,9 +22,19 @@ import pinocchio as pin
 
 from ..collision.geometry import robot_geometry
 from ..collision.part_geometry import Obstacle, drop, signed_distance
-from .goals import Goal, GoalBook, GoalResult, score
-from .grasp import at_cup, extent, finger_links, jaws, opening_for, take
-from .parts import FLOOR, G_M_S2, Falls, Part, PartError, Parts
+from .part_rules import (
+    Goal,
+    GoalBook,
+    GoalResult,
+    at_cup,
+    extent,
+    finger_links,
+    jaws,
+    opening_for,
+    score,
+    take,
+)
+from .parts import FLOOR, Falls, Part, PartError, Parts
 
 if TYPE_CHECKING:
     from ..collision.model import CollisionModel, PartShape
@@ -32,7 +42,6 @@ if TYPE_CHECKING:
     from .live_collisions import Contacts
     from .state import RobotState
 
-__all__ = ["G_M_S2", "OVERLAP_TOL_M", "REST_TOL_M", "PartInsideObject", "WorldParts"]
 
 REST_TOL_M = 0.002
 """A part put down this close above something rests on it [m]."""

@@ -34,23 +34,6 @@ from ..collision.workcell import (
 from ..errors import shown
 from .clock import Clock, Timer
 
-__all__ = [
-    "CHECK_MARGIN_M",
-    "FLOOR",
-    "Falls",
-    "G_M_S2",
-    "MAX_PARTS",
-    "PART_SHAPES",
-    "PART_SIZE_M",
-    "Part",
-    "PartError",
-    "PartNameInUse",
-    "Parts",
-    "TooManyParts",
-    "UnknownPart",
-]
-
-
 MAX_PARTS = 100
 """Parts in a world at once."""
 PART_SIZE_M = (0.001, 2.0)

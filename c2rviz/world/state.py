@@ -18,9 +18,6 @@ import pinocchio as pin
 from ..errors import C2rvizError
 from ..robot.model import Robot
 
-__all__ = ["MAX_MARKERS", "Marker", "MoveRules", "RobotState"]
-
-
 MAX_MARKERS = 1000
 """Markers kept at once per robot; beyond it the oldest goes first, so a flood of
 ``mark`` costs neither the server's memory nor the page's frame rate. Every holder

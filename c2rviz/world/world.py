@@ -7,6 +7,10 @@ through one fan-out. Nothing else writes the state.
 
 Each robot has a commanded ``target`` and the ``q`` shown now; without motion
 they are equal at once. ``clock`` (``world.clock``) is the time of every effect.
+
+At its end, what a camera of the world sees now (``sight``, ``occluders``, ``seen_text``):
+``cameras.py`` holds the rules (pure); these hand them the world's parts (their world
+poses) and every robot's workcell objects (placed in the world) at the clock's time.
 """
 
 from __future__ import annotations
@@ -20,19 +24,18 @@ from ..collision.model import CollisionModel, Pair
 from ..collision.workcell import MAX_OBJECTS
 from ..errors import C2rvizError, UnknownRobot
 from ..motion.planner import MotionLimits, motion_limits
-from ..robot.frames import se3_wxyz
+from ..protocol import replies
+from ..robot.frames import se3_pose, se3_wxyz
 from ..robot.model import Robot
-from .cameras import Cameras
+from .cameras import Cameras, Occluder, PartLike, Seen, see
 from .clock import Clock
-from .effects import Observer
 from .fault_rules import FaultRules
 from .grips import Grips
 from .live_collisions import Contacts
 from .moves import Travel, Travels
+from .observer import Observer
 from .part_world import WorldParts
 from .state import Marker, RobotState
-
-__all__ = ["RobotState", "World"]
 
 
 class World:
@@ -96,7 +99,7 @@ class World:
         """The parts: grasped, carried, released (``part_world.py``)."""
         self.contacts.furnish = self.parts.furnish
         self.cameras = Cameras(lambda cameras: self._tell("on_cameras", cameras))
-        """The logical cameras (``cameras.py``; what one sees: ``camera_sight.py``)."""
+        """The logical cameras (``cameras.py``; what one sees: ``sight`` below)."""
         self.faults.parts, self.parts.slips = self.parts, self.faults.slips  # drop, slip
         self.faults.cameras = self.cameras  # blackout
 
@@ -329,3 +332,39 @@ class World:
 def _repliers(observers: Sequence[Observer]) -> list[Observer]:
     """The observers that do something with ``on_reply``."""
     return [o for o in observers if type(o).on_reply is not Observer.on_reply]
+
+
+def occluders(world: World) -> list[Occluder]:
+    """Every object of every built workcell, placed in the world frame."""
+    found: list[Occluder] = []
+    for name, state in world.robots.items():
+        model = world.contacts.models.get(name)
+        if model is None:
+            continue
+        for obj in model.object_list():
+            found.append((obj.name, obj.shape, obj.size, state.base * obj.placement))
+    return found
+
+
+def sight(world: World, name: str, noisy: bool = True) -> list[Seen]:
+    """What camera ``name`` sees now (raises ``UnknownCamera``); ``noisy`` False: the exact
+    poses, drawing nothing from its generator (the page's look, which must not change
+    what the camera reports to clients)."""
+    camera = world.cameras.get(name)
+    parts: list[PartLike] = [
+        (p.name, p.kind or p.obj.shape, p.pose) for p in world.parts.parts.all()
+    ]
+    return see(camera, parts, occluders(world), world.clock.now(), noisy)
+
+
+def seen_text(seen: Sequence[Seen], angle_scale: float = 1.0) -> str:
+    """``p1:TYPE:x,y,z,roll,pitch,yaw;...`` (metres; angles [rad] / ``angle_scale``: a
+    connection's unit), or ``none``."""
+    if not seen:
+        return "none"
+    items = []
+    for one in seen:
+        x, y, z, roll, pitch, yaw = se3_pose(one.pose)
+        angles = [roll / angle_scale, pitch / angle_scale, yaw / angle_scale]
+        items.append(f"{one.name}:{one.kind}:{replies.numbers([x, y, z, *angles])}")
+    return ";".join(items)

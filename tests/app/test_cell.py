@@ -25,7 +25,7 @@ from c2rviz.collision import first_hit_between
 from c2rviz.errors import ConfigError
 from c2rviz.session import Services
 from c2rviz.transports.tcp_server import CommandServer
-from c2rviz.world.effects import RecordingScene
+from c2rviz.world.observer import RecordingScene
 from c2rviz.world.world import World
 
 LEFT = "0,0,0,0,0,0"

@@ -15,7 +15,7 @@ from support import load_robot
 from c2rviz.session import Services
 from c2rviz.session.session import Session
 from c2rviz.world import moves
-from c2rviz.world.effects import RecordingScene
+from c2rviz.world.observer import RecordingScene
 from c2rviz.world.world import World
 
 

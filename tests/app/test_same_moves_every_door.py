@@ -34,7 +34,7 @@ from c2rviz.session import Services, Session, SessionDefaults
 from c2rviz.transports.crcl.server import CrclServer
 from c2rviz.transports.tcp_server import CommandServer
 from c2rviz.view.viser_scene import ViserScene
-from c2rviz.world.effects import Observer
+from c2rviz.world.observer import Observer
 from c2rviz.world.world import World
 
 WAIT_S = 60.0

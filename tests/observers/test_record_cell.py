@@ -27,7 +27,7 @@ from c2rviz.clients import player
 from c2rviz.observers.bag_topics import namespaces
 from c2rviz.session import ServerLimits, Services
 from c2rviz.transports.tcp_server import CommandServer
-from c2rviz.world.effects import RecordingScene
+from c2rviz.world.observer import RecordingScene
 from c2rviz.world.world import World
 
 LEFT_ORIGIN = pin.SE3(pin.rpy.rpyToMatrix(0, 0, 0.3), np.array([0.0, 0.6, 0.0]))

@@ -27,8 +27,8 @@ from c2rviz.app.program import write_page
 from c2rviz.observers.recorded import Recorded
 from c2rviz.session import ServerLimits
 from c2rviz.view import record_page
-from c2rviz.world.clocks import VirtualClock
 from c2rviz.world.state import RobotState
+from c2rviz.world.virtual_clock import VirtualClock
 
 
 @pytest.fixture

@@ -9,7 +9,7 @@ import pytest
 from support import Client, ServerLimits, ServerThread, load_robot
 
 from c2rviz.clients import player
-from c2rviz.world.clocks import VirtualClock
+from c2rviz.world.virtual_clock import VirtualClock
 
 PICK = "0,0.3,-0.3,0,-0.9707963,0"  # the fanuc pointing down at the part (test_part_verbs)
 LIFT = "0,0,0,0,-1.5707963,0"

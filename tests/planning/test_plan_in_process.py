@@ -10,7 +10,7 @@ from support import Client, ServerThread
 from c2rviz.collision import CollisionModel
 from c2rviz.protocol.replies import numbers
 from c2rviz.session import SessionDefaults, plan_process
-from c2rviz.session.settings import ServerLimits
+from c2rviz.session.services import ServerLimits
 
 
 def test_a_seeded_plan_that_goes_on_in_a_process_finds_the_path_of_one_search(

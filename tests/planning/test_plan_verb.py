@@ -27,7 +27,7 @@ from c2rviz.collision import CollisionModel
 from c2rviz.motion import motion_limits
 from c2rviz.robot import Robot
 from c2rviz.session import ServerLimits, SessionDefaults
-from c2rviz.world.clocks import VirtualClock
+from c2rviz.world.virtual_clock import VirtualClock
 
 ARMS = [
     *BUNDLED,

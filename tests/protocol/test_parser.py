@@ -13,27 +13,63 @@ from support import ROOT
 
 from c2rviz.errors import BadArguments, LineError, UnknownCommand
 from c2rviz.protocol.grammar import ForeignProtocol, parse_line
-from c2rviz.protocol.verbs.cameras import CameraEdit, CamerasQuery
-from c2rviz.protocol.verbs.cartesian import Ik, LinearSpeed, MoveL, MoveTo, Tool
-from c2rviz.protocol.verbs.cell import RobotChoice, RobotsList
+from c2rviz.protocol.verbs.arm import (
+    Ik,
+    LinearSpeed,
+    MotionMode,
+    MoveL,
+    MoveTo,
+    RobotChoice,
+    RobotsList,
+    Speed,
+    Status,
+    Stop,
+    Target,
+    Tool,
+    Wait,
+)
 from c2rviz.protocol.verbs.faults import Faults, FaultSpec, FaultVerb, Reset
-from c2rviz.protocol.verbs.joints import Home, Joints, Move, Rand, Units
-from c2rviz.protocol.verbs.markers import Clear, Color, Mark, MarkerShape
-from c2rviz.protocol.verbs.motion import MotionMode, Speed, Status, Stop, Target, Wait
-from c2rviz.protocol.verbs.observe import Ghost, Record, Trail, Unwatch, Watch
-from c2rviz.protocol.verbs.parts import GoalEdit, Grip, PartEdit, PartsQuery, Score
-from c2rviz.protocol.verbs.queries import (
+from c2rviz.protocol.verbs.parts import (
+    CameraEdit,
+    CamerasQuery,
+    GoalEdit,
+    Grip,
+    PartEdit,
+    PartsQuery,
+    Score,
+)
+from c2rviz.protocol.verbs.scene import (
+    Collisions,
+    Ghost,
+    Guard,
+    ObjectEdit,
+    Objects,
+    Plan,
+    Record,
+    Trail,
+    Unwatch,
+    Watch,
+)
+from c2rviz.protocol.verbs.seed import (
     Bye,
+    Clear,
+    Color,
     Help,
+    Home,
+    Joints,
     Limits,
+    Mark,
+    MarkerShape,
+    Move,
     Names,
     Pose,
     Quit,
+    Rand,
     Sleep,
+    Units,
     Version,
     Where,
 )
-from c2rviz.protocol.verbs.workcell import Collisions, Guard, ObjectEdit, Objects, Plan
 
 GOOD = [
     ("home", Home(), "home"),

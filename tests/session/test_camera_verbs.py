@@ -13,7 +13,7 @@ from support import Client, ServerLimits, ServerThread, load_robot
 from watch_support import is_reply
 
 from c2rviz.world.cameras import MAX_CAMERAS
-from c2rviz.world.clocks import VirtualClock
+from c2rviz.world.virtual_clock import VirtualClock
 
 # Looking straight down (pitch 90 deg turns +x onto -z) from 1 m above the origin.
 DOWN = "camera top 0,0,1,0,1.5707963267948966,0"

@@ -19,7 +19,8 @@ from support import Client, ServerThread
 from c2rviz.errors import C2rvizError
 from c2rviz.planning.cancel import STOPPED, SUPERSEDED, WENT_AWAY, Cancel, PlanCancelled
 from c2rviz.session import Session
-from c2rviz.session.worker import MAX_PER_OWNER, Superseded, Worker, WorkerBusy
+from c2rviz.session.lanes import Superseded, WorkerBusy
+from c2rviz.session.worker import MAX_PER_OWNER, Worker
 
 GOAL = "0,90,0,0,0,0,0"  # [deg] the arm lying along +x: inside the chimney
 HALF, WALL, Z = 0.16, 0.02, 0.41  # [m] the chimney's inner half width, its walls, its axis

@@ -8,7 +8,7 @@ from support import Client, ServerThread, load_robot
 
 from c2rviz.protocol import replies
 from c2rviz.session import ServerLimits
-from c2rviz.world.clocks import VirtualClock
+from c2rviz.world.virtual_clock import VirtualClock
 
 
 def test_grip_at_once_and_asked(start_server, connect) -> None:

@@ -12,7 +12,7 @@ import pytest
 from support import Client, ServerLimits, ServerThread, load_robot
 
 from c2rviz.session import guard_watch
-from c2rviz.world.clocks import VirtualClock
+from c2rviz.world.virtual_clock import VirtualClock
 
 WALL = "object wall box 0.05,2,2 0.6,0,0.9,0,0,0"  # in the way of the arm lying down
 

@@ -14,7 +14,7 @@ from support import Client, ServerThread, load_robot
 
 from c2rviz.motion.planner import motion_limits
 from c2rviz.session import ServerLimits
-from c2rviz.world.clocks import VirtualClock
+from c2rviz.world.virtual_clock import VirtualClock
 
 FAR = "90,45,0,-30,0,60,0"  # degrees, motoman_sia20d
 OTHER = "-45,20,30,0,0,-30,0"

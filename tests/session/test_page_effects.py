@@ -8,7 +8,7 @@ import math
 import numpy as np
 from support import ServerThread
 
-from c2rviz.world.effects import Observer
+from c2rviz.world.observer import Observer
 
 BOX = "object table box 0.2,0.2,0.2 0,0.8,0.85,0,0,0"  # beside the motoman, at +y
 REACH = "0,60,0,0,0,0,0"  # degrees: the arm held out along +x

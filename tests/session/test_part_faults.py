@@ -220,8 +220,8 @@ def vacuum():
     from support import ROBOTS, ROOT, ServerLimits, ServerThread
 
     from c2rviz.robot.model import Robot
-    from c2rviz.world.clocks import VirtualClock
-    from c2rviz.world.grasp import make_vacuum
+    from c2rviz.world.part_rules import make_vacuum
+    from c2rviz.world.virtual_clock import VirtualClock
 
     path, base, eelink = ROBOTS["motoman_sia20d"]
     robot = Robot.from_urdf(ROOT / path, base, eelink)  # its own: the cached one stays bare

@@ -15,7 +15,7 @@ import pytest
 from support import Client, ServerLimits, ServerThread, load_robot
 from watch_support import ask
 
-from c2rviz.world.clocks import VirtualClock
+from c2rviz.world.virtual_clock import VirtualClock
 
 PICK = "0,0.3,-0.3,0,-0.9707963,0"  # pointing straight down
 LIFT = "0,0,0,0,-1.5707963,0"  # straight down, 210 mm higher

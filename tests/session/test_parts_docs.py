@@ -10,8 +10,8 @@ import pytest
 from support import ROOT, Client, ServerLimits, ServerThread, load_robot
 
 from c2rviz.protocol.verbs import parts as verbs_parts
-from c2rviz.world import goals, grasp, part_world, parts
-from c2rviz.world.clocks import VirtualClock
+from c2rviz.world import part_rules, part_world, parts
+from c2rviz.world.virtual_clock import VirtualClock
 
 DOC = ROOT / "docs" / "parts.md"
 NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
@@ -61,9 +61,9 @@ def test_the_limits_table_is_the_code() -> None:
     values = {
         "MAX_PARTS": f"| {parts.MAX_PARTS} |",
         "PART_SIZE_M": f"| {parts.PART_SIZE_M[0]:g}..{parts.PART_SIZE_M[1]:g} m |",
-        "MAX_GOALS": f"| {goals.MAX_GOALS} |",
-        "GRIP_TOL_M": f"| {grasp.GRIP_TOL_M * 1000:g} mm |",
-        "CUP_M": f"| {grasp.CUP_M * 1000:g} mm |",
+        "MAX_GOALS": f"| {part_rules.MAX_GOALS} |",
+        "GRIP_TOL_M": f"| {part_rules.GRIP_TOL_M * 1000:g} mm |",
+        "CUP_M": f"| {part_rules.CUP_M * 1000:g} mm |",
         "REST_TOL_M": f"| {part_world.REST_TOL_M * 1000:g} mm |",
         "OVERLAP_TOL_M": f"| {part_world.OVERLAP_TOL_M * 1000:g} mm |",
         "CHECK_MARGIN_M": f"| {parts.CHECK_MARGIN_M * 1000:g} mm |",
@@ -72,4 +72,4 @@ def test_the_limits_table_is_the_code() -> None:
         row = next(line for line in table.splitlines() if f".{name}`" in line)
         assert cell in row, (name, row)
     assert verbs_parts.PART_SIZE_M == parts.PART_SIZE_M  # the parser's copy
-    assert goals.DEFAULT_TOL_M == 0.005 and math.degrees(goals.DEFAULT_TOL_RAD) == 5.0
+    assert part_rules.DEFAULT_TOL_M == 0.005 and math.degrees(part_rules.DEFAULT_TOL_RAD) == 5.0

@@ -8,7 +8,7 @@ import pytest
 from support import ROBOTS, ServerThread, load_robot
 
 from c2rviz.session import ServerLimits
-from c2rviz.world.clocks import parse_clock
+from c2rviz.world.virtual_clock import parse_clock
 
 FOLDED = {
     "motoman_sia20d": ("0,-106,0,122,0,0,0", "base_link~link_b,base_link~link_r,base_link~link_u"),

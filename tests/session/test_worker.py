@@ -9,7 +9,8 @@ import threading
 
 import pytest
 
-from c2rviz.session.worker import SWITCH_S, Superseded, Worker, WorkerBusy
+from c2rviz.session.lanes import Superseded, WorkerBusy
+from c2rviz.session.worker import SWITCH_S, Worker
 
 
 def run(coro):  # type: ignore[no-untyped-def]

@@ -8,7 +8,7 @@ from support import ServerLimits, ServerThread, load_robot
 
 from c2rviz import Client
 from c2rviz.testing import assert_goals_met, assert_part_at
-from c2rviz.world.clocks import VirtualClock
+from c2rviz.world.virtual_clock import VirtualClock
 
 
 @pytest.fixture

@@ -23,7 +23,7 @@ import pytest
 
 from c2rviz import Client, CommandError
 from c2rviz.testing import assert_arrives, assert_no_collision_during
-from c2rviz.world.clocks import VirtualClock
+from c2rviz.world.virtual_clock import VirtualClock
 
 HOME = (0.0,) * 7
 

@@ -22,7 +22,7 @@ from c2rviz.app.config import ServerLimits
 from c2rviz.errors import C2rvizError, LineTooLong
 from c2rviz.protocol import replies
 from c2rviz.protocol.grammar import ForeignProtocol, parse_line
-from c2rviz.protocol.verbs.queries import Bye, Quit, Sleep
+from c2rviz.protocol.verbs.seed import Bye, Quit, Sleep
 from c2rviz.session import Services, Session
 from c2rviz.world.world import World
 

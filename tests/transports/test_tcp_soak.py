@@ -16,7 +16,7 @@ import time
 
 from c2rviz.errors import LineTooLong
 from c2rviz.protocol import replies
-from c2rviz.world.effects import MAX_MARKERS
+from c2rviz.world.observer import MAX_MARKERS
 
 CLIENTS = 20
 LINES = 2000

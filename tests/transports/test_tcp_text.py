@@ -13,7 +13,7 @@ import pytest
 
 import c2rviz
 from c2rviz.protocol import replies
-from c2rviz.world.effects import MAX_MARKERS
+from c2rviz.world.observer import MAX_MARKERS
 
 MOTOMAN_LIMITS_DEG = [180.0, 109.4, 169.6, 129.5, 180.0, 109.4, 180.0]
 

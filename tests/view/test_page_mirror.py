@@ -14,9 +14,8 @@ import pinocchio as pin
 import pytest
 from support import load_robot
 
-from c2rviz.session.services import Services
+from c2rviz.session.services import Services, SessionDefaults
 from c2rviz.session.session import Session
-from c2rviz.session.settings import SessionDefaults
 from c2rviz.view import adapter
 from c2rviz.view.page_channel import FrameReader
 from c2rviz.view.page_link import IN_FLIGHT, PageLink

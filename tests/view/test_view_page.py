@@ -31,7 +31,7 @@ from c2rviz.view import adapter
 from c2rviz.view.panel import MAX_LABEL_CHARS, short_label
 from c2rviz.view.policy import DoorPolicy
 from c2rviz.view.viser_scene import ViserScene
-from c2rviz.world.effects import MAX_MARKERS
+from c2rviz.world.observer import MAX_MARKERS
 from c2rviz.world.world import World
 
 

@@ -19,7 +19,7 @@ from viewer_tabs import Harness, Tab
 
 from c2rviz.view import adapter
 from c2rviz.view.panel import NO_MARKER
-from c2rviz.world.effects import MAX_MARKERS, Marker
+from c2rviz.world.observer import MAX_MARKERS, Marker
 from c2rviz.world.world import World
 
 RED = (1.0, 0.0, 0.0)

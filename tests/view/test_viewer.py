@@ -30,7 +30,7 @@ from c2rviz.robot.visuals import load_link_geometry
 from c2rviz.session import Services
 from c2rviz.view import adapter
 from c2rviz.view.viser_scene import RECENT_COMMANDS, ViserScene
-from c2rviz.world.effects import Marker
+from c2rviz.world.observer import Marker
 from c2rviz.world.world import World
 
 

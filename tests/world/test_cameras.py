@@ -206,7 +206,7 @@ def test_registry_limit_and_unknown() -> None:
 def test_the_docs_limits_are_the_code() -> None:
     from support import ROOT
 
-    from c2rviz.protocol.verbs.cameras import MAX_CAMERA_RATE_HZ, MAX_SIGMA_M
+    from c2rviz.protocol.verbs.parts import MAX_CAMERA_RATE_HZ, MAX_SIGMA_M
     from c2rviz.world import cameras
 
     table = (ROOT / "docs" / "cameras.md").read_text().split("## Limits")[1]

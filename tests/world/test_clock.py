@@ -17,7 +17,7 @@ from c2rviz.app.config import load_settings
 from c2rviz.errors import ConfigError
 from c2rviz.session import ServerLimits
 from c2rviz.world.clock import NO_HOLD, Clock, ScaledClock
-from c2rviz.world.clocks import CLOCK_FORMS, VirtualClock, parse_clock
+from c2rviz.world.virtual_clock import CLOCK_FORMS, VirtualClock, parse_clock
 
 
 @pytest.mark.parametrize(

@@ -1,4 +1,4 @@
-"""``world/latency``: replies late on the world's clock (virtual here), ok and error alike,
+"""``world/clock``: replies late on the world's clock (virtual here), ok and error alike,
 and a door's unasked messages late in the order they were made."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ import asyncio
 import pytest
 
 from c2rviz.errors import C2rvizError
-from c2rviz.world.clocks import VirtualClock
-from c2rviz.world.latency import LateSends, late
+from c2rviz.world.clock import LateSends, late
+from c2rviz.world.virtual_clock import VirtualClock
 
 
 def test_sends_keep_their_order_whatever_the_delays_drew() -> None:

@@ -15,8 +15,7 @@ from c2rviz.collision.other_robots import placed_shapes
 from c2rviz.collision.part_geometry import drop, extent
 from c2rviz.collision.workcell import collision_geometry, make_object
 from c2rviz.robot.gripper import Gripper
-from c2rviz.world.goals import Goal, score
-from c2rviz.world.grasp import Jaws, opening_for, take
+from c2rviz.world.part_rules import Goal, Jaws, opening_for, score, take
 from c2rviz.world.parts import PartError, Parts, TooManyParts, UnknownPart
 from c2rviz.world.world import World
 

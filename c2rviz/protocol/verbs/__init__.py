@@ -5,29 +5,11 @@ Importing this package registers every verb in ``registry.VERBS``, in the order
 """
 
 # isort: off
-from . import joints, markers, queries  # the seed's verbs (queries: then sleep, bye, quit)
-from . import (
-    cartesian,
-    cell,
-    motion,
-    observe,
-    workcell,
-)  # observe: then record; workcell: then plan
-from . import parts  # grip first, then the part verbs
-from . import cameras
+from . import seed  # the joints, markers, questions, then sleep, bye, quit
+from . import arm  # the tool and Cartesian moves, the cell's robots, motion
+from . import scene  # watch, trail, ghost, record; the workcell and plan
+from . import parts  # grip first, then the part verbs, then cameras
 from . import faults
 # isort: on
 
-__all__ = [
-    "cameras",
-    "cartesian",
-    "cell",
-    "faults",
-    "joints",
-    "markers",
-    "motion",
-    "observe",
-    "parts",
-    "queries",
-    "workcell",
-]
+__all__ = ["arm", "faults", "parts", "scene", "seed"]

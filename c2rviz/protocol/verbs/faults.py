@@ -18,18 +18,6 @@ from ...errors import BadArguments, shown
 from ..grammar import numbers
 from ..registry import usage, verb
 
-__all__ = [
-    "FAULT_KINDS",
-    "FAULT_TIME_S",
-    "LATENCY_MS",
-    "NOISE_SIGMA",
-    "FaultKind",
-    "FaultSpec",
-    "Faults",
-    "FaultVerb",
-    "Reset",
-]
-
 FAULT_TIME_S = 1e6
 """``fault at T`` and ``fault after S``: T and S lie within 0..this [s of the world's clock]."""
 NOISE_SIGMA = 100.0

@@ -1,32 +1,21 @@
-"""What every verb does: ``@handler`` functions, grouped by what they act on. Each
-``protocol.verbs`` family's handlers live together in one module:
+"""What every verb does: ``@handler`` functions, one module per ``protocol.verbs`` module,
+of the same name and in the same order:
 
-========================  ==============================================================
-module                    verb families (``protocol.verbs``)
-========================  ==============================================================
-``arm``                   ``joints``, ``motion``: the arm moved by its joints
-``cartesian``             ``cartesian``: the tool, IK, moves to a tool pose
-``scene``                 ``markers``, ``workcell``, ``cell``: what the scene holds, and
-                          ``plan``: a path around it
-``parts``                 ``parts``: the gripper, parts, goals, the score; ``cameras``
-``faults``                ``faults``
-``queries``               ``queries``: questions, and ``sleep``, ``bye``, ``quit``
-``observe``               ``observe``: watch, trail, ghost, and record
-========================  ==============================================================
+============  ===================================================================
+module        verbs
+============  ===================================================================
+``seed``      the joints, the markers, the questions, ``sleep``, ``bye``, ``quit``
+``arm``       the tool, IK and Cartesian moves; the cell's robots; motion
+``scene``     ``watch``, ``trail``, ``ghost``, ``record``; the workcell; ``plan``
+``parts``     the gripper, parts, goals, the score; cameras
+``faults``    faults, ``reset``
+============  ===================================================================
 
 The import below is the whole list: importing this package registers every handler in
 ``registry.HANDLERS`` (the ``session`` package does, so a session can run every verb;
 ``tests/protocol/test_registry.py`` checks that every verb has exactly one).
 """
 
-from . import arm, cartesian, faults, observe, parts, queries, scene
+from . import arm, faults, parts, scene, seed
 
-__all__ = [
-    "arm",
-    "cartesian",
-    "faults",
-    "observe",
-    "parts",
-    "queries",
-    "scene",
-]
+__all__ = ["arm", "faults", "parts", "scene", "seed"]

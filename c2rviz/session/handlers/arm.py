@@ -1,64 +1,110 @@
-"""What the verbs that move the arm by its joints do: ``rand``, ``home``, ``joints``,
-``move`` and ``degrees``/``radians`` (``protocol.verbs.joints``); this connection's
-``motion`` mode and ``speed``, ``stop``, ``wait``, ``target``, ``status``
-(``protocol.verbs.motion``).
+"""What the arm's verbs do (``protocol.verbs.arm``): the tool, IK and moves to a tool pose
+(``tool``, ``ik``, ``moveto``, ``movel``, ``lspeed``); the cell's robots (``robot``,
+``robots``); this connection's ``motion`` mode and ``speed``, ``stop``, ``wait``,
+``target``, ``status``.
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ...errors import JointCountError, JointIndexError
+from ...errors import UnknownMarker
+from ...ik.target import PointTarget
+from ...ik.target import Target as ToolTarget  # (Target here is the `target` verb)
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
-from ...protocol.verbs.joints import Home, Joints, Move, Rand, Units
-from ...protocol.verbs.motion import MotionMode, Speed, Status, Stop, Target, Wait
-from ..guarded import guarded_rand
+from ...protocol.verbs.arm import (
+    Ik,
+    LinearSpeed,
+    MotionMode,
+    MoveL,
+    MoveTo,
+    PoseValues,
+    RobotChoice,
+    RobotsList,
+    Speed,
+    Status,
+    Stop,
+    Target,
+    Tool,
+    Wait,
+)
+from ...robot.frames import in_base, wxyz_se3
+from ..calls import plan_straight, play_straight, solve
+from ..guarded import unstopped
 
 if TYPE_CHECKING:
     from ..session import Session
 
 
-@handler(Rand)
-def rand(session: Session, command: Rand) -> Reply:
-    if session.guard:  # a configuration that collides with nothing, drawn off the loop
-        return guarded_rand(session)
-    return session.go(session.robot.random(session.services.rng))
-
-
-@handler(Home)
-def home(session: Session, command: Home) -> Reply:
-    return session.go(session.robot.home)
-
-
-@handler(Units)
-def units(session: Session, command: Units) -> str:
-    session.set_degrees(command.degrees)
+@handler(Tool)
+def tool(session: Session, command: Tool) -> str:
+    if command.pose is None:
+        return replies.ok(session.pose_text(session.state.tool))
+    session.world.set_tool(session.state.name, session.pose_se3(command.pose))
     return replies.OK
 
 
-@handler(Joints)
-def joints(session: Session, command: Joints) -> Reply:
-    values = command.values
-    n = session.n
-    if len(values) != n:
-        raise JointCountError(n, len(values))
-    table = session.table
-    # The hot path (a stream of `joints` lines): all within limits, checked in C.
-    within = table.within(values)
-    return session.go(table.to_si(values) if within else session.to_si(range(n), values))
+@handler(Ik)
+async def ik(session: Session, command: Ik) -> str:
+    target = _target(session, command.pose)
+    return replies.ok(replies.numbers(session.from_si(await solve(session, target))))
 
 
-@handler(Move)
-def move(session: Session, command: Move) -> Reply:
-    n = session.n
-    for index in command.indices:
-        if index >= n:
-            raise JointIndexError(index, session.state.name, n)
-    q = list(session.state.target)
-    for index, value in zip(command.indices, session.to_si(command.indices, command.values)):
-        q[index] = value
-    return session.go(q)
+@handler(MoveTo)
+async def moveto(session: Session, command: MoveTo) -> str:
+    if command.pose is None:
+        markers = session.state.markers
+        index = command.marker or 0
+        if not 0 < index <= len(markers):
+            raise UnknownMarker(index, len(markers))
+        marker = markers[index - 1]
+        target = in_base(session.state.base, wxyz_se3(marker.position, marker.wxyz))
+    else:
+        target = _target(session, command.pose)
+    q = await unstopped(session, solve(session, target))
+    return await _reply(session.go(q))
+
+
+@handler(MoveL)
+async def movel(session: Session, command: MoveL) -> str:
+    plan = await plan_straight(session, _target(session, command.pose))
+    return await _reply(play_straight(session, plan))
+
+
+@handler(LinearSpeed)
+def lspeed(session: Session, command: LinearSpeed) -> str:
+    if command.m_s is None:
+        return replies.ok(replies.numbers([session.lspeed]))
+    session.lspeed = command.m_s
+    return replies.OK
+
+
+def _target(session: Session, pose: PoseValues) -> ToolTarget:
+    """A pose as the connection wrote it; ``x,y,z`` alone is a point (any orientation)."""
+    return PointTarget.at(pose) if len(pose) == 3 else session.pose_se3(pose)
+
+
+async def _reply(reply: Reply) -> str:
+    return reply if isinstance(reply, str) else await reply
+
+
+@handler(RobotChoice)
+def robot(session: Session, command: RobotChoice) -> str:
+    if command.name is None:
+        return replies.ok(session.state.name)
+    session.select(command.name)
+    return replies.OK
+
+
+@handler(RobotsList)
+def robots(session: Session, command: RobotsList) -> str:
+    return replies.ok(
+        ",".join(
+            name if state.port is None else f"{name}:{state.port}"
+            for name, state in session.world.robots.items()
+        )
+    )
 
 
 @handler(MotionMode)

@@ -18,8 +18,6 @@ from ...world.faults import Fault, to_fault
 if TYPE_CHECKING:
     from ..session import Session
 
-__all__: list[str] = []
-
 
 def describe(session: Session, fault: Fault) -> str:
     """``fault`` as this session reads it (noise in its angle unit)."""

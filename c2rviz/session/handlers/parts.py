@@ -14,11 +14,18 @@ import numpy as np
 from ...errors import NoGripper
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
-from ...protocol.verbs.cameras import CameraEdit, CamerasQuery
-from ...protocol.verbs.parts import GoalEdit, Grip, PartEdit, PartsQuery, Score
-from ...world.camera_sight import seen_text, sight
+from ...protocol.verbs.parts import (
+    CameraEdit,
+    CamerasQuery,
+    GoalEdit,
+    Grip,
+    PartEdit,
+    PartsQuery,
+    Score,
+)
 from ...world.cameras import DEFAULT_FOV_RAD, DEFAULT_RANGE_M, Camera, CameraError
-from ...world.goals import DEFAULT_TOL_M, DEFAULT_TOL_RAD, Goal
+from ...world.part_rules import DEFAULT_TOL_M, DEFAULT_TOL_RAD, Goal
+from ...world.world import seen_text, sight
 
 if TYPE_CHECKING:
     import pinocchio as pin

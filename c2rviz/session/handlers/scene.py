@@ -1,9 +1,8 @@
-"""What the verbs that place things in this connection's scene do: the markers
-(``clear``, ``mark``, ``color``/``rgb``, ``marker``; ``protocol.verbs.markers``), the
-workcell's objects, collisions now and this connection's guard (``object``,
-``objects``, ``collisions``, ``guard``; ``protocol.verbs.workcell``), and the cell's
-robots (``robot``, ``robots``; ``protocol.verbs.cell``); and ``plan``: a path around
-the obstacles to joint values or a tool pose, and its settings.
+"""What the scene's verbs do (``protocol.verbs.scene``): ``watch``, ``unwatch``, ``trail``,
+``ghost`` and ``record`` (start, stop and ask about this connection's robot's
+recording); the workcell's objects, collisions now and this connection's guard
+(``object``, ``objects``, ``collisions``, ``guard``); and ``plan``: a path around the
+obstacles to joint values or a tool pose, and its settings.
 
 The search runs on the worker's plan lane (``guarded.checked_move`` with
 ``plan="always"``: the direct edge first, then RRT-Connect and shortening; ``stop``,
@@ -16,18 +15,29 @@ guard's watch re-checks it while it runs, whatever the connection's guard.
 
 from __future__ import annotations
 
+import asyncio
 from typing import TYPE_CHECKING
 
 from ...errors import BadArguments, JointCountError
 from ...ik.target import PointTarget, Target
+from ...observers.recorded import Recorded
 from ...planning import MAX_TIMEOUT_S, goal_candidates, time_path
 from ...planning.edge_resolution import RANGES
 from ...planning.errors import checked_setting
 from ...protocol import replies
 from ...protocol.registry import Reply, handler, usage
-from ...protocol.verbs.cell import RobotChoice, RobotsList
-from ...protocol.verbs.markers import Clear, Color, Mark, MarkerShape
-from ...protocol.verbs.workcell import Collisions, Guard, ObjectEdit, Objects, Plan
+from ...protocol.verbs.scene import (
+    Collisions,
+    Ghost,
+    Guard,
+    ObjectEdit,
+    Objects,
+    Plan,
+    Record,
+    Trail,
+    Unwatch,
+    Watch,
+)
 from ..guarded import checked_move, play_checked
 
 if TYPE_CHECKING:
@@ -35,31 +45,83 @@ if TYPE_CHECKING:
     from ..session import Session
 
 
-@handler(Clear)
-def clear(session: Session, command: Clear) -> Reply:
-    session.world.clear_markers(session.state.name)
-    return session.go(session.robot.home)
-
-
-@handler(Mark)
-def mark(session: Session, command: Mark) -> str:
-    pose = None if command.pose is None else session.pose_se3(command.pose)
-    session.world.add_marker(
-        pose, session.rgb, session.shape, session.state.name, in_world=command.in_world
-    )
+@handler(Watch)
+def watch(session: Session, command: Watch) -> str:
+    session.services.watch.watch(session, command.hz)
+    session.listens = True  # only listens from now on, until its next line
     return replies.OK
 
 
-@handler(Color)
-def color(session: Session, command: Color) -> str:
-    session.rgb = command.rgb
+@handler(Unwatch)
+def unwatch(session: Session, command: Unwatch) -> str:
+    session.services.watch.unwatch(session)
     return replies.OK
 
 
-@handler(MarkerShape)
-def marker_shape(session: Session, command: MarkerShape) -> str:
-    session.shape = command.shape
+@handler(Trail)
+def trail(session: Session, command: Trail) -> str:
+    keeper = session.services.trails
+    robot = session.state.name
+    if command.action is None:
+        on = robot in keeper.trails
+        return replies.ok(f"on {len(keeper.trails[robot])}" if on else "off")
+    if command.action == "on":
+        keeper.start(robot)
+    elif command.action == "off":
+        keeper.stop(robot)
+    else:
+        keeper.clear(robot)
     return replies.OK
+
+
+@handler(Ghost)
+def ghost(session: Session, command: Ghost) -> str:
+    state = session.state
+    if command.shown is None:
+        return replies.ok("on" if state.ghost else "off")
+    session.world.set_ghost(state.name, command.shown)
+    return replies.OK
+
+
+@handler(Record)
+def record(session: Session, command: Record) -> Reply:
+    desk = session.services.recordings
+    robot = session.state.name
+    if command.stop:
+        return _stopped(desk.stop(robot, f"stopped by {session.source}"))
+    if command.name is None:
+        running = desk.running.get(robot)
+        if running is None:
+            return replies.ok("not recording")
+        return replies.ok(f"recording {running.name} {desk.world.clock.now() - running.t0:.3f}")
+    recording = desk.start(command.name, robot, command.overwrite, command.every)
+    return replies.ok(f"recording {recording.name} into {desk.folder.resolve()}")
+
+
+async def _stopped(finished: asyncio.Future[list[Recorded]]) -> str:
+    done = await asyncio.shield(finished)  # a client gone meanwhile does not cut it short
+    failed = [r for r in done if r.error is not None]
+    if failed:
+        first = failed[0]
+        return replies.error(f"record: {first.name} stopped early ({first.error})")
+    return replies.ok(recorded_text(done))
+
+
+def recorded_text(done: list[Recorded]) -> str:
+    """``recorded NAME: N frames, S s (FILES)`` for a finished recording (one ``ROBOT N
+    frames`` per robot when it recorded several)."""
+    first = done[0]
+    bag = first.bag
+    name = bag.name if bag is not None else first.name
+    if len(done) == 1:
+        frames = f"{first.frames} frame{'s' * (first.frames != 1)}"
+    else:
+        frames = ", ".join(f"{r.name} {r.frames} frames" for r in done)
+    files = [p for r in done for p in (r.txt, r.csv, r.html) if p is not None]
+    if bag is not None:
+        files.append(bag)
+    seconds = max(r.duration_s for r in done)
+    return f"recorded {name}: {frames}, {seconds:.3f} s ({', '.join(str(p) for p in files)})"
 
 
 @handler(ObjectEdit)
@@ -101,24 +163,6 @@ def guard(session: Session, command: Guard) -> str:
     session.guard = command.on
     session.plan_around = command.plan
     return replies.OK
-
-
-@handler(RobotChoice)
-def robot(session: Session, command: RobotChoice) -> str:
-    if command.name is None:
-        return replies.ok(session.state.name)
-    session.select(command.name)
-    return replies.OK
-
-
-@handler(RobotsList)
-def robots(session: Session, command: RobotsList) -> str:
-    return replies.ok(
-        ",".join(
-            name if state.port is None else f"{name}:{state.port}"
-            for name, state in session.world.robots.items()
-        )
-    )
 
 
 MIN_TIMEOUT_S = 0.001  # [s] shortest search a connection may set

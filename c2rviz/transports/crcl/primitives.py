@@ -72,7 +72,7 @@ AXIS_COMPONENT_LIMIT: Final = 1e6
 """The largest magnitude of a direction's component (``XAxis``, ``ZAxis``)."""
 POSITION_LIMIT: Final = 1e6
 """The largest magnitude of a point's coordinate in any length unit: the text port's
-1000 m (``protocol.ranges.POSITION_M``) in millimeters, the finest CRCL length unit.
+1000 m (``protocol.grammar.POSITION_M``) in millimeters, the finest CRCL length unit.
 ``units.pose_to_matrix`` holds a point to 1000 m in the connection's own unit."""
 ORTHOGONALITY_TOLERANCE: Final = 1e-3
 

@@ -14,7 +14,7 @@ from typing import Final
 import numpy as np
 from numpy.typing import NDArray
 
-from ...protocol.ranges import POSITION_M
+from ...protocol.grammar import POSITION_M
 from ...session.units import DEGREE_RAD, FOOT_M, INCH_M, MILLIMETER_M, POUND_FORCE_N, joint_scale
 from .errors import CrclValueError
 from .primitives import Point, Pose, Vector
@@ -114,7 +114,7 @@ def pose_to_matrix(pose: Pose, length_unit: str = "meter") -> NDArray[np.float64
         length_unit: The unit its point is in.
 
     Raises:
-        CrclValueError: A coordinate farther than ``protocol.ranges.POSITION_M``
+        CrclValueError: A coordinate farther than ``protocol.grammar.POSITION_M``
             (1000 m) from the origin, as the text port refuses it.
     """
     factor = length_factor(length_unit)

@@ -23,10 +23,9 @@ import pinocchio as pin
 
 from ...observers.camera_feed import CAMERA_TOPIC, POSE_ARRAY, CameraFeed, camera_items, pose_array
 from ...ros.messages import Msg, tf_message, transforms
-from ...world.camera_sight import sight
 from ...world.cameras import Camera, Seen
-from ...world.effects import Observer
-from ...world.world import World
+from ...world.observer import Observer
+from ...world.world import World, sight
 from .topic_hub import TopicHub
 
 __all__ = ["CameraTopics"]

@@ -41,7 +41,7 @@ from ...observers.watch import WatchHub
 from ...ros.markers import marker_array
 from ...ros.messages import Msg, string, tf_message, transforms
 from ...world.clock import Timer
-from ...world.effects import MAX_MARKERS, Marker, Observer
+from ...world.observer import MAX_MARKERS, Marker, Observer
 from ...world.parts import Part
 from ...world.world import World
 from .diagnostics import DIAGNOSTICS_TOPIC, diagnostics

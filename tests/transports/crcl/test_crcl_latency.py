@@ -10,7 +10,7 @@ from crcl_support import DONE, CrclClient, CrclServerThread, command
 from support import Client, load_robot
 
 from c2rviz.session import ServerLimits
-from c2rviz.world.clocks import VirtualClock
+from c2rviz.world.virtual_clock import VirtualClock
 
 
 @pytest.fixture

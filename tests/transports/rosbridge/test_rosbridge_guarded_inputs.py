@@ -18,7 +18,7 @@ from websockets.sync.connection import Connection as ClientConnection
 from world_support import WAIT_S, WorldServer
 
 from c2rviz.errors import C2rvizError
-from c2rviz.world.effects import Observer
+from c2rviz.world.observer import Observer
 
 
 class Refusals(Observer):

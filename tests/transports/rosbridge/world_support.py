@@ -31,7 +31,7 @@ from c2rviz.session import Services
 from c2rviz.transports.rosbridge import COMMAND_SERVICE_TYPE
 from c2rviz.transports.tcp_server import CommandServer
 from c2rviz.world.clock import Clock
-from c2rviz.world.effects import Observer
+from c2rviz.world.observer import Observer
 from c2rviz.world.world import World
 
 WAIT_S = 20.0  # generous: the machine is shared; a passing test never waits this long

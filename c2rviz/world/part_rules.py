@@ -1,8 +1,9 @@
-"""The grasp rule: when closing fingers (or a suction cup) take a part. Pure, no state.
+"""The rules of parts, pure: the grasp rule (what closing fingers or a suction cup take) and
+goals (where parts should end, and a score). No state but the goals'.
 
-Parallel gripper. The *jaws* are the finger links' collision shapes: their centre is
-the midpoint of the first two fingers' shapes (the middle of each shape's bounding box)
-at the opening shown now, and the *closing axis* runs from one to the other (at the
+**The grasp rule.** Parallel gripper. The *jaws* are the finger links' collision shapes:
+their centre is the midpoint of the first two fingers' shapes (the middle of each shape's
+bounding box) at the opening shown now, and the *closing axis* runs from one to the other (at the
 gripper's full opening). The *gap* is the gripper's separation now (the one CRCL reports).
 Closing to opening S takes a part when all of these hold (of several, the one whose
 centre is nearest the closing line):
@@ -18,10 +19,18 @@ the part is moved along the axis to the jaws' centre (the closing fingers centre
 
 Vacuum gripper: the tool point is the cup; suction on takes the nearest part whose
 surface is within ``CUP_M`` of it.
+
+**Goals** (after the grasp rule). A goal names a part (``p1``) or a type (``type=gear``:
+any part of that type, each part counting for one goal at most) and a pose in the world
+frame, with a tolerance in position [m] and in angle [rad]. ``score`` pairs each goal
+with its part (a type goal: the nearest part of its type not taken by an earlier goal, in
+the order the goals were set) and says whether it is met and by how much it is off; a
+goal with no part is missing. A part that is held, or still falling, does not meet its goal.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -30,25 +39,10 @@ import numpy as np
 import pinocchio as pin
 
 from ..collision.part_geometry import contains, extent, signed_distance
+from ..errors import C2rvizError
 from ..robot.gripper import FINGER_WORD, Gripper
 from ..robot.model import Robot
-from .parts import Part
-
-__all__ = [
-    "SUCTION_BELOW",
-    "VACUUM_STROKE_S",
-    "is_vacuum",
-    "make_vacuum",
-    "CUP_M",
-    "GRIP_TOL_M",
-    "Jaws",
-    "at_cup",
-    "extent",
-    "finger_links",
-    "jaws",
-    "opening_for",
-    "take",
-]
+from .parts import Part, PartError, Parts
 
 GRIP_TOL_M = 0.002
 """How far a part may stand out of the gap between the fingers and still be taken [m]."""
@@ -208,3 +202,115 @@ def at_cup(cup: pin.SE3, parts: Sequence[Part]) -> Part | None:
         if distance <= CUP_M and (best is None or distance < best[0]):
             best = (distance, part)
     return None if best is None else best[1]
+
+
+DEFAULT_TOL_M = 0.005
+"""A goal's position tolerance when none is given [m]."""
+DEFAULT_TOL_RAD = math.radians(5.0)
+"""A goal's angle tolerance when none is given [rad]."""
+MAX_GOALS = 100
+"""Goals at once."""
+TYPE_PREFIX = "type="
+
+
+class TooManyGoals(C2rvizError):
+    def __init__(self, limit: int) -> None:
+        super().__init__(f"there are already {limit} goals, the limit; remove one first")
+
+
+@dataclass(frozen=True)
+class Goal:
+    """Where a part (``name``) or a part of a type (``type=T``) should end.
+
+    Attributes:
+        key: A part's name, or ``type=T``.
+        pose: The pose in the world frame.
+        tol_m: How far off its position may be [m].
+        tol_rad: How far off its orientation may be [rad].
+    """
+
+    key: str
+    pose: pin.SE3
+    tol_m: float = DEFAULT_TOL_M
+    tol_rad: float = DEFAULT_TOL_RAD
+
+    @property
+    def kind(self) -> str | None:
+        """The type it asks for, or None for a named part."""
+        return self.key[len(TYPE_PREFIX) :] if self.key.startswith(TYPE_PREFIX) else None
+
+
+@dataclass(frozen=True)
+class GoalResult:
+    """One goal scored: its part (None: missing), how far off [m, rad], and whether met."""
+
+    goal: Goal
+    part: str | None
+    off_m: float = math.inf
+    off_rad: float = math.inf
+    met: bool = False
+
+
+def off(pose: pin.SE3, goal: pin.SE3) -> tuple[float, float]:
+    """How far ``pose`` is from ``goal``: distance [m] and angle [rad]."""
+    distance = float(np.linalg.norm(pose.translation - goal.translation))
+    angle = float(np.linalg.norm(pin.log3(goal.rotation.T @ pose.rotation)))
+    return distance, angle
+
+
+def score(goals: Sequence[Goal], parts: Sequence[Part]) -> list[GoalResult]:
+    """Each goal with its part and how far off it is (see the module)."""
+    by_name = {part.name: part for part in parts}
+    named = {goal.key for goal in goals if goal.kind is None}
+    used: set[str] = set()
+    results = []
+    for goal in goals:
+        kind = goal.kind
+        if kind is None:
+            part = by_name.get(goal.key)
+        else:
+            candidates = [
+                p for p in parts if p.kind == kind and p.name not in used and p.name not in named
+            ]
+            part = min(candidates, key=lambda p: off(p.pose, goal.pose)[0], default=None)
+        if part is None:
+            results.append(GoalResult(goal, None))
+            continue
+        used.add(part.name)
+        distance, angle = off(part.pose, goal.pose)
+        met = (
+            distance <= goal.tol_m
+            and angle <= goal.tol_rad
+            and part.holder is None
+            and not part.falling
+        )
+        results.append(GoalResult(goal, part.name, distance, angle, met))
+    return results
+
+
+class GoalBook:
+    """The goals of a world, by key, in the order they were first set."""
+
+    def __init__(self, max_goals: int = MAX_GOALS) -> None:
+        self.max_goals = max_goals
+        self._goals: dict[str, Goal] = {}
+
+    def set(self, goal: Goal, parts: Parts) -> None:
+        """Add or replace ``goal``; one for a named part that is not in ``parts`` is refused
+        (``UnknownPart``; a type goal with no part of its type counts as missing)."""
+        if goal.kind is None:
+            parts.get(goal.key)
+        if goal.key not in self._goals and len(self._goals) >= self.max_goals:
+            raise TooManyGoals(self.max_goals)
+        self._goals[goal.key] = goal
+
+    def remove(self, key: str) -> None:
+        """Remove one goal (``all``: every one)."""
+        if key == "all":
+            self._goals.clear()
+        elif self._goals.pop(key, None) is None:
+            have = ", ".join(self._goals) or "none"
+            raise PartError(f"no goal for {key!r} (goals: {have})")
+
+    def all(self) -> list[Goal]:
+        return list(self._goals.values())

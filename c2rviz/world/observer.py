@@ -24,10 +24,8 @@ if TYPE_CHECKING:
     from ..collision.workcell import WorkcellObject
     from ..errors import C2rvizError
     from .cameras import Camera
-    from .goals import Goal
+    from .part_rules import Goal
     from .parts import Part
-
-__all__ = ["MAX_MARKERS", "Marker", "NullScene", "Observer", "RecordingScene", "Scene"]
 
 
 class Observer:

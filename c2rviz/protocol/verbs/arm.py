@@ -1,4 +1,5 @@
-"""Cartesian verbs: the tool point, inverse kinematics, and moves to a pose.
+"""The arm's verbs: the tool point and moves to a pose (Cartesian), which robot this
+connection drives, and how its moves travel; registered in that order.
 
 Poses are ``x,y,z,roll,pitch,yaw`` in the robot's base frame: metres, and
 angles in the connection's unit, as ``pose`` and ``mark`` use them. A target
@@ -8,14 +9,12 @@ there with any orientation (what an arm of fewer than six joints can reach).
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
-from ...errors import BadArguments
-from ..grammar import numbers, numbers_arg, one_word
-from ..ranges import LSPEED_M_S, TOOL_M, check_pose
+from ...errors import BadArguments, shown
+from ..grammar import LSPEED_M_S, TOOL_M, check_pose, numbers, numbers_arg, one_word
 from ..registry import usage, verb
-
-__all__ = ["Ik", "LinearSpeed", "MoveL", "MoveTo", "PoseValues", "Tool"]
 
 PoseValues = tuple[float, ...]
 """``x, y, z, roll, pitch, yaw`` (a target may be ``x, y, z`` alone: any orientation)."""
@@ -44,6 +43,7 @@ def _target(verb: str, words: list[str]) -> PoseValues:
     "[x,y,z,roll,pitch,yaw]",
     "the tool point (TCP) relative to the end-effector link, for this robot (every "
     "connection); alone, reply it; default the robot's ini `tool`, else none",
+    page="docs/cartesian.md",
 )
 @dataclass(frozen=True, slots=True)
 class Tool:
@@ -66,6 +66,7 @@ class Tool:
     "reply `ok v0,...,vn-1`: joint values within the limits that put the tool point at "
     "that pose (`x,y,z` alone: that point, any orientation), nearest the arm's "
     "configuration; nothing moves",
+    page="docs/cartesian.md",
 )
 @dataclass(frozen=True, slots=True)
 class Ik:
@@ -83,6 +84,7 @@ class Ik:
     "x,y,z[,roll,pitch,yaw] | marker N",
     "go to that tool pose (`x,y,z` alone: that point, any orientation; or marker N, 1 the "
     "oldest) through joint space, like `joints` with the IK solution",
+    page="docs/cartesian.md",
 )
 @dataclass(frozen=True, slots=True)
 class MoveTo:
@@ -106,6 +108,7 @@ class MoveTo:
     "the tool point travels a straight line to that pose (orientation by slerp; `x,y,z` "
     "alone: orientation free) at this connection's `lspeed`, slower where a joint cannot "
     "keep up; the whole line is checked first; with `motion off` only its end is shown",
+    page="docs/cartesian.md",
 )
 @dataclass(frozen=True, slots=True)
 class MoveL:
@@ -122,6 +125,7 @@ class MoveL:
     "lspeed",
     "[V]",
     "this connection's `movel` tool speed, m/s (0.001..5; default 0.25); alone, reply it",
+    page="docs/cartesian.md",
 )
 @dataclass(frozen=True, slots=True)
 class LinearSpeed:
@@ -138,3 +142,129 @@ class LinearSpeed:
         if not low <= value <= high:
             raise BadArguments(verb, f"{value:g} m/s is outside {low:g}..{high:g}", usage(verb))
         return LinearSpeed(value)
+
+
+_NAME = re.compile(r"[A-Za-z0-9_.-]+")
+
+
+@verb(
+    "robot",
+    "[NAME]",
+    "drive robot NAME of the cell from now on (units, speed and marker style stay); "
+    "alone, reply the robot this connection drives",
+    page="docs/cells.md",
+)
+@dataclass(frozen=True, slots=True)
+class RobotChoice:
+    """Switch this connection to robot ``name`` (None: ask which it drives)."""
+
+    name: str | None
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> RobotChoice:
+        if not words:
+            return RobotChoice(None)
+        name = one_word(verb, words)
+        if _NAME.fullmatch(name) is None:
+            raise BadArguments(verb, f"bad robot name {shown(name)}", usage(verb))
+        return RobotChoice(name)
+
+
+@verb(
+    "robots",
+    "",
+    "reply the cell's robots and their command ports: `ok left:31000,...`",
+    page="docs/cells.md",
+)
+@dataclass(frozen=True, slots=True)
+class RobotsList:
+    """Ask for the robots of the cell."""
+
+
+MOTION_MODES = ("off", "on", "follow")
+
+
+@verb(
+    "motion",
+    "[off|on|follow]",
+    "how this connection's moves are shown: `off` at once (the default, the seed's way); "
+    "`on` travel at the joints' limits, `ok` when the arm arrives; `follow` travel, `ok` "
+    "at once (streamed setpoints); alone, reply the mode",
+    page="docs/motion.md",
+)
+@dataclass(frozen=True, slots=True)
+class MotionMode:
+    """Set (or, with None, ask) this connection's motion mode, one of ``MOTION_MODES``."""
+
+    mode: str | None
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> MotionMode:
+        if not words:
+            return MotionMode(None)
+        mode = one_word(verb, words).lower()
+        if mode not in MOTION_MODES:
+            raise BadArguments(
+                verb, f"unknown mode {shown(mode)}; choose off, on or follow", usage(verb)
+            )
+        return MotionMode(mode)
+
+
+@verb(
+    "speed",
+    "[P]",
+    "this connection's moves at P % (1..100) of each joint's velocity limit (acceleration "
+    "and jerk scaled to match); alone, reply it",
+    page="docs/motion.md",
+)
+@dataclass(frozen=True, slots=True)
+class Speed:
+    """Set (or, with None, ask) this connection's speed [% of the limits]."""
+
+    percent: float | None
+
+    @staticmethod
+    def parse(verb: str, words: list[str]) -> Speed:
+        if not words:
+            return Speed(None)
+        (percent,) = numbers_arg(verb, words, 1)
+        if not 1.0 <= percent <= 100.0:
+            raise BadArguments(verb, f"{percent:g} is outside 1..100", usage(verb))
+        return Speed(percent)
+
+
+@verb(
+    "stop",
+    "",
+    "the arm decelerates to rest within its limits (any connection); a connection waiting "
+    "for an arrival gets `error: motion stopped by ...`; the reply comes at rest",
+    page="docs/motion.md",
+)
+@dataclass(frozen=True, slots=True)
+class Stop:
+    """Bring the arm to rest."""
+
+
+@verb("wait", "", "reply when the arm is at rest", page="docs/motion.md")
+@dataclass(frozen=True, slots=True)
+class Wait:
+    """Reply once the arm is at rest."""
+
+
+@verb(
+    "target",
+    "",
+    "reply the joint values the arm is moving to (or stands at)",
+    page="docs/motion.md",
+)
+@dataclass(frozen=True, slots=True)
+class Target:
+    """Ask for the joint values of the running move's end."""
+
+
+@verb(
+    "status", "", "reply `ok idle`, or `ok moving S` with the seconds left", page="docs/motion.md"
+)
+@dataclass(frozen=True, slots=True)
+class Status:
+    """Ask whether the arm moves, and how long it has to go."""

@@ -29,8 +29,6 @@ from typing import Any
 from ..errors import ConfigError
 from .clock import ACTING, Clock, Hold, ScaledClock, Timer
 
-__all__ = ["CLOCK_FORMS", "TimedFuture", "VirtualClock", "VirtualHold", "parse_clock"]
-
 
 class VirtualHold(Hold):
     """A hold that counts: held unless released, waiting on the clock, or closed."""
