@@ -17,9 +17,8 @@ from dataclasses import dataclass
 from typing import Final, cast
 
 from .binding import Nested, Record, many, one, opt, read_record, write_record
-from .documents import ROOT_ATTRIBUTES, XML_DECLARATION
+from .documents import ROOT_ATTRIBUTES, XML_DECLARATION, parse_xml
 from .errors import CrclValueError
-from .hardened import parse_xml
 from .primitives import (
     JointPositionsTolerances,
     ParameterSetting,
