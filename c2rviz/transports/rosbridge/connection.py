@@ -26,7 +26,7 @@ from ...errors import C2rvizError
 from ..parse_process import ParseProcess
 from . import messages, protocol, rosapi
 from .bridge import Bridge
-from .command_lines import CommandRefused
+from .inputs import CommandRefused
 from .outbox import Outbox
 from .policy import RosbridgePolicy
 from .protocol import LEVELS, SUPPORTED_OPS, FrameId, RosbridgeError, resolve_name
