@@ -41,8 +41,6 @@ from .tcp_reading import (
     waited_reply,
 )
 
-__all__ = ["Connection", "Host"]
-
 log = logging.getLogger("c2rviz.server")
 
 

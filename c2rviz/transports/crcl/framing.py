@@ -51,8 +51,6 @@ from .markup import (
 )
 from .markup import starts as _starts
 
-__all__ = ["CRCL_ROOTS", "DocumentSplitter"]
-
 CRCL_ROOTS: Final = ("CRCLCommandInstance", "CRCLProgram", "CRCLStatus")
 
 _LT, _SLASH, _BANG, _QUESTION = 0x3C, 0x2F, 0x21, 0x3F

@@ -50,16 +50,6 @@ from .documents import CommandInstance, parse_instance
 from .errors import CrclError, CrclFramingError
 from .framing import DocumentSplitter
 
-__all__ = [
-    "DEFAULT_PORT",
-    "PARSE_ON_LOOP_BYTES",
-    "READ_BYTES",
-    "REFUSALS_SUMMED_S",
-    "SPLIT_BYTES",
-    "CrclLimits",
-    "CrclServer",
-]
-
 log = logging.getLogger("c2rviz.crcl")
 
 DEFAULT_PORT: Final = 64444

@@ -51,23 +51,6 @@ from .scalars import (
 )
 from .setting_commands import ANGLE_UNITS, FORCE_UNITS, LENGTH_UNITS, TORQUE_UNITS
 
-__all__ = [
-    "COMMAND_STATES",
-    "CommandStatus",
-    "CrclStatus",
-    "GripperStatus",
-    "JointLimit",
-    "JointStatus",
-    "JointStatuses",
-    "ParallelGripperStatus",
-    "PoseStatus",
-    "SettingsStatus",
-    "ThreeFingerGripperStatus",
-    "VacuumGripperStatus",
-    "parse_status",
-    "write_status",
-]
-
 COMMAND_STATES: Final = ("CRCL_Done", "CRCL_Error", "CRCL_Working", "CRCL_Ready")
 """Done: the command completed; Error: it cannot (say why in ``description``);
 Working: it is executing; Ready: no command received yet."""

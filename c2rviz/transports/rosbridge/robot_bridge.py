@@ -55,8 +55,6 @@ from .topics import (
 )
 from .world_feed import TF_STATIC_TOPIC, TF_TOPIC, WorldFeed
 
-__all__ = ["DOOR", "RobotBridge"]
-
 DOOR = "rosbridge"
 """How the door counts its clients among the program's (``Services.count_clients``)."""
 

@@ -25,7 +25,7 @@ from typing import Any
 
 from ...errors import C2rvizError
 from .messages import TypeNameError, normalize_type
-from .protocol import resolve_name
+from .ops import resolve_name
 
 _SEPARATOR = "=" * 80
 _XYZ = "float64 x\nfloat64 y\nfloat64 z\n"

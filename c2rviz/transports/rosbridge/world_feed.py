@@ -47,8 +47,6 @@ from ...world.world import World
 from .bridge import TopicHub
 from .topics import DIAGNOSTICS_TOPIC, WORLD_FRAME, RobotTopics, diagnostics
 
-__all__ = ["FLUSH_SLACK", "WorldFeed"]
-
 FLUSH_SLACK = 0.9
 """A flush comes at once when the previous one is this many frames old (timer jitter)."""
 TF_TOPIC, TF_STATIC_TOPIC = "/tf", "/tf_static"
