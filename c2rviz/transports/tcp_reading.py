@@ -66,6 +66,8 @@ def close_lingering(transport: asyncio.Transport, eof: bool) -> asyncio.TimerHan
     return asyncio.get_running_loop().call_later(LINGER_S, transport.abort)
 
 
+# The text port's reading behind a reply that waits.
+
 log = logging.getLogger("c2rviz.server")
 
 LOOK_AHEAD_BYTES: Final = 16384

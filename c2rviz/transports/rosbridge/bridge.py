@@ -130,6 +130,8 @@ class Bridge(Protocol):
         ...
 
 
+# The TopicHub: who subscribes to what c2rviz publishes.
+
 log = logging.getLogger("c2rviz.rosbridge")
 
 Greeting = Callable[[], "dict[str, Any] | None"]

@@ -51,6 +51,8 @@ from ...session.session import Session
 from ...tolerance import within_limit
 from .messages import JointPositions, JointTrajectory
 
+# Text command lines.
+
 log = logging.getLogger("c2rviz.rosbridge")
 
 MAX_WAITING = 100
@@ -199,6 +201,8 @@ class CommandLines:
         for key in [k for k in self.queues if k[0] == source]:
             self.queues.pop(key).close()
 
+
+# Joint positions and trajectories.
 
 MAX_GUARD_SAMPLES = MAX_TRAJECTORY_CHECKS
 """Most instants of a trajectory checked for collisions (one per frame, or fewer)."""

@@ -27,6 +27,8 @@ from ...errors import C2rvizError
 from .messages import TypeNameError, normalize_type
 from .ops import resolve_name
 
+# The .msg texts.
+
 _SEPARATOR = "=" * 80
 _XYZ = "float64 x\nfloat64 y\nfloat64 z\n"
 _STAMP = "int32 sec\nuint32 nanosec\n"
@@ -137,6 +139,9 @@ def full_text(type_name: str) -> str:
                 seen.add(used)
                 stack.append(used)
     return text
+
+
+# The /rosapi/* services.
 
 
 class RosapiError(C2rvizError):

@@ -72,6 +72,8 @@ from ...world.world import World
 from .bridge import TopicHub
 from .messages import JOINT_TRAJECTORY, STRING
 
+# One robot's topics.
+
 TF_MESSAGE = "tf2_msgs/msg/TFMessage"
 MARKER_ARRAY = "visualization_msgs/msg/MarkerArray"
 WORLD_FRAME = "world"
@@ -235,6 +237,9 @@ class RobotTopics:
         return out
 
 
+# The cameras' topics.
+
+
 class CameraTopics(Observer):
     """Publishes every camera of the world (add it to the world's observers)."""
 
@@ -292,6 +297,8 @@ class CameraTopics(Observer):
             items = camera_items(self.parent, self.to_parent, camera, seen)
             self.hub.publish(self.tf_topic, tf_message(transforms(t, items)))
 
+
+# The robots' diagnostics.
 
 DIAGNOSTICS_TOPIC = "/diagnostics"
 DIAGNOSTIC_ARRAY = "diagnostic_msgs/msg/DiagnosticArray"
