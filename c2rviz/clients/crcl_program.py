@@ -27,10 +27,9 @@ from typing import TextIO
 from ..errors import C2rvizError
 from ..ini import find_ini, number, read_ini
 from ..transports.crcl.commands import Command
-from ..transports.crcl.documents import CommandInstance, write_instance
+from ..transports.crcl.documents import CommandInstance, parse_program, write_instance
 from ..transports.crcl.errors import CrclError
 from ..transports.crcl.framing import DocumentSplitter
-from ..transports.crcl.program import parse_program
 from ..transports.crcl.status import CrclStatus, parse_status
 from .connect import ServerUnavailable, dial
 from .options import default_address, find_script

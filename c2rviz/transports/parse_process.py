@@ -43,20 +43,6 @@ from typing import Any, BinaryIO, Final
 from ..errors import C2rvizError
 from ..session.plan_process import portable_error, rebuilt_error
 
-__all__ = [
-    "DEADLINE_S",
-    "LONG",
-    "NICE",
-    "START_S",
-    "SLICE_ITEMS",
-    "UNPACK_TURN_S",
-    "ParseProcess",
-    "ProcessLost",
-    "pack",
-    "serve",
-    "unpack",
-]
-
 log = logging.getLogger("c2rviz.parse")
 
 LONG: Final = 512

@@ -15,8 +15,6 @@ from ..protocol import replies
 from ..session.services import Services
 from .tcp_text import Connection
 
-__all__ = ["CommandServer"]
-
 log = logging.getLogger("c2rviz.server")
 
 

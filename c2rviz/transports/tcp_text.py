@@ -29,10 +29,16 @@ from ..protocol.framing import Line, LineFramer
 from ..protocol.grammar import ForeignProtocol
 from ..session.services import ServerLimits, Services
 from ..session.session import BATCHED, Session
-from .read_ahead import StopScan, is_command, is_stop, pace_reading, stop_plans, waited_reply
-from .tcp_rules import TURN_S, close_lingering
-
-__all__ = ["Connection", "Host"]
+from .tcp_reading import (
+    TURN_S,
+    StopScan,
+    close_lingering,
+    is_command,
+    is_stop,
+    pace_reading,
+    stop_plans,
+    waited_reply,
+)
 
 log = logging.getLogger("c2rviz.server")
 
@@ -57,7 +63,7 @@ class Connection(asyncio.Protocol):
 
     Lines run in order. A reply that waits (an awaitable from the handler, such as
     ``sleep``'s) holds the lines read behind it in ``backlog`` (and the framer) until it
-    comes, while other connections go on. Reading goes on behind it (``read_ahead``): a
+    comes, while other connections go on. Reading goes on behind it (``tcp_reading``): a
     ``stop`` read there cancels the connection's plans at once, and the end of the stream
     cancels them all (its client went away: the plan lane is free for the others).
     """
@@ -259,7 +265,7 @@ class Connection(asyncio.Protocol):
 
     def _look_ahead(self) -> None:
         """Behind a reply that waits: act on a ``stop`` read ahead, and stop reading once
-        ``read_ahead.LOOK_AHEAD_BYTES`` wait (the lines run in their turn)."""
+        ``tcp_reading.LOOK_AHEAD_BYTES`` wait (the lines run in their turn)."""
         if not self.halted and self.scan.stop_in(self.framer):
             self._stop_ahead()
         if self.transport is not None and not self.closing:
@@ -349,7 +355,7 @@ class Connection(asyncio.Protocol):
         self._close()
 
     def _close(self) -> None:
-        """Send what is queued, then close without a reset (``tcp_rules.close_lingering``:
+        """Send what is queued, then close without a reset (``tcp_reading.close_lingering``:
         what the client still sends is dropped, as ``closing`` is set)."""
         self.closing = True
         self.framer.clear()

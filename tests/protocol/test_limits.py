@@ -10,7 +10,7 @@ from support import ROOT
 from c2rviz.app import config
 from c2rviz.protocol.limits import DOORS, LIMITS, below_floor, bounds, rows
 from c2rviz.session.services import ServerLimits
-from c2rviz.transports.crcl.hardened import MAX_DOCUMENT_BYTES
+from c2rviz.transports.crcl.documents import MAX_DOCUMENT_BYTES
 from c2rviz.transports.crcl.server import CrclLimits
 from c2rviz.transports.rosbridge.policy import PolicyError, RosbridgePolicy
 from c2rviz.view.policy import DoorPolicy, DoorPolicyError

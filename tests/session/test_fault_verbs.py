@@ -15,7 +15,7 @@ from c2rviz.errors import MotionInterrupted
 from c2rviz.session import Session
 from c2rviz.session.services import Services
 from c2rviz.testing.server import TestServer
-from c2rviz.transports.rosbridge.joint_inputs import joint_trajectory
+from c2rviz.transports.rosbridge.inputs import joint_trajectory
 from c2rviz.transports.rosbridge.messages import JointTrajectory, TrajectoryPoint
 from c2rviz.world.world import World
 

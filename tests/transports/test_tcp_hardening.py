@@ -30,8 +30,7 @@ from c2rviz.protocol import replies
 from c2rviz.protocol.framing import BATCH_BYTES
 from c2rviz.protocol.grammar import _MAX_INDEX_DIGITS
 from c2rviz.transports import tcp_text as server_module
-from c2rviz.transports.read_ahead import LOOK_AHEAD_BYTES
-from c2rviz.transports.tcp_rules import LINGER_S, TURN_S
+from c2rviz.transports.tcp_reading import LINGER_S, LOOK_AHEAD_BYTES, TURN_S
 from c2rviz.transports.tcp_server import CommandServer
 from c2rviz.view.policy import DoorPolicy
 
@@ -541,9 +540,9 @@ def test_the_limits_table_matches_the_code():
         seen.add(field)
     assert seen == set(defaults)  # every limit is in the table
     assert f"| {BATCH_BYTES} | `protocol.framing.BATCH_BYTES` |" in text
-    assert f"| {LOOK_AHEAD_BYTES} | `transports.read_ahead.LOOK_AHEAD_BYTES` |" in text
-    assert f"| {TURN_S * 1000:g} ms | `transports.tcp_rules.TURN_S` |" in text
-    assert f"| {LINGER_S:g} s | `transports.tcp_rules.LINGER_S` |" in text
+    assert f"| {LOOK_AHEAD_BYTES} | `transports.tcp_reading.LOOK_AHEAD_BYTES` |" in text
+    assert f"| {TURN_S * 1000:g} ms | `transports.tcp_reading.TURN_S` |" in text
+    assert f"| {LINGER_S:g} s | `transports.tcp_reading.LINGER_S` |" in text
     assert f"| {_MAX_INDEX_DIGITS} | `protocol.grammar._MAX_INDEX_DIGITS` |" in text
     grace = inspect.signature(CommandServer.stop).parameters["grace_s"].default
     assert f"| {grace:g} s | `CommandServer.stop(grace_s)` |" in text

@@ -8,7 +8,7 @@ NIST's Canonical Robot Command Language sends XML documents over TCP with no fra
   lxml parser (no DOCTYPE, no entities, no network), or raises a ``CrclError`` that
   carries the ``command_id`` (when known) and a description for the status;
   ``write_command`` is its inverse;
-- ``program.parse_program`` reads a ``<CRCLProgram>`` file into its list of commands;
+- ``documents.parse_program`` reads a ``<CRCLProgram>`` file into its list of commands;
 - ``status.write_status`` writes a ``<CRCLStatus>`` valid against CRCLStatus.xsd;
 - ``units`` converts CRCL units to SI and poses to matrices.
 
@@ -20,38 +20,51 @@ from __future__ import annotations
 
 from .binding import RecordField, record_fields
 from .commands import (
+    STOP_CONDITIONS,
+    ActuateJoint,
+    ActuateJoints,
+    CloseToolChanger,
     Command,
     ConfigureJointReport,
     ConfigureJointReports,
     ConfigureStatusReport,
+    DisableGripper,
+    DisableRobotParameterStatus,
+    DisableSensor,
+    Dwell,
+    EnableGripper,
+    EnableRobotParameterStatus,
+    EnableSensor,
     EndCanon,
     GetStatus,
     InitCanon,
+    JointForceTorque,
+    JointSpeedAccel,
     LoopBlockEnd,
     LoopBlockStart,
     Message,
     MiddleCommand,
-    RunProgram,
-)
-from .device_commands import (
-    CloseToolChanger,
-    DisableGripper,
-    DisableRobotParameterStatus,
-    DisableSensor,
-    EnableGripper,
-    EnableRobotParameterStatus,
-    EnableSensor,
+    MoveScrew,
+    MoveThroughTo,
+    MoveTo,
     OpenToolChanger,
+    RunProgram,
     SetEndEffector,
+    StopMotion,
 )
 from .documents import (
     COMMAND_TYPES,
+    MAX_DOCUMENT_BYTES,
+    MAX_PROGRAM_BYTES,
     MIDDLE_COMMAND_TYPES,
     CommandInstance,
+    Program,
     parse_command,
     parse_instance,
+    parse_program,
     write_command,
     write_instance,
+    write_program,
 )
 from .errors import (
     CrclError,
@@ -63,21 +76,6 @@ from .errors import (
 from .framing import (
     CRCL_ROOTS,
     DocumentSplitter,
-)
-from .hardened import (
-    MAX_DOCUMENT_BYTES,
-)
-from .motion_commands import (
-    STOP_CONDITIONS,
-    ActuateJoint,
-    ActuateJoints,
-    Dwell,
-    JointForceTorque,
-    JointSpeedAccel,
-    MoveScrew,
-    MoveThroughTo,
-    MoveTo,
-    StopMotion,
 )
 from .primitives import (
     MIN_AXIS_NORM,
@@ -101,12 +99,6 @@ from .primitives import (
     Twist,
     Vector,
     Wrench,
-)
-from .program import (
-    MAX_PROGRAM_BYTES,
-    Program,
-    parse_program,
-    write_program,
 )
 from .scalars import xml_safe_text
 from .setting_commands import (

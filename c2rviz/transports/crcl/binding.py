@@ -25,22 +25,6 @@ from lxml import etree
 from .errors import CrclError, CrclValueError, UnknownCrclType
 from .scalars import COMMAND_ID, Scalar
 
-__all__ = [
-    "MANY",
-    "ONE",
-    "OPTIONAL",
-    "XSI_NAMESPACE",
-    "Nested",
-    "RecordField",
-    "Record",
-    "many",
-    "one",
-    "opt",
-    "read_record",
-    "record_fields",
-    "write_record",
-]
-
 XSI_NAMESPACE: Final = "http://www.w3.org/2001/XMLSchema-instance"
 _XSI_TYPE: Final = "{" + XSI_NAMESPACE + "}type"
 _KEY: Final = "crcl"

@@ -1,36 +1,8 @@
-"""One CRCL connection as a controller sees it: canon state, command states, statuses.
+"""What a CRCL ``Controller`` keeps of each command: its report, its job, the lanes.
 
-A ``Controller`` takes the connection's documents in order (``receive``) and runs
-each command through the connection's ``Session`` (``actions`` says what each type
-does; motions are ``motions``' jobs). The rules:
-
-- **Canon**: before ``InitCanon`` and after ``EndCanon`` every command but InitCanon
-  and GetStatus is ``CRCL_Error``.
-- **States**: a command is ``CRCL_Working`` while it runs and then ``CRCL_Done``, or
-  ``CRCL_Error`` with a ``StateDescription`` naming it (``MoveToType (CommandID 3): ...``)
-  and why; before any command the status is ``CRCL_Ready`` (CommandID 0). A document
-  whose own CommandID cannot be read is reported under CommandID 0.
-- **Reporting**: every change of a command's state is pushed at once as a compact
-  status (``CommandStatus`` and ``PoseStatus``, and ``JointStatuses`` once
-  ``ConfigureJointReports`` asked for them); ``GetStatus`` answers a full one about
-  the latest command received (GetStatus aside). ``StatusID`` increases with every
-  status of the connection.
-- **Takeover**: the arm, the gripper and Dwell each run one command at a time. A new
-  one of the same kind takes over the one Working: a move blends from the arm's
-  motion (or, for a straight line, brakes to rest first) and ``StopMotion`` brakes;
-  the old command is then reported ``CRCL_Done`` "taken over by ..." (if it had not
-  started moving: once its planning ends, so a move that cannot be planned is
-  ``CRCL_Error`` saying why; else when the new motion starts: a refused new command
-  leaves the old one running and reported as usual). A move stopped or preempted by
-  another door (its ``stop``, the page) is ``CRCL_Error`` naming who.
-- **The world** hears of every command through the session (``Session.said``): taken
-  or refused, and how it ended (``ok`` and its StateDescription, or the error).
-- **Faults**: while a stop holds the robot (``fault estop``, ``fault protective``,
-  docs/faults.md) every status is ``CRCL_Error`` with the stop as its description; a
-  ``fault latency`` sends every status that much late, in order.
-
-Values in and out are in the connection's units; the session sees SI, its angles in
-the connection's angle unit (so its limit errors speak it).
+A ``Report`` is a command as its statuses tell it (CommandID, name, state, why). A
+``Job`` is a command that takes time, running in a lane (``ARM``, ``GRIPPER``,
+``DWELL``: each runs one command of a connection at a time).
 """
 
 from __future__ import annotations
@@ -38,48 +10,67 @@ from __future__ import annotations
 import asyncio
 import logging
 from collections.abc import Awaitable, Callable
+from dataclasses import dataclass
 from typing import Any, Final
 
 from ...errors import C2rvizError, MotionInterrupted
 from ...protocol import replies
 from ...protocol.registry import Reply
+from ...session.notes import Said
 from ...session.session import Session
 from .commands import GetStatus, InitCanon
 from .documents import CommandInstance, parse_instance
 from .errors import CrclError
-from .jobs import (
-    ARM,
-    DONE,
-    DWELL,
-    ERROR,
-    GRIPPER,
-    READY,
-    WORKING,
-    Job,
-    Refused,
-    Report,
-    TakenOver,
-)
 from .reports import ConnectionSettings, StatusParts
 from .scalars import xml_safe_text
 from .status import CommandStatus, CrclStatus
 
-__all__ = [
-    "ARM",
-    "DONE",
-    "DWELL",
-    "ERROR",
-    "GRIPPER",
-    "READY",
-    "WORKING",
-    "Controller",
-    "Action",
-    "Job",
-    "Refused",
-    "Report",
-    "TakenOver",
-    "registrar",
-]  # the lanes, states and records are ``jobs``'; here for the actions and motions
+DONE, ERROR, WORKING, READY = "CRCL_Done", "CRCL_Error", "CRCL_Working", "CRCL_Ready"
+ARM, GRIPPER, DWELL = "arm", "gripper", "dwell"
+"""The lanes: each runs one command at a time; a new one takes over."""
+
+
+class Refused(C2rvizError):
+    """A command c2rviz will not carry out; the message says why."""
+
+
+class TakenOver(Exception):
+    """A job taken over before its motion began: it starts none (``Controller.moving``)."""
+
+
+@dataclass(eq=False)
+class Report:
+    """A command as its statuses report it."""
+
+    command_id: int
+    what: str
+    """``MoveToType (CommandID 3)``, as the codec's errors name a command."""
+    state: str = WORKING
+    description: str | None = None
+    program_file: str | None = None
+    program_index: int | None = None
+    program_length: int | None = None
+    said: Said | None = None
+    """How the world is told of it (``Session.said``), once it is a command."""
+
+
+@dataclass(eq=False)
+class Job:
+    """A command running in a lane: its task, whether its motion began, who took over."""
+
+    report: Report
+    lane: str
+    task: asyncio.Task[None] | None = None
+    moving: bool = False
+    successor: Report | None = None
+    under_way: Job | None = None
+    """This connection's job of the lane still moving when this one started (its motion
+    is this one's to brake or blend from), until this one moves."""
+
+    @property
+    def over(self) -> bool:
+        return self.report.state != WORKING
+
 
 log = logging.getLogger("c2rviz.crcl")
 

@@ -11,14 +11,6 @@ from collections.abc import Sequence
 
 from c2rviz.errors import C2rvizError, shown
 
-__all__ = [
-    "CrclError",
-    "CrclFramingError",
-    "CrclSyntaxError",
-    "CrclValueError",
-    "UnknownCrclType",
-]
-
 
 class CrclError(C2rvizError):
     """A CRCL byte stream, document or value that c2rviz refuses.

@@ -35,8 +35,8 @@ import operator
 from itertools import accumulate, islice
 from typing import Final
 
+from .documents import MAX_DOCUMENT_BYTES
 from .errors import CrclFramingError
-from .hardened import MAX_DOCUMENT_BYTES
 from .markup import (
     BOM,
     CONTROL,
@@ -50,8 +50,6 @@ from .markup import (
     shown_at,
 )
 from .markup import starts as _starts
-
-__all__ = ["CRCL_ROOTS", "DocumentSplitter"]
 
 CRCL_ROOTS: Final = ("CRCLCommandInstance", "CRCLProgram", "CRCLStatus")
 

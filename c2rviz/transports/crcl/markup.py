@@ -12,22 +12,6 @@ from typing import Final
 
 from c2rviz.errors import shown
 
-__all__ = [
-    "BOM",
-    "CONTROL",
-    "MAX_NAME",
-    "NAME",
-    "NOT_SPACE",
-    "SPACE",
-    "TAG_STOP",
-    "PLAIN_TAG",
-    "TOKEN",
-    "declaration_at",
-    "root_at",
-    "shown_at",
-    "starts",
-]
-
 NOT_SPACE: Final = re.compile(rb"[^ \t\r\n]")
 CONTROL: Final = re.compile(rb"[\x00-\x08\x0b\x0c\x0e-\x1f]")
 """Bytes XML 1.0 never allows (C0 controls but tab, LF, CR): binary data."""

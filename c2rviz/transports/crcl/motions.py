@@ -32,16 +32,6 @@ from .controller import Controller, Job, Refused
 from .primitives import Pose
 from .units import pose_to_matrix
 
-__all__ = [
-    "actuate",
-    "dwell",
-    "grip",
-    "halt",
-    "move_through",
-    "move_to",
-    "placement",
-]
-
 
 def placement(pose: Pose, length_unit: str) -> pin.SE3:
     """A CRCL pose (in ``length_unit``) as a placement in the base frame [m]."""

@@ -36,37 +36,6 @@ from .scalars import (
     enumeration,
 )
 
-__all__ = [
-    "AXIS_COMPONENT_LIMIT",
-    "POSITION_LIMIT",
-    "MIN_AXIS_NORM",
-    "ORTHOGONALITY_TOLERANCE",
-    "POSE",
-    "ROT_ACCEL",
-    "ROT_SPEED",
-    "TRANS_ACCEL",
-    "TRANS_SPEED",
-    "Guard",
-    "JointPositionTolerance",
-    "JointPositionsTolerances",
-    "ParameterSetting",
-    "Point",
-    "Pose",
-    "PoseAndSet",
-    "PoseTolerance",
-    "RotAccelAbsolute",
-    "RotAccelRelative",
-    "RotSpeedAbsolute",
-    "RotSpeedRelative",
-    "TransAccelAbsolute",
-    "TransAccelRelative",
-    "TransSpeedAbsolute",
-    "TransSpeedRelative",
-    "Twist",
-    "Vector",
-    "Wrench",
-]
-
 MIN_AXIS_NORM: Final = 1e-6
 AXIS_COMPONENT_LIMIT: Final = 1e6
 """The largest magnitude of a direction's component (``XAxis``, ``ZAxis``)."""

@@ -47,16 +47,6 @@ from .units import angle_factor, joint_factors, length_factor, matrix_to_pose
 
 _STATUS_PARTS = record_fields(CrclStatus)  # the status's elements, in the schema's order
 
-__all__ = [
-    "ConnectionSettings",
-    "StatusParts",
-    "tidy",
-    "gripper_status",
-    "joint_statuses",
-    "pose_status",
-    "settings_status",
-]
-
 T = TypeVar("T")
 _VELOCITY_DT_S = 1e-3  # a path's joint velocity: its positions this far apart [s]
 

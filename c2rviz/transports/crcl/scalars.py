@@ -20,25 +20,6 @@ from c2rviz.errors import shown
 
 from .errors import CrclValueError
 
-__all__ = [
-    "BOOLEAN",
-    "COMMAND_ID",
-    "COUNT",
-    "DOUBLE",
-    "FRACTION",
-    "INT",
-    "JOINT_NUMBER",
-    "LONG",
-    "NMTOKEN",
-    "NON_NEGATIVE",
-    "POSITIVE",
-    "STRING",
-    "TOKEN",
-    "Scalar",
-    "enumeration",
-    "xml_safe_text",
-]
-
 _DOUBLE = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _SPECIAL = {"NaN", "INF", "+INF", "-INF", "nan", "inf", "-inf", "+inf", "infinity"}
 _INTEGER = re.compile(r"[+-]?[0-9]{1,30}")

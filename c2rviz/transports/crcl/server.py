@@ -18,11 +18,11 @@ status whose ``StateDescription`` says what was wrong):
 - what the stream cannot be re-synchronised after (a document over
   ``max_document_bytes``, binary bytes, a ``<!DOCTYPE`` or other markup declaration):
   that error, then the documented close (the server ends its side, reads and drops
-  what the client still sends for up to ``tcp_rules.LINGER_S``, then closes);
+  what the client still sends for up to ``tcp_reading.LINGER_S``, then closes);
 - one connection over ``max_connections``: an error status, then the close;
 - statuses left unread past ``max_unread``: the connection is reset.
 
-A long run of documents in one read is worked through ``tcp_rules.TURN_S`` at a time, so one
+A long run of documents in one read is worked through ``tcp_reading.TURN_S`` at a time, so one
 client's flood delays the others by no more than that; a document too large to parse
 in that time (over ``PARSE_ON_LOOP_BYTES``) is parsed in the door's parsing process
 (``parse_process``: it holds no lock of the server's; it starts with the first such
@@ -43,22 +43,12 @@ from ...protocol.limits import default, default_s
 from ...session.services import Services
 from ...session.session import Session
 from ..parse_process import ParseProcess, ProcessLost
-from ..tcp_rules import TURN_S, close_lingering
+from ..tcp_reading import TURN_S, close_lingering
 from .actions import ACTIONS
 from .controller import Controller
 from .documents import CommandInstance, parse_instance
 from .errors import CrclError, CrclFramingError
 from .framing import DocumentSplitter
-
-__all__ = [
-    "DEFAULT_PORT",
-    "PARSE_ON_LOOP_BYTES",
-    "READ_BYTES",
-    "REFUSALS_SUMMED_S",
-    "SPLIT_BYTES",
-    "CrclLimits",
-    "CrclServer",
-]
 
 log = logging.getLogger("c2rviz.crcl")
 
@@ -375,7 +365,7 @@ class _Connection:
         self.writer.transport.abort()  # the reads end (EOF): run and close return
 
     async def close(self) -> None:
-        """The documented close (``tcp_rules.close_lingering``): statuses out, our side
+        """The documented close (``tcp_reading.close_lingering``): statuses out, our side
         ended, the client's rest read and dropped until it closes or the linger ends (a
         reset would lose the last status), then closed."""
         self.controller.close()

@@ -29,27 +29,6 @@ from .primitives import (
 )
 from .scalars import BOOLEAN, enumeration
 
-__all__ = [
-    "ANGLE_UNITS",
-    "FORCE_UNITS",
-    "LENGTH_UNITS",
-    "TORQUE_UNITS",
-    "SetAngleUnits",
-    "SetDefaultJointPositionsTolerances",
-    "SetEndEffectorParameters",
-    "SetEndPoseTolerance",
-    "SetForceUnits",
-    "SetIntermediatePoseTolerance",
-    "SetLengthUnits",
-    "SetMotionCoordination",
-    "SetRobotParameters",
-    "SetRotAccel",
-    "SetRotSpeed",
-    "SetTorqueUnits",
-    "SetTransAccel",
-    "SetTransSpeed",
-]
-
 LENGTH_UNITS = ("meter", "millimeter", "inch")
 ANGLE_UNITS = ("degree", "radian")
 FORCE_UNITS = ("newton", "pound", "ounce")

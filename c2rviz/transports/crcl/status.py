@@ -17,9 +17,8 @@ from dataclasses import dataclass
 from typing import Final, cast
 
 from .binding import Nested, Record, many, one, opt, read_record, write_record
-from .documents import ROOT_ATTRIBUTES, XML_DECLARATION
+from .documents import ROOT_ATTRIBUTES, XML_DECLARATION, parse_xml
 from .errors import CrclValueError
-from .hardened import parse_xml
 from .primitives import (
     JointPositionsTolerances,
     ParameterSetting,
@@ -51,23 +50,6 @@ from .scalars import (
     enumeration,
 )
 from .setting_commands import ANGLE_UNITS, FORCE_UNITS, LENGTH_UNITS, TORQUE_UNITS
-
-__all__ = [
-    "COMMAND_STATES",
-    "CommandStatus",
-    "CrclStatus",
-    "GripperStatus",
-    "JointLimit",
-    "JointStatus",
-    "JointStatuses",
-    "ParallelGripperStatus",
-    "PoseStatus",
-    "SettingsStatus",
-    "ThreeFingerGripperStatus",
-    "VacuumGripperStatus",
-    "parse_status",
-    "write_status",
-]
 
 COMMAND_STATES: Final = ("CRCL_Done", "CRCL_Error", "CRCL_Working", "CRCL_Ready")
 """Done: the command completed; Error: it cannot (say why in ``description``);

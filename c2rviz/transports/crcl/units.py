@@ -19,21 +19,6 @@ from ...session.units import DEGREE_RAD, FOOT_M, INCH_M, MILLIMETER_M, POUND_FOR
 from .errors import CrclValueError
 from .primitives import Point, Pose, Vector
 
-__all__ = [
-    "ANGLE_FACTORS",
-    "FORCE_FACTORS",
-    "LENGTH_FACTORS",
-    "TORQUE_FACTORS",
-    "angle_factor",
-    "force_factor",
-    "joint_factors",
-    "length_factor",
-    "matrix_to_pose",
-    "pose_rotation",
-    "pose_to_matrix",
-    "torque_factor",
-]
-
 LENGTH_FACTORS: Final[Mapping[str, float]] = {
     "meter": 1.0,
     "millimeter": MILLIMETER_M,

@@ -1,17 +1,17 @@
 """rosbridge v2: ROS web tools and scripts (roslibpy, roslibjs) talk to c2rviz.
 
-``protocol`` reads and writes the JSON frames, ``messages`` checks the ROS 2
-messages c2rviz takes, ``rosapi`` answers the discovery services,
-``msg_definitions`` holds the ``.msg`` texts, all pure; ``server`` is the
-asyncio websocket server (``policy`` its guard, ``outbox`` its per-subscriber
-queues, ``connection`` one client), and ``bridge`` the protocol the rest of
-c2rviz implements for it.
+``protocol`` reads and writes the JSON frames (``ops`` the requests), ``messages``
+checks the ROS 2 messages c2rviz takes, ``rosapi`` answers the discovery services and
+holds the ``.msg`` texts, all pure; ``server`` is the asyncio websocket server
+(``policy`` its guard, ``outbox`` its per-subscriber queues, ``connection`` one client),
+and ``bridge`` the protocol the rest of c2rviz implements for it (and the
+``TopicHub`` of its subscribers).
 
-``robot_bridge.RobotBridge`` is that ``Bridge`` for the world: ``robot_topics``
-names each robot's topics and frames and builds its messages (``c2rviz.ros``'s
-shapes), ``world_feed`` publishes the world's effects at the frame rate through
-``topic_hub``, ``command_lines`` runs each client's text lines through its
-``Session``, and ``joint_inputs`` takes joint commands and trajectories.
+``robot_bridge.RobotBridge`` is that ``Bridge`` for the world: ``topics`` names each
+robot's topics and frames and builds its messages (``c2rviz.ros``'s shapes), the
+cameras' and the diagnostics; ``world_feed`` publishes the world's effects at the frame
+rate through the ``TopicHub``; ``inputs`` runs each client's text lines through its
+``Session`` and takes joint commands and trajectories.
 """
 
 from .bridge import Bridge, Deliver

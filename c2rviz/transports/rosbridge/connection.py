@@ -26,12 +26,11 @@ from ...errors import C2rvizError
 from ..parse_process import ParseProcess
 from . import messages, protocol, rosapi
 from .bridge import Bridge
-from .command_lines import CommandRefused
+from .inputs import CommandRefused
+from .ops import FrameId, op_name, resolve_name
 from .outbox import Outbox
 from .policy import RosbridgePolicy
-from .protocol import LEVELS, SUPPORTED_OPS, FrameId, RosbridgeError, resolve_name
-
-__all__ = ["DECODE_ON_LOOP_BYTES", "Connection", "Host"]
+from .protocol import LEVELS, SUPPORTED_OPS, RosbridgeError
 
 log = logging.getLogger("c2rviz.rosbridge")
 
@@ -319,7 +318,7 @@ class Connection:
                 self.reply_error(text, getattr(op, "topic", None))
         else:
             id = op.id if op is not None else None
-            what = protocol.op_name(op) if op is not None else "request"
+            what = op_name(op) if op is not None else "request"
             target = getattr(op, "topic", None) or getattr(op, "service", None)
             text = f"{what} {target}: {error}" if target else f"{what}: {error}"
             if not isinstance(error, CommandRefused):  # its reply is on the topic already

@@ -22,28 +22,6 @@ from typing import Any
 
 from ...errors import C2rvizError
 
-__all__ = [
-    "COMMAND_SERVICE_TYPE",
-    "JOINT_STATE",
-    "JOINT_TRAJECTORY",
-    "STRING",
-    "JointPositions",
-    "JointTrajectory",
-    "MessageError",
-    "TrajectoryPoint",
-    "TypeNameError",
-    "command_request",
-    "command_response",
-    "forget",
-    "joint_positions",
-    "joint_trajectory",
-    "normalize_type",
-    "read_ahead",
-    "remember",
-    "same_type",
-    "string_data",
-]
-
 STRING = "std_msgs/msg/String"
 JOINT_STATE = "sensor_msgs/msg/JointState"
 JOINT_TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"

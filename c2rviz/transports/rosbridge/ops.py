@@ -10,21 +10,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any, TypeAlias
 
-__all__ = [
-    "Advertise",
-    "CallService",
-    "FrameId",
-    "Op",
-    "Publish",
-    "SetLevel",
-    "Subscribe",
-    "Unadvertise",
-    "Unsubscribe",
-    "Unsupported",
-    "op_name",
-    "resolve_name",
-]
-
 FrameId: TypeAlias = "str | int | None"
 """A request's ``id``: a string or an integer, echoed in the answers to it."""
 

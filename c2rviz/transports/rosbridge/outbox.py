@@ -35,9 +35,7 @@ from typing import Any
 
 from websockets.exceptions import ConnectionClosed
 
-from .protocol import FrameId
-
-__all__ = ["Outbox"]
+from .ops import FrameId
 
 log = logging.getLogger("c2rviz.rosbridge")
 

@@ -19,8 +19,6 @@ from ...errors import C2rvizError
 from ...origins import LOOPBACK_HOSTS, normalize_origin, token_ok
 from ...protocol.limits import below_floor, default
 
-__all__ = ["LOOPBACK_HOSTS", "PolicyError", "RosbridgePolicy", "normalize_origin"]
-
 
 class PolicyError(C2rvizError):
     """A rosbridge setting that cannot work (an origin that is not one, a limit below 1)."""

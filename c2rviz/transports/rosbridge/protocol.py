@@ -35,33 +35,7 @@ from .ops import (
     Unadvertise,
     Unsubscribe,
     Unsupported,
-    op_name,
-    resolve_name,
 )
-
-__all__ = [
-    "COMPRESSIONS",
-    "LEVELS",
-    "SUPPORTED_OPS",
-    "UNSUPPORTED_OPS",
-    "Advertise",
-    "CallService",
-    "FrameId",
-    "Op",
-    "Publish",
-    "RosbridgeError",
-    "SetLevel",
-    "Subscribe",
-    "Unadvertise",
-    "Unsubscribe",
-    "Unsupported",
-    "op_name",
-    "parse_frame",
-    "publish",
-    "resolve_name",
-    "service_response",
-    "status",
-]
 
 LEVELS = ("none", "error", "warning", "info")
 """Status levels, least verbose first; a client sees statuses up to its level."""

@@ -1,7 +1,7 @@
 """c2rviz's world behind the rosbridge server: the ``Bridge`` the door hands it.
 
 What it publishes, per robot (``[NS]`` is the robot's namespace in a cell,
-nothing for a robot alone; ``robot_topics``):
+nothing for a robot alone; ``topics``):
 
 =================================  ===================================  ===============
 topic                              type                                 when
@@ -21,9 +21,9 @@ What it takes: ``[NS]/c2rviz/command`` (``std_msgs/msg/String``, one line of
 the text language; its reply on ``[NS]/c2rviz/reply``), the service
 ``[NS]/c2rviz/command`` (``{command}`` -> ``{reply, ok}``), ``[NS]/joint_command``
 (``sensor_msgs/msg/JointState``) and ``[NS]/joint_trajectory``
-(``trajectory_msgs/msg/JointTrajectory``), see ``joint_inputs``. Each client
+(``trajectory_msgs/msg/JointTrajectory``), see ``inputs``. Each client
 is a source of commands (``rosbridge HOST:PORT``) with a ``Session`` per robot
-(``command_lines``): it is bound to the robots it has one on, and ``fault disconnect``
+(``inputs``): it is bound to the robots it has one on, and ``fault disconnect``
 on one of them closes its connection. The parameter ``robot_description`` is the (first)
 robot's URDF; in a cell ``NS/robot_description`` is each robot's too.
 """
@@ -39,18 +39,21 @@ import pinocchio as pin
 from ...errors import C2rvizError
 from ...ros.messages import string
 from ...session.services import Services
-from .camera_topics import CameraTopics
-from .command_lines import CommandLines
-from .diagnostics import DIAGNOSTIC_ARRAY, DIAGNOSTICS_TOPIC
-from .joint_inputs import joint_command, joint_trajectory
+from .bridge import TopicHub
+from .inputs import CommandLines, joint_command, joint_trajectory
 from .messages import COMMAND_SERVICE_TYPE, command_request, command_response, string_data
 from .messages import joint_positions as read_joint_positions
 from .messages import joint_trajectory as read_joint_trajectory
-from .robot_topics import TF_MESSAGE, WORLD_FRAME, RobotTopics, namespaces
-from .topic_hub import TopicHub
+from .topics import (
+    DIAGNOSTIC_ARRAY,
+    DIAGNOSTICS_TOPIC,
+    TF_MESSAGE,
+    WORLD_FRAME,
+    CameraTopics,
+    RobotTopics,
+    namespaces,
+)
 from .world_feed import TF_STATIC_TOPIC, TF_TOPIC, WorldFeed
-
-__all__ = ["DOOR", "RobotBridge"]
 
 DOOR = "rosbridge"
 """How the door counts its clients among the program's (``Services.count_clients``)."""

@@ -46,8 +46,6 @@ from .connection import Connection
 from .messages import normalize_type
 from .policy import RosbridgePolicy
 
-__all__ = ["CLOSE_TIMEOUT_S", "RosbridgeServer"]
-
 log = logging.getLogger("c2rviz.rosbridge")
 
 CLOSE_TIMEOUT_S = 1.0

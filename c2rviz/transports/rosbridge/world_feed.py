@@ -18,7 +18,7 @@ that changed and only for topics someone reads:
   half of those left, then all sent again), and the workcell objects as a whole
   when they changed.
 
-``/diagnostics`` carries every robot's faults whenever they change (``diagnostics.py``);
+``/diagnostics`` carries every robot's faults whenever they change (``topics.diagnostics``);
 ``/tf_static`` and ``[NS]/robot_description`` are latched from the start;
 events (``watch``'s texts) go out on ``[NS]/c2rviz/events`` as they happen.
 New subscribers of joints, TF and markers get the state now at once; a marker
@@ -44,11 +44,8 @@ from ...world.clock import Timer
 from ...world.observer import MAX_MARKERS, Marker, Observer
 from ...world.parts import Part
 from ...world.world import World
-from .diagnostics import DIAGNOSTICS_TOPIC, diagnostics
-from .robot_topics import WORLD_FRAME, RobotTopics
-from .topic_hub import TopicHub
-
-__all__ = ["FLUSH_SLACK", "WorldFeed"]
+from .bridge import TopicHub
+from .topics import DIAGNOSTICS_TOPIC, WORLD_FRAME, RobotTopics, diagnostics
 
 FLUSH_SLACK = 0.9
 """A flush comes at once when the previous one is this many frames old (timer jitter)."""

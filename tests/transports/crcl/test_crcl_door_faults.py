@@ -43,7 +43,7 @@ def test_a_bug_reading_a_document_costs_that_document_only(
     """Whatever a document raises, the client hears an error and the connection goes on
     (an unexpected exception used to end it with no status: "Unhandled exception in
     client_connected_cb")."""
-    from c2rviz.transports.crcl import motion_commands
+    from c2rviz.transports.crcl import commands
     from c2rviz.transports.crcl.server import INTERNAL_ERROR
 
     def boom(self: object) -> None:
@@ -51,7 +51,7 @@ def test_a_bug_reading_a_document_costs_that_document_only(
 
     client = crcl_connect(crcl_server)
     assert client.run(INIT, 1).command_status.state == DONE
-    monkeypatch.setattr(motion_commands.MoveTo, "_check", boom)
+    monkeypatch.setattr(commands.MoveTo, "_check", boom)
     client.send(move_to(2, (0.5, 0.0, 0.8)))
     refused = client.status().command_status
     assert refused.state == ERROR and refused.description == INTERNAL_ERROR

@@ -24,7 +24,7 @@ from c2rviz.transports.crcl import (
     parse_status,
     write_command,
 )
-from c2rviz.transports.crcl.hardened import _parser
+from c2rviz.transports.crcl.documents import _parser
 
 SECRET = "c2rviz-secret-7f3a9b"
 XSI = 'xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"'

@@ -12,7 +12,7 @@ from roslibpy.ros import set_rosapi_timeout
 from support import load_robot
 from world_support import WAIT_S, WorldServer, ask, command_service, listen, until
 
-from c2rviz.transports.rosbridge.msg_definitions import full_text
+from c2rviz.transports.rosbridge.rosapi import full_text
 
 
 @pytest.fixture

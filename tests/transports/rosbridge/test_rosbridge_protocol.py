@@ -7,6 +7,7 @@ import json
 import pytest
 
 from c2rviz.errors import C2rvizError
+from c2rviz.transports.rosbridge.ops import op_name, resolve_name
 from c2rviz.transports.rosbridge.protocol import (
     UNSUPPORTED_OPS,
     Advertise,
@@ -18,10 +19,8 @@ from c2rviz.transports.rosbridge.protocol import (
     Unadvertise,
     Unsubscribe,
     Unsupported,
-    op_name,
     parse_frame,
     publish,
-    resolve_name,
     service_response,
     status,
 )

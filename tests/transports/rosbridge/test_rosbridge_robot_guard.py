@@ -215,7 +215,7 @@ def test_a_trajectorys_plan_and_checks_run_off_the_loop(
     import threading
 
     from c2rviz.session import calls
-    from c2rviz.transports.rosbridge import joint_inputs
+    from c2rviz.transports.rosbridge import inputs
 
     threads: list[tuple[str, str]] = []
 
@@ -226,7 +226,7 @@ def test_a_trajectorys_plan_and_checks_run_off_the_loop(
 
         return wrapped
 
-    monkeypatch.setattr(joint_inputs, "plan_trajectory", spy("plan", joint_inputs.plan_trajectory))
+    monkeypatch.setattr(inputs, "plan_trajectory", spy("plan", inputs.plan_trajectory))
     monkeypatch.setattr(calls, "_check", spy("check", calls._check))
     assert command(ws, "guard on")["values"]["ok"]
     assert command(ws, "object wall box 0.05,2,2 0.6,0,0.9,0,0,0")["values"]["ok"]

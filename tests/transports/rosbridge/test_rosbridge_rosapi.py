@@ -6,13 +6,15 @@ import json
 
 import pytest
 
-from c2rviz.transports.rosbridge.msg_definitions import DEFINITIONS, dependencies, full_text
 from c2rviz.transports.rosbridge.policy import PolicyError, RosbridgePolicy
 from c2rviz.transports.rosbridge.rosapi import (
+    DEFINITIONS,
     ROSAPI_SERVICES,
     Graph,
     RosapiError,
     answer,
+    dependencies,
+    full_text,
     is_rosapi,
 )
 

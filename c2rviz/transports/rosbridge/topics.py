@@ -1,40 +1,77 @@
-"""One robot's topics as rosbridge serves them: their names, its frames, its messages.
+"""The topics rosbridge serves of each robot and camera, and the robots' diagnostics.
 
-The messages are those of ``c2rviz.ros`` (the bag writer's shapes): a robot
-alone lives in the root namespace (``/joint_states``, frames ``base_link``...);
-in a cell each robot lives in its own (``/left/joint_states``, frames
-``left/base_link``), ``/tf`` and ``/tf_static`` stay global, and the cell's
-``world`` frame holds every robot's root where the cell places it.
+One robot's topics: their names, its frames, its messages. The messages are those of
+``c2rviz.ros`` (the bag writer's shapes): a robot alone lives in the root namespace
+(``/joint_states``, frames ``base_link``...); in a cell each robot lives in its own
+(``/left/joint_states``, frames ``left/base_link``), ``/tf`` and ``/tf_static`` stay
+global, and the cell's ``world`` frame holds every robot's root where the cell places
+it. A marker of the world (``world.state.Marker``) is drawn in the world frame: the
+cell's ``world``, or a robot alone's root link. Workcell objects are placed in the
+robot's base link. Sizes follow the page's (``MARKER_SIZE_M``).
 
-A marker of the world (``world.state.Marker``) is drawn in the world frame: the
-cell's ``world``, or a robot alone's root link. Workcell objects are placed in
-the robot's base link. Sizes follow the page's (``MARKER_SIZE_M``).
+The logical cameras: each camera NAME publishes ``/c2rviz/cameras/NAME``
+(``geometry_msgs/msg/PoseArray``): its header's ``frame_id`` is the camera's frame
+``cameras/NAME`` and its poses are the seen parts' in that frame, in the order ``camera
+NAME`` replies them (an empty array: it sees nothing). A PoseArray is in rosbags' ROS 2
+stores and RViz draws it; it carries no names, so the same report goes on ``/tf`` too:
+the camera's frame (a child of the world's frame, as the parts' frames are) and a frame
+``cameras/NAME/PART`` per seen part, a child of the camera's, so a TF listener knows
+which part is where. Reports come at the camera's rate on the world's clock
+(``observers.camera_feed``), while anyone subscribes to a camera's topic; a new
+subscriber gets what the camera sees now at once. A camera's topic exists from the
+moment the camera is placed (topics are never taken back: a removed camera's topic
+publishes nothing more).
+
+The robots' faults as ROS diagnostics (pure): ``/diagnostics``
+(``diagnostic_msgs/msg/DiagnosticArray``), the ROS convention for a machine's health.
+One ``DiagnosticStatus`` per robot, named ``c2rviz/ROBOT`` with ``hardware_id`` ROBOT:
+
+* level ``ERROR`` (2) while a stop holds the robot (``estop``, ``protective``, a released
+  estop not yet ``reset``) or a joint is stalled; ``WARN`` (1) with only noise or latency;
+  ``OK`` (0) without faults;
+* ``message``: the stop's refusal (``emergency stop since t=...``), else the faults, else
+  ``ok``;
+* ``values``: one ``{key, value}`` per fault, active or scheduled (``estop`` ->
+  ``since 1.500``, ``noise 0.01`` -> ``at 5.000``), as ``faults`` lists them (SI).
+
+The level is sent as a JSON number (what roslibpy clients read; rosbridge_suite's own
+encoding of a ``byte`` varies with its version).
 """
 
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
+from functools import partial
 
 import numpy as np
 import pinocchio as pin
 
 from ...collision.workcell import WorkcellObject
+from ...observers.camera_feed import CAMERA_TOPIC, POSE_ARRAY, CameraFeed, camera_items, pose_array
 from ...robot.model import Robot
 from ...ros.markers import SHAPES, delete_all, delete_marker, marker, object_marker
-from ...ros.messages import JOINT_STATE, Msg, frame_prefix, joint_state, topic, transform
+from ...ros.messages import (
+    JOINT_STATE,
+    Msg,
+    frame_prefix,
+    header,
+    joint_state,
+    tf_message,
+    topic,
+    transform,
+    transforms,
+)
 from ...ros.tf_tree import TfTree, Transform
+from ...world.cameras import Camera, Seen
+from ...world.observer import Observer
+from ...world.faults import RobotFaults
 from ...world.state import Marker
+from ...world.world import World, sight
+from .bridge import TopicHub
 from .messages import JOINT_TRAJECTORY, STRING
 
-__all__ = [
-    "MARKER_ARRAY",
-    "MARKER_SIZE_M",
-    "TF_MESSAGE",
-    "WORLD_FRAME",
-    "RobotTopics",
-    "namespaces",
-]
+# One robot's topics.
 
 TF_MESSAGE = "tf2_msgs/msg/TFMessage"
 MARKER_ARRAY = "visualization_msgs/msg/MarkerArray"
@@ -197,3 +234,104 @@ class RobotTopics:
                 )
             )
         return out
+
+
+# The cameras' topics.
+
+
+class CameraTopics(Observer):
+    """Publishes every camera of the world (add it to the world's observers)."""
+
+    def __init__(
+        self, world: World, hub: TopicHub, parent: str, to_parent: pin.SE3, tf_topic: str
+    ) -> None:
+        """Set up.
+
+        Args:
+            world: The world whose cameras it publishes.
+            hub: Where the messages go.
+            parent: The frame cameras hang from on ``/tf`` (the parts' parent).
+            to_parent: Takes a world pose into ``parent``.
+            tf_topic: ``/tf``.
+        """
+        self.world, self.hub = world, hub
+        self.parent, self.to_parent, self.tf_topic = parent, to_parent, tf_topic
+        self.topics: dict[str, str] = {}
+        self._readers = 0
+        self.feed = CameraFeed(world, self._report)
+        self.on_cameras(world.cameras.all())
+
+    def published(self) -> list[tuple[str, str]]:
+        """``(topic, type)`` of every camera's topic."""
+        return [(topic, POSE_ARRAY) for topic in self.topics.values()]
+
+    def close(self) -> None:
+        self.feed.close()
+
+    def on_cameras(self, cameras: Sequence[Camera]) -> None:
+        for camera in cameras:
+            if camera.name not in self.topics:
+                topic = self.topics[camera.name] = CAMERA_TOPIC.format(name=camera.name)
+                self.hub.add_topic(topic, partial(self._now, camera.name), watcher=self._reading)
+        self.feed.sync(self._readers > 0)
+
+    def on_command(self, source: str, line: str, accepted: bool) -> None:
+        self.feed.wake()
+
+    def _reading(self, reading: bool) -> None:
+        self._readers += 1 if reading else -1
+        self.feed.sync(self._readers > 0)
+
+    def _now(self, name: str) -> Msg | None:
+        if name not in self.world.cameras:
+            return None
+        return pose_array(self.world.clock.now(), name, sight(self.world, name))
+
+    def _report(self, name: str, t: float, seen: Sequence[Seen]) -> None:
+        topic = self.topics.get(name)
+        if topic is not None and self.hub.wanted(topic):
+            self.hub.publish(topic, pose_array(t, name, seen))
+        if self.hub.wanted(self.tf_topic):
+            camera = self.world.cameras.get(name)
+            items = camera_items(self.parent, self.to_parent, camera, seen)
+            self.hub.publish(self.tf_topic, tf_message(transforms(t, items)))
+
+
+# The robots' diagnostics.
+
+DIAGNOSTICS_TOPIC = "/diagnostics"
+DIAGNOSTIC_ARRAY = "diagnostic_msgs/msg/DiagnosticArray"
+OK, WARN, ERROR = 0, 1, 2
+
+
+def status(robot: str, faults: RobotFaults, origin: float) -> Msg:
+    """``robot``'s ``DiagnosticStatus`` (times from ``origin`` [s])."""
+    listed = faults.listing(origin)
+    texts = [fault.text(faults.joint_names) for fault, _ in listed]
+    refusal = faults.refusal(origin)
+    if refusal is not None or faults.held:
+        level = ERROR
+    elif faults.active:
+        level = WARN
+    else:
+        level = OK
+    if refusal is not None:
+        message = str(refusal)
+    else:
+        active = [fault.text(faults.joint_names) for fault, _ in faults.active.values()]
+        message = "faults: " + ", ".join(active) if active else "ok"
+    return {
+        "level": level,
+        "name": f"c2rviz/{robot}",
+        "message": message,
+        "hardware_id": robot,
+        "values": [{"key": text, "value": when} for text, (_, when) in zip(texts, listed)],
+    }
+
+
+def diagnostics(t: float, robots: Mapping[str, RobotFaults], origin: float) -> Msg:
+    """``/diagnostics`` at time ``t`` [s]: every robot's status."""
+    return {
+        "header": header(t),
+        "status": [status(name, faults, origin) for name, faults in robots.items()],
+    }
