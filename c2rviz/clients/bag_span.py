@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ..tolerance import within_limit
+from ..errors import within_limit
 
 if TYPE_CHECKING:
     from ..ros.bag_reader import JointStateBag

@@ -19,9 +19,8 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ..errors import C2rvizError, JointCountError, JointLimitError
+from ..errors import C2rvizError, JointCountError, JointLimitError, within_limit
 from ..protocol.verbs.motion import MOTION_MODES
-from ..tolerance import within_limit
 from .client import Client
 
 __all__ = [

@@ -24,13 +24,12 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ...errors import ArmMoved, C2rvizError, JointLimitError
+from ...errors import ArmMoved, C2rvizError, JointLimitError, within_limit
 from ...motion.trajectory import PlannedTrajectory, plan_trajectory
 from ...protocol import replies
 from ...robot.model import Robot
 from ...session.calls import MAX_TRAJECTORY_CHECKS
 from ...session.session import Session
-from ...tolerance import within_limit
 from .messages import JointPositions, JointTrajectory
 
 __all__ = ["MAX_GUARD_SAMPLES", "ROWS", "UnknownJointName", "joint_command", "joint_trajectory"]
