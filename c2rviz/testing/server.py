@@ -329,7 +329,7 @@ class TestServer:
             scene.stop()
 
     def _door_ports(self, doors: Sequence[Opened]) -> None:
-        from ..app.rosbridge_door import RosbridgeDoor
+        from ..app.doors import RosbridgeDoor
         from ..transports.crcl.server import CrclServer
 
         for opened in doors:
