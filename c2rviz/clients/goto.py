@@ -23,16 +23,6 @@ from ..errors import C2rvizError, JointCountError, JointLimitError, within_limit
 from ..protocol.verbs.motion import MOTION_MODES
 from .client import Client
 
-__all__ = [
-    "Arrival",
-    "motion_of",
-    "Stepped",
-    "step",
-    "stop_elsewhere",
-    "target_problem",
-    "travel",
-]
-
 
 def motion_of(reply: str) -> str | None:
     """The connection's motion mode from the reply to a bare ``motion``; None when the

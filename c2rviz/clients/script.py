@@ -26,18 +26,6 @@ from ..protocol.verbs.markers import Clear
 from ..protocol.verbs.motion import MotionMode, Stop, Wait
 from ..protocol.verbs.queries import Bye, Quit
 
-__all__ = [
-    "MAX_LINE_BYTES",
-    "MAX_PROBLEMS",
-    "Script",
-    "ScriptLine",
-    "check_robot",
-    "load_script",
-    "motion_after",
-    "robot_mismatch",
-    "waits_for_the_arm",
-]
-
 _MOVES = (Joints, Move, Home, Rand, Clear, MoveTo, MoveL)
 """Commands whose reply comes on arrival with ``motion on``."""
 MAX_PROBLEMS = 100

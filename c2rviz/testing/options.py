@@ -17,8 +17,6 @@ from ..motion.planner import motion_limits
 from ..robot.model import Robot
 from ..world.clock import Clock
 
-__all__ = ["RUNTIME_OPTIONS", "give_back", "given_members", "settings_for", "take_members"]
-
 RUNTIME_OPTIONS = (
     "clock",
     "viewer",

@@ -43,9 +43,7 @@ from ..world.clocks import parse_clock
 from ..world.effects import NullScene, Observer, Scene
 from ..world.state import RobotState
 from ..world.world import World
-from .options import RUNTIME_OPTIONS, give_back, given_members, settings_for, take_members
-
-__all__ = ["RUNTIME_OPTIONS", "TestServer"]
+from .options import give_back, given_members, settings_for, take_members
 
 T = TypeVar("T")
 _START_TIMEOUT_S = 120.0
