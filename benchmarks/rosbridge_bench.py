@@ -70,7 +70,7 @@ def percentile(values: Sequence[float], q: float) -> float:
 async def serve() -> None:
     """c2rviz as the program wires it; stdin: ``start`` / ``stop`` (figures) / ``quit``."""
     from c2rviz.app.config import Settings
-    from c2rviz.app.rosbridge_door import RosbridgeDoor
+    from c2rviz.app.doors import RosbridgeDoor
     from c2rviz.robot.model import Robot
     from c2rviz.session import Services
     from c2rviz.transports.rosbridge import RosbridgePolicy

@@ -25,11 +25,11 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # what type checkers see of the lazy names below
-    from .clients.arm_calls import PlanSummary
     from .clients.client import AsyncClient, Client
-    from .clients.connect import ServerUnavailable
+    from .clients.connection import ServerUnavailable
     from .clients.errors import CommandError, ConnectionLost
     from .clients.records import Event, JointLimit, Pose, State
+    from .clients.task_calls import PlanSummary
 
 __all__ = [
     "__version__",
@@ -78,8 +78,8 @@ _HOME.update(  # a controller's side: the clients (no Pinocchio, no viser)
         "Event": "clients.records",
         "JointLimit": "clients.records",
         "Pose": "clients.records",
-        "PlanSummary": "clients.arm_calls",
-        "ServerUnavailable": "clients.connect",
+        "PlanSummary": "clients.task_calls",
+        "ServerUnavailable": "clients.connection",
         "State": "clients.records",
     }
 )

@@ -1,29 +1,28 @@
-"""Reading ``cmdinterpreter.ini``: where it is, its text, and its numbers.
+"""Reading ``cmdinterpreter.ini``: where it is, its text, and its numbers; and the browser
+origins the doors that browsers reach allow (pure, standard library).
 
-The server's settings (``app.config``) and the clients (``clients.options``) both
+The server's settings (``app.config``) and the clients (``clients.connection``) both
 read the ini; this module is what they share, with the standard library alone, so
 a client finds the server's address without loading any robot. Every problem is a
 ``ConfigError`` that names the file and what it accepts.
+
+Browsers send ``Origin`` with every websocket they open and do not hold websockets to the
+same-origin rule, so the page's door (``view.policy``) and rosbridge's
+(``transports.rosbridge.policy``) both compare it with the origins they allow (the ini's
+``viewer_origins``, the flags), spelled one way by ``normalize_origin``, and both read a
+URL's token with ``token_ok``. A host name that resolves to 127.0.0.1 is not enough (DNS
+rebinding): the loopback names are fixed.
 """
 
 from __future__ import annotations
 
 import configparser
+import hmac
 from pathlib import Path
 from typing import Any
+from urllib.parse import parse_qs, urlsplit
 
 from .errors import ConfigError
-
-__all__ = [
-    "DEFAULT_HOST",
-    "DEFAULT_PORT",
-    "INI_NAME",
-    "PROJECT_DIR",
-    "address",
-    "find_ini",
-    "number",
-    "read_ini",
-]
 
 INI_NAME = "cmdinterpreter.ini"
 PROJECT_DIR = Path(__file__).resolve().parent.parent
@@ -91,3 +90,40 @@ def address(ini: Path | None) -> tuple[str, int]:
     host = parser.get("options", "host", fallback=DEFAULT_HOST)
     port = parser.get("options", "port", fallback=None)
     return host, DEFAULT_PORT if port is None else number("[options] port", port, int, 0, 65535)
+
+
+LOOPBACK_HOSTS = ("localhost", "127.0.0.1", "[::1]")
+
+
+def normalize_origin(origin: str) -> str | None:
+    """``scheme://host:port`` in lower case with the port spelled out, or None.
+
+    None for anything but an ``http``/``https`` origin (``null``, a path, ...).
+    """
+    try:
+        parts = urlsplit(origin.strip())
+        port = parts.port
+    except ValueError:
+        return None
+    if (
+        parts.scheme not in ("http", "https")
+        or not parts.hostname
+        or parts.path not in ("", "/")
+        or parts.query
+        or parts.fragment
+        or "@" in parts.netloc
+    ):
+        return None
+    host = f"[{parts.hostname}]" if ":" in parts.hostname else parts.hostname
+    return f"{parts.scheme}://{host}:{port or (443 if parts.scheme == 'https' else 80)}"
+
+
+def token_ok(token: str | None, path: str) -> bool:
+    """Whether the request target ``path`` carries ``?token=<token>`` (None: none is needed).
+
+    Any ``token`` value in the query may match; each is compared in constant time.
+    """
+    if token is None:
+        return True
+    given = parse_qs(urlsplit(path).query, keep_blank_values=True).get("token", [])
+    return any(hmac.compare_digest(g.encode(), token.encode()) for g in given)

@@ -1,10 +1,10 @@
-"""The one token check both browser-reached doors use (``origins.token_ok``)."""
+"""The one token check both browser-reached doors use (``ini.token_ok``)."""
 
 from __future__ import annotations
 
 import pytest
 
-from c2rviz.origins import token_ok
+from c2rviz.ini import token_ok
 from c2rviz.transports.rosbridge.policy import RosbridgePolicy
 from c2rviz.view.policy import DoorPolicy
 

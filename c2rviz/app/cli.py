@@ -15,12 +15,11 @@ from pathlib import Path
 
 from ..collision.geometry import read_srdf
 from ..errors import C2rvizError
+from ..ini import find_ini
 from ..robot.catalogue import catalogue, listing
-from .config import LIGHTINGS, MOTION_FLAGS, find_ini, load_settings, read_robots
+from .config import LIGHTINGS, MOTION_FLAGS, load_settings, read_robots
 from .members import members
 from .program import serve
-
-__all__ = ["build_parser", "main"]
 
 log = logging.getLogger("c2rviz")
 

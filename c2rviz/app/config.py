@@ -19,28 +19,12 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ConfigError
-from ..ini import INI_NAME, PROJECT_DIR, find_ini, number, read_ini
+from ..ini import INI_NAME, PROJECT_DIR, number, read_ini
 from ..protocol.limits import bounds, default
 from ..robot.catalogue import catalogue, find_robot
 from ..robot.sources import split_package_path
 from ..session.services import ServerLimits, SessionDefaults
 from ..world.virtual_clock import parse_clock
-
-__all__ = [
-    "INI_NAME",
-    "LIGHTINGS",
-    "MOTION_FLAGS",
-    "ROBOT_KEYS",
-    "ServerLimits",
-    "SessionDefaults",
-    "RobotEntry",
-    "Settings",
-    "find_ini",
-    "load_settings",
-    "bundled_robots",
-    "read_robots",
-    "replaced_bundled",
-]
 
 
 @dataclass(frozen=True)
@@ -207,7 +191,7 @@ MOTION_FLAGS = ("max_velocity", "max_acceleration", "max_jerk")
 """Motion limits a flag may give every robot (over the ini's)."""
 _EXTRA_KEYS = ["tool", "gripper", *MOTION_FLAGS]
 ROBOT_KEYS = ["base", "eelink", "urdf", "package_path", "xacro_args", *_EXTRA_KEYS]
-_MEMBER_PLACE_KEYS = ("origin", "port")  # a cell member's, beside its robot keys (cell.py)
+_MEMBER_PLACE_KEYS = ("origin", "port")  # a cell member's, beside its robot keys (members.py)
 _LIMIT_FIELDS = {f for f in ServerLimits.__dataclass_fields__}
 _SESSION_FIELDS = {f for f in SessionDefaults.__dataclass_fields__}
 
@@ -251,7 +235,7 @@ def _read_ini(path: Path) -> tuple[dict[str, Any], dict[str, RobotEntry]]:
         ):
             continue
         items = dict(parser.items(section))
-        if "robot" in items:  # a member of a cell (see cell.py), not a robot of its own
+        if "robot" in items:  # a member of a cell (see members.py), not a robot of its own
             continue
         if section in members:
             items = {k: v for k, v in items.items() if k not in _MEMBER_PLACE_KEYS}

@@ -29,14 +29,10 @@ from ..world.observer import NullScene, Scene
 from ..world.state import RobotState
 from ..world.virtual_clock import parse_clock
 from ..world.world import World
-from . import crcl_door  # noqa: F401 (its opener joins doors.OPENERS)
 from .config import Settings, replaced_bundled
 from .doors import close_doors, open_doors
 from .ini_world import ini_cameras, place_cameras
 from .members import Member, furnish
-from .rosbridge_door import open_rosbridge  # noqa: F401 (importing it adds it to OPENERS)
-
-__all__ = ["serve", "write_page"]
 
 log = logging.getLogger("c2rviz")
 

@@ -19,15 +19,12 @@ from collections import deque
 from collections.abc import AsyncIterator
 
 from ..protocol.framing import Line, LineFramer
-from ..protocol.verbs.arm import RobotChoice
-from ..protocol.verbs.seed import Units
-from .connect import ServerUnavailable
+from ..protocol.verbs.cell import RobotChoice
+from ..protocol.verbs.joints import Units
+from .connection import MAX_REPLY_BYTES, LineState, ServerUnavailable
 from .errors import CommandError, ConnectionLost, ReplyTimeout, ReplyTooLong
-from .line_state import MAX_REPLY_BYTES, LineState
 from .records import Event, State, read_stream_line
 from .stream import line_text, watch_request
-
-__all__ = ["AsyncLineClient", "AsyncWatchStream", "open_stream"]
 
 Streams = tuple[asyncio.StreamReader, asyncio.StreamWriter]
 

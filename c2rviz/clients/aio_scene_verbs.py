@@ -11,12 +11,10 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TypeVar
 
-from . import calls, scene_calls
+from . import calls, task_calls
 from .calls import Call, speaks
 from .records import RecordingResult, RecordingStatus, TrailStatus
-from .scene_calls import CameraInfo, PartState, Score, Seen
-
-__all__ = ["AsyncSceneVerbs"]
+from .task_calls import CameraInfo, PartState, Score, Seen
 
 T = TypeVar("T")
 
@@ -137,29 +135,29 @@ class AsyncSceneVerbs:
         ``cylinder`` (r, length [m]) or a ``sphere`` (r [m]) at ``pose`` (x, y, z [m], roll,
         pitch, yaw [rad, or deg]; a sphere's x, y, z alone) in the base frame; ``kind`` is
         its ``type=``, ``color`` its r, g, b (0..1)."""
-        return await self.call(scene_calls.add_part(name, shape, size, pose, kind, color))
+        return await self.call(task_calls.add_part(name, shape, size, pose, kind, color))
 
     @speaks("part")
     async def part(self, name: str) -> PartState:
         """Where part ``name`` is (x, y, z [m], roll, pitch, yaw [rad, or deg], base frame)
         and what holds it (``free``, ``held``, ``resting on WHAT``)."""
-        return await self.call(scene_calls.part(name))
+        return await self.call(task_calls.part(name))
 
     @speaks("part")
     async def remove_part(self, name: str) -> None:
         """Remove part ``name``."""
-        return await self.call(scene_calls.remove_part(name))
+        return await self.call(task_calls.remove_part(name))
 
     @speaks("part")
     async def remove_parts(self) -> None:
         """Remove every part."""
-        return await self.call(scene_calls.REMOVE_PARTS)
+        return await self.call(task_calls.REMOVE_PARTS)
 
     @speaks("parts")
     async def parts(self) -> dict[str, PartState]:
         """Every part by name: its pose (x, y, z [m], roll, pitch, yaw [rad, or deg], base
         frame) and state."""
-        return await self.call(scene_calls.PARTS)
+        return await self.call(task_calls.PARTS)
 
     @speaks("goal")
     async def goal(
@@ -168,23 +166,23 @@ class AsyncSceneVerbs:
         """Say where part ``target`` (or any part of a type: ``type=T``) should end: ``pose``
         (x, y, z [m], roll, pitch, yaw [rad, or deg], base frame) within ``tol`` (metres,
         angle [rad, or deg]; default 5 mm and 5 degrees)."""
-        return await self.call(scene_calls.goal(target, pose, tol))
+        return await self.call(task_calls.goal(target, pose, tol))
 
     @speaks("goal")
     async def remove_goal(self, target: str) -> None:
         """Remove the goal of ``target`` (a part's name or ``type=T``)."""
-        return await self.call(scene_calls.remove_goal(target))
+        return await self.call(task_calls.remove_goal(target))
 
     @speaks("goal")
     async def remove_goals(self) -> None:
         """Remove every goal."""
-        return await self.call(scene_calls.REMOVE_GOALS)
+        return await self.call(task_calls.REMOVE_GOALS)
 
     @speaks("score")
     async def score(self) -> Score:
         """How many goals are met, and how far off the others are (mm, and degrees or
         radians as the server words it)."""
-        return await self.call(scene_calls.SCORE)
+        return await self.call(task_calls.SCORE)
 
     # Logical cameras (docs/cameras.md).
 
@@ -195,32 +193,32 @@ class AsyncSceneVerbs:
         """Place (or move) logical camera ``name`` at ``pose`` (x, y, z [m], roll, pitch, yaw
         [rad, or deg], world frame; it looks along its +x axis) with ``fov`` (h_fov, v_fov
         [rad, or deg], range [m]; default 60, 45 degrees and 2 m)."""
-        return await self.call(scene_calls.add_camera(name, pose, fov))
+        return await self.call(task_calls.add_camera(name, pose, fov))
 
     @speaks("camera")
     async def camera(self, name: str) -> list[Seen]:
         """What camera ``name`` sees now: each part's name, type and pose in the camera's
         frame (x, y, z [m], roll, pitch, yaw [rad, or deg])."""
-        return await self.call(scene_calls.camera(name))
+        return await self.call(task_calls.camera(name))
 
     @speaks("camera")
     async def remove_camera(self, name: str) -> None:
         """Remove camera ``name``."""
-        return await self.call(scene_calls.remove_camera(name))
+        return await self.call(task_calls.remove_camera(name))
 
     @speaks("camera")
     async def camera_rate(self, name: str, hz: float) -> None:
         """How often [Hz] camera ``name`` reports to ``watch``, rosbridge and bags."""
-        return await self.call(scene_calls.camera_rate(name, hz))
+        return await self.call(task_calls.camera_rate(name, hz))
 
     @speaks("camera")
     async def camera_noise(self, name: str, sigma_m: float, sigma_angle: float) -> None:
         """Noise on what camera ``name`` reports: ``sigma_m`` [m] and ``sigma_angle`` [rad,
         or deg], drawn from the server's seed."""
-        return await self.call(scene_calls.camera_noise(name, sigma_m, sigma_angle))
+        return await self.call(task_calls.camera_noise(name, sigma_m, sigma_angle))
 
     @speaks("cameras")
     async def cameras(self) -> dict[str, CameraInfo]:
         """Every camera by name: its pose (x, y, z [m], roll, pitch, yaw [rad, or deg], world
         frame), fields of view [rad, or deg] and range [m], and rate [Hz]."""
-        return await self.call(scene_calls.CAMERAS)
+        return await self.call(task_calls.CAMERAS)

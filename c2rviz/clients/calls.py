@@ -2,7 +2,7 @@
 
 Pure (no sockets): ``Client`` and ``AsyncClient`` both send a ``Call``'s ``line`` and
 hand the reply to its ``read``. Arguments are checked here, before anything is sent:
-types and counts by ``arguments``, ranges and words by the server's own parser
+types and counts by ``errors``'s checks, ranges and words by the server's own parser
 (``protocol.parse_line``), whose complaint becomes an ``ArgumentError`` naming the
 argument. A joint count is checked against the robot's by the client
 (``Call.joint_count``), which knows it from ``names``.
@@ -16,14 +16,13 @@ from typing import Any, Generic, TypeVar
 
 from ..errors import BadArguments, C2rvizError
 from ..protocol.grammar import MARKER_SHAPES, parse_line
-from ..protocol.verbs.arm import MOTION_MODES, RobotChoice
-from ..protocol.verbs.scene import TRAIL_ACTIONS
-from ..protocol.verbs.seed import Units
-from . import arguments as check
+from ..protocol.verbs.cell import RobotChoice
+from ..protocol.verbs.joints import Units
+from ..protocol.verbs.motion import MOTION_MODES
+from ..protocol.verbs.observe import TRAIL_ACTIONS
+from . import errors as check
 from . import records as read
 from .errors import ArgumentError, CommandError, UnexpectedReply
-
-__all__ = ["OBJECT_SHAPES", "Call", "count_problem", "fixed", "read_call", "speaks", "with_value"]
 
 T = TypeVar("T")
 F = TypeVar("F", bound=Callable[..., object])

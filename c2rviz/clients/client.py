@@ -58,26 +58,11 @@ from .aio_lines import AsyncLineClient, AsyncWatchStream
 from .aio_scene_verbs import AsyncSceneVerbs
 from .aio_verbs import AsyncVerbs
 from .calls import Call, count_problem, read_call, speaks
-from .connect import ServerUnavailable
-from .errors import CommandError, ConnectionLost, ServerShutdown
+from .errors import CommandError, ServerShutdown
 from .lines import LineClient
-from .options import COMMANDS_DIR, add_connection_args, default_address, find_script, server_address
 from .scene_verbs import SceneVerbs
 from .stream import WatchStream
 from .verbs import Verbs
-
-__all__ = [
-    "AsyncClient",
-    "COMMANDS_DIR",
-    "Client",
-    "ConnectionLost",
-    "ServerUnavailable",
-    "add_connection_args",
-    "default_address",
-    "find_script",
-    "server_address",
-]
-
 
 T = TypeVar("T")
 

@@ -31,10 +31,7 @@ from ..transports.crcl.documents import CommandInstance, parse_program, write_in
 from ..transports.crcl.errors import CrclError
 from ..transports.crcl.framing import DocumentSplitter
 from ..transports.crcl.status import CrclStatus, parse_status
-from .connect import ServerUnavailable, dial
-from .options import default_address, find_script
-
-__all__ = ["CRCL_PORT", "build_parser", "crcl_address", "is_crcl_program", "main", "run"]
+from .connection import ServerUnavailable, default_address, dial, find_script
 
 CRCL_PORT = 64444
 """The CRCL port when neither ``--port`` nor the ini's ``crcl_port`` says."""

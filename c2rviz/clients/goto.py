@@ -19,20 +19,9 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ..errors import C2rvizError, JointCountError, JointLimitError
-from ..protocol.verbs.arm import MOTION_MODES
-from ..tolerance import within_limit
+from ..errors import C2rvizError, JointCountError, JointLimitError, within_limit
+from ..protocol.verbs.motion import MOTION_MODES
 from .client import Client
-
-__all__ = [
-    "Arrival",
-    "motion_of",
-    "Stepped",
-    "step",
-    "stop_elsewhere",
-    "target_problem",
-    "travel",
-]
 
 
 def motion_of(reply: str) -> str | None:

@@ -1,7 +1,7 @@
 """One TCP connection to the command server: a line out, a reply line back, in order.
 
 ``LineClient`` is the wire under ``Client`` (and so under the REPL and the player):
-it connects with retries (``connect.dial``: the server may not be up yet, or may be
+it connects with retries (``connection.dial``: the server may not be up yet, or may be
 restarting), sends lines and reads their replies through the protocol's own
 ``LineFramer`` (a reply longer than ``max_reply`` closes the connection: a server
 that streams without newlines cannot grow the client's memory), and remembers the
@@ -19,11 +19,8 @@ from collections.abc import Callable
 from ..errors import C2rvizError, LineTooLong
 from ..protocol.framing import Line, LineFramer
 from ..protocol.grammar import parse_line
-from .connect import dial
+from .connection import MAX_REPLY_BYTES, LineState, dial
 from .errors import ConnectionLost, ReplyTimeout, ReplyTooLong, UnexpectedReply
-from .line_state import MAX_REPLY_BYTES, LineState
-
-__all__ = ["MAX_REPLY_BYTES", "LineClient"]
 
 _CHUNK = 65536
 _STREAM = ("state ", "event ")  # a watch stream's lines, which no reply starts with

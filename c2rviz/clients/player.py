@@ -5,7 +5,7 @@ sent, so a typo on line 40 is reported as ``file:40: error: ...`` (every such
 line, up to ``script.MAX_PROBLEMS``) while the robot is still where it was; then the
 file is read again line by line as it plays, so a long recording costs no more
 memory than a short one. FILE is found as given, else in the recording folder, else
-in the project's ``commands/`` (``options.find_script``). Once connected, the joint
+in the project's ``commands/`` (``connection.find_script``). Once connected, the joint
 counts of ``joints`` lines and the indices of ``move`` lines are checked against the
 server's robot (``names``), again before the first line is sent; a file that declares
 its robot in its opening comments (a ``# robot: NAME`` line) and finds another
@@ -41,15 +41,9 @@ from ..protocol.verbs.arm import MOTION_MODES, MotionMode
 from ..protocol.verbs.seed import Sleep
 from .bag_play import add_bag_args, is_bag
 from .bag_play import run as play_bag
-from .client import (
-    Client,
-    ConnectionLost,
-    ServerUnavailable,
-    add_connection_args,
-    find_script,
-    server_address,
-)
-from .display import Progress, shown
+from .client import Client
+from .connection import ServerUnavailable, add_connection_args, find_script, server_address
+from .errors import ConnectionLost
 from .goto import motion_of
 from .script import (
     Script,
@@ -60,19 +54,7 @@ from .script import (
     robot_mismatch,
     waits_for_the_arm,
 )
-
-__all__ = [
-    "Progress",
-    "Script",
-    "ScriptLine",
-    "build_parser",
-    "check_robot",
-    "load_script",
-    "main",
-    "play",
-    "robot_mismatch",
-    "waits_for_the_arm",
-]
+from .stream import Progress, shown
 
 
 def _wire(line: ScriptLine, speed: float) -> str:

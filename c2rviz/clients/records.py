@@ -12,21 +12,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
 
-__all__ = [
-    "Event",
-    "JointLimit",
-    "MotionLimit",
-    "MotionStatus",
-    "Pose",
-    "RecordingResult",
-    "RecordingStatus",
-    "RobotNames",
-    "State",
-    "TrailStatus",
-    "VersionInfo",
-    "read_stream_line",
-]
-
 
 class Pose(NamedTuple):
     """A tool pose: position [m] and roll, pitch, yaw [rad, or deg in degrees mode]."""

@@ -11,7 +11,7 @@ On a terminal there is a ``> `` prompt with line editing and history
 (``~/.c2rviz_history``, or ``$C2RVIZ_HISTORY``), and ``where`` prints a table of
 joint names and values; with piped input there is no prompt, ``where`` gets the
 server's own reply, the replies go to stdout and the connection messages to stderr.
-The server's text is printed with control characters escaped (``display.shown``), and a
+The server's text is printed with control characters escaped (``stream.shown``), and a
 reply longer than the client's limit closes the connection rather than fill memory
 (``lines.LineClient``).
 
@@ -33,12 +33,11 @@ from typing import TextIO
 
 from ..errors import C2rvizError
 from ..protocol.registry import usages
-from .client import Client, ServerUnavailable, add_connection_args, server_address
+from .client import Client
+from .connection import ServerUnavailable, add_connection_args, server_address
 from .errors import CommandError, UnexpectedReply
 from .repl_local import LOCAL_USAGE, LocalCommands
-from .stream import watch_lines, watch_main
-
-__all__ = ["LOCAL_USAGE", "Repl", "build_parser", "main", "watch_lines"]
+from .stream import watch_main
 
 
 class Repl(LocalCommands):

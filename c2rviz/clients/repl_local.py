@@ -19,14 +19,13 @@ from ..protocol.grammar import parse_line
 from ..protocol.verbs.scene import Watch
 from ..protocol.verbs.seed import Joints, Sleep
 from .bag_play import is_bag, play_in_repl
-from .client import Client, ConnectionLost, find_script
-from .display import shown
+from .client import Client
+from .connection import find_script
+from .errors import ConnectionLost
 from .goto import motion_of, step, target_problem, travel
-from .player import Progress, play
+from .player import play
 from .script import check_robot, load_script, robot_mismatch
-from .stream import watch_lines
-
-__all__ = ["DEFAULT_STEP_DEG", "LOCAL_USAGE", "LocalCommands"]
+from .stream import Progress, shown, watch_lines
 
 LOCAL_USAGE = {
     "file": (
@@ -118,11 +117,11 @@ class LocalCommands:
         """Each local word's runner: it returns False when the REPL should end."""
 
     def say(self, message: str) -> None:
-        """A connection message (the server's text in it escaped: ``display.shown``)."""
+        """A connection message (the server's text in it escaped: ``stream.shown``)."""
         print(shown(message), file=self.info, flush=True)
 
     def show(self, message: str) -> None:
-        """A reply or a result (the server's text in it escaped: ``display.shown``)."""
+        """A reply or a result (the server's text in it escaped: ``stream.shown``)."""
         print(shown(message), file=self.out, flush=True)
 
     def ask(self, line: str) -> str:

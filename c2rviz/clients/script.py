@@ -23,18 +23,6 @@ from ..protocol.grammar import Command, parse_line
 from ..protocol.verbs.arm import MotionMode, MoveL, MoveTo, Stop, Wait
 from ..protocol.verbs.seed import Bye, Clear, Home, Joints, Move, Quit, Rand
 
-__all__ = [
-    "MAX_LINE_BYTES",
-    "MAX_PROBLEMS",
-    "Script",
-    "ScriptLine",
-    "check_robot",
-    "load_script",
-    "motion_after",
-    "robot_mismatch",
-    "waits_for_the_arm",
-]
-
 _MOVES = (Joints, Move, Home, Rand, Clear, MoveTo, MoveL)
 """Commands whose reply comes on arrival with ``motion on``."""
 MAX_PROBLEMS = 100

@@ -8,8 +8,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, TypeVar
 
 from ..protocol.registry import VERBS
-from . import arm_calls, calls, records
-from .arm_calls import PlanSummary
+from . import calls, records, task_calls
 from .calls import Call, speaks
 from .records import (
     JointLimit,
@@ -19,8 +18,7 @@ from .records import (
     RobotNames,
     VersionInfo,
 )
-
-__all__ = ["Verbs"]
+from .task_calls import PlanSummary
 
 T = TypeVar("T")
 
@@ -231,47 +229,47 @@ class Verbs:
     def plan_joints(self, values: Sequence[float]) -> PlanSummary:
         """A collision-free path to joint ``values`` [rad, or deg; m]; with motion on, the
         arm moves along it (the reply comes as ``motion`` says)."""
-        return self.call(arm_calls.plan_joints(values))
+        return self.call(task_calls.plan_joints(values))
 
     @speaks("plan")
     def plan_pose(self, pose: Sequence[float]) -> PlanSummary:
         """A collision-free path to a tool ``pose`` (x, y, z [m], and roll, pitch, yaw
         [rad, or deg], or the position alone); moves as ``plan_joints``."""
-        return self.call(arm_calls.plan_pose(pose))
+        return self.call(task_calls.plan_pose(pose))
 
     @speaks("plan")
     def plan(self) -> list[tuple[float, ...]]:
         """The last planned path's waypoints, each the chain's joint values [rad, or deg; m]."""
-        return self.call(arm_calls.PLAN)
+        return self.call(task_calls.PLAN)
 
     @speaks("plan")
     def plan_timeout(self, seconds: float | None = None) -> float:
         """Set (or with None, return) this connection's planning time limit [s]."""
-        return self.call(arm_calls.plan_timeout(seconds))
+        return self.call(task_calls.plan_timeout(seconds))
 
     @speaks("plan")
     def plan_resolution(self, steps: Sequence[float] | None = None) -> tuple[float, ...]:
         """Set (or with None, return) the checks' steps: (a joint's angle [rad, or deg],
         the tool's travel [m])."""
-        return self.call(arm_calls.plan_resolution(steps))
+        return self.call(task_calls.plan_resolution(steps))
 
     @speaks("guard")
     def guard_mode(self, mode: str | None = None) -> str:
         """The guard as ``on``, ``off`` or ``plan`` (a refused move is planned around);
         returns it."""
-        return self.call(arm_calls.guard_mode(mode))
+        return self.call(task_calls.guard_mode(mode))
 
     @speaks("grip")
     def grip(self, opening: float | None = None) -> float:
         """The gripper to ``opening`` [0 closed .. 1 open] (arrives as ``motion`` says), or
         with None return its opening; returns the opening."""
-        return self.call(arm_calls.grip(opening))
+        return self.call(task_calls.grip(opening))
 
     @speaks("ghost")
     def ghost(self, on: bool | None = None) -> bool:
         """Show this connection's targets and paths as a ghost on the page (``True``, the
         default); returns whether it does."""
-        return self.call(arm_calls.ghost(on))
+        return self.call(task_calls.ghost(on))
 
     # Faults on demand (docs/faults.md).
 
@@ -282,19 +280,19 @@ class Verbs:
         """Make a fault happen on this robot: now, at the server's clock time ``at`` [s] or
         ``after`` [s] from now. ``fault("estop")``, ``fault("stall", "joint_l")``,
         ``fault("noise", 0.01)`` [rad, or deg], ``fault("latency", 50, 10)`` [ms]."""
-        return self.call(arm_calls.fault(kind, args, at, after))
+        return self.call(task_calls.fault(kind, args, at, after))
 
     @speaks("fault")
     def clear_faults(self, kind: str = "all") -> None:
         """End this robot's faults of ``kind`` (``all``: every one, scheduled ones too)."""
-        return self.call(arm_calls.clear_faults(kind))
+        return self.call(task_calls.clear_faults(kind))
 
     @speaks("faults")
     def faults(self) -> list[str]:
         """This robot's faults: ``estop since 1.500``, ``noise 0.01 at 5.000`` [s]..."""
-        return self.call(arm_calls.FAULTS)
+        return self.call(task_calls.FAULTS)
 
     @speaks("reset")
     def reset(self) -> None:
         """Lift a stop (a protective one, or an emergency stop already cleared)."""
-        return self.call(arm_calls.RESET)
+        return self.call(task_calls.RESET)

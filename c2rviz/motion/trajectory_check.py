@@ -16,8 +16,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from ..errors import C2rvizError
-from ..tolerance import LIMIT_TOLERANCE, within_limit
+from ..errors import LIMIT_TOLERANCE, C2rvizError, within_limit
 from .limits import MotionLimits
 
 __all__ = [
@@ -73,7 +72,7 @@ first point too far for its time) is refused after little work."""
 
 
 def _within(values: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
-    """``tolerance.within_limit`` of each value, the limits broadcast against them."""
+    """``errors.within_limit`` of each value, the limits broadcast against them."""
     slack_low = LIMIT_TOLERANCE * np.maximum(1.0, np.abs(lower))
     slack_high = LIMIT_TOLERANCE * np.maximum(1.0, np.abs(upper))
     return (lower - slack_low <= values) & (values <= upper + slack_high)

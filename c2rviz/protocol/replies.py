@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from ..tolerance import limit_text
+from ..errors import limit_text
 from .registry import help_text
 
 OK = "ok"
@@ -59,7 +59,7 @@ def limit(value: float) -> str:
     Returns:
         10 significant digits, no trailing zeros (``-89.9999999``, ``3.1416``);
         ``0`` within 1e-9 of zero. A value printed this way and sent back is
-        within the limit's tolerance (``tolerance.within_limit``).
+        within the limit's tolerance (``errors.within_limit``).
     """
     return limit_text(value)
 

@@ -20,11 +20,10 @@ from typing import Final
 
 import pinocchio as pin
 
-from ..errors import JointLimitError
+from ..errors import JointLimitError, within_limit
 from ..protocol import replies
 from ..robot.frames import pose_se3, se3_pose
 from ..robot.model import Robot
-from ..tolerance import within_limit
 
 DEGREE_RAD: Final = math.pi / 180.0
 """Radians in a degree."""

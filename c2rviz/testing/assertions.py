@@ -21,8 +21,6 @@ from ..clients.client import Client
 from ..clients.records import State, read_pairs, read_stream_line
 from ..clients.stream import WatchStream
 
-__all__ = ["assert_arrives", "assert_goals_met", "assert_no_collision_during", "assert_part_at"]
-
 
 def _values(values: Sequence[float]) -> str:
     return ",".join(f"{value:.6g}" for value in values)

@@ -10,13 +10,12 @@ from typing import Any
 
 import pinocchio as pin
 
-from ..app.config import MOTION_FLAGS, Settings, find_ini, load_settings
+from ..app.config import MOTION_FLAGS, Settings, load_settings
 from ..app.members import Member, members
+from ..ini import find_ini
 from ..motion.planner import motion_limits
 from ..robot.model import Robot
 from ..world.clock import Clock
-
-__all__ = ["RUNTIME_OPTIONS", "give_back", "given_members", "settings_for", "take_members"]
 
 RUNTIME_OPTIONS = (
     "clock",

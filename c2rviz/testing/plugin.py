@@ -48,8 +48,6 @@ if TYPE_CHECKING:  # the server side loads when a test asks for a server, not wi
     from ..clients.client import Client
     from .server import TestServer
 
-__all__ = ["DEFAULT_CLOCK", "c2rviz", "c2rviz_server", "recording_name"]
-
 DEFAULT_CLOCK = "virtual"
 """Every server's clock unless the test, the command line or the ini says otherwise: a test
 judges what happened, which virtual time gives at once and the same every run; a test that

@@ -43,9 +43,7 @@ from ..world.observer import NullScene, Observer, Scene
 from ..world.state import RobotState
 from ..world.virtual_clock import parse_clock
 from ..world.world import World
-from .options import RUNTIME_OPTIONS, give_back, given_members, settings_for, take_members
-
-__all__ = ["RUNTIME_OPTIONS", "TestServer"]
+from .options import give_back, given_members, settings_for, take_members
 
 T = TypeVar("T")
 _START_TIMEOUT_S = 120.0
@@ -329,7 +327,7 @@ class TestServer:
             scene.stop()
 
     def _door_ports(self, doors: Sequence[Opened]) -> None:
-        from ..app.rosbridge_door import RosbridgeDoor
+        from ..app.doors import RosbridgeDoor
         from ..transports.crcl.server import CrclServer
 
         for opened in doors:

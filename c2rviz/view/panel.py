@@ -24,9 +24,9 @@ import numpy as np
 import pinocchio as pin
 import viser
 
+from ..errors import limit_text
 from ..robot.frames import se3_pose
-from ..tolerance import limit_text
-from ..world.observer import Marker
+from ..world.effects import Marker
 from ..world.world import RobotState
 from . import adapter
 

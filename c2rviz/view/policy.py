@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from urllib.parse import quote
 
 from ..errors import C2rvizError, shown
-from ..origins import LOOPBACK_HOSTS, normalize_origin, token_ok
+from ..ini import LOOPBACK_HOSTS, normalize_origin, token_ok
 from ..protocol.limits import below_floor, default, default_s
 
 __all__ = ["LOOPBACK_HOSTS", "DoorPolicy", "DoorPolicyError", "normalize_origin"]

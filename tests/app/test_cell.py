@@ -19,8 +19,8 @@ import pytest
 from support import ROOT, Client, load_robot
 from watch_support import read_until
 
-from c2rviz.app.cell import load_cell
 from c2rviz.app.cli import main
+from c2rviz.app.members import load_cell
 from c2rviz.collision import first_hit_between
 from c2rviz.errors import ConfigError
 from c2rviz.session import Services

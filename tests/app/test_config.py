@@ -9,8 +9,9 @@ import pytest
 from support import ROOT, Client
 
 from c2rviz.app.cli import main
-from c2rviz.app.config import ServerLimits, find_ini, load_settings
+from c2rviz.app.config import ServerLimits, load_settings
 from c2rviz.errors import ConfigError
+from c2rviz.ini import find_ini
 from c2rviz.robot.sources import load_source
 
 INI = ROOT / "cmdinterpreter.ini"

@@ -48,7 +48,8 @@ def test_a_program_without_a_viewer_never_loads_viser():
 START_RUN = """
 import sys
 import c2rviz.app.cli, c2rviz.app.program, c2rviz.view.viser_scene
-from c2rviz.app.config import find_ini, load_settings
+from c2rviz.app.config import load_settings
+from c2rviz.ini import find_ini
 from c2rviz.app.members import members
 from c2rviz.robot.visuals import load_link_geometry
 flags = {"robot_flag": False, "port_flag": False, "urdf_flag": False, "motion_flags": ()}

@@ -21,7 +21,7 @@ from roslibpy.ros import set_rosapi_timeout
 from support import ROOT, Process
 
 from c2rviz.app.config import load_settings
-from c2rviz.app.rosbridge_door import DEFAULT_ROSBRIDGE_PORT
+from c2rviz.app.doors import DEFAULT_ROSBRIDGE_PORT
 from c2rviz.errors import ConfigError
 
 WAIT_S = 60.0

@@ -28,7 +28,7 @@ from viewer_tabs import Tab
 from websockets.sync.client import connect
 
 from c2rviz.app.config import Settings
-from c2rviz.app.rosbridge_door import RosbridgeDoor
+from c2rviz.app.doors import RosbridgeDoor
 from c2rviz.errors import C2rvizError, JointLimitError
 from c2rviz.session import Services, Session, SessionDefaults
 from c2rviz.transports.crcl.server import CrclServer

@@ -22,10 +22,10 @@ from support import ROOT
 
 from c2rviz.clients import player
 from c2rviz.clients.client import Client
-from c2rviz.clients.display import shown
+from c2rviz.clients.connection import find_script, recording_folder
 from c2rviz.clients.errors import ReplyTooLong, UnexpectedReply
-from c2rviz.clients.options import find_script, recording_folder
 from c2rviz.clients.script import MAX_PROBLEMS, load_script
+from c2rviz.clients.stream import shown
 
 ENV = {**os.environ, "PYTHONUNBUFFERED": "1", "PYTHONPATH": str(ROOT)}  # this tree's c2rviz
 REPL_SCRIPT = str(ROOT / "clients" / "socketcmdline.py")

@@ -24,15 +24,10 @@ from types import SimpleNamespace
 import pytest
 from support import ROOT
 
-from c2rviz.clients import client as client_module
-from c2rviz.clients import connect as dialing
+from c2rviz.clients import connection as dialing
 from c2rviz.clients import player, repl
-from c2rviz.clients.client import (
-    Client,
-    ServerUnavailable,
-    default_address,
-    server_address,
-)
+from c2rviz.clients.client import Client
+from c2rviz.clients.connection import ServerUnavailable, default_address, server_address
 from c2rviz.clients.goto import motion_of
 from c2rviz.errors import C2rvizError, ConfigError
 from c2rviz.protocol import registry
@@ -96,7 +91,7 @@ def old_server(server, monkeypatch):
 def test_clients_do_not_import_pinocchio():
     code = (
         "import sys, c2rviz.clients.client, c2rviz.clients.repl, c2rviz.clients.player\n"
-        "print(c2rviz.clients.client.default_address())\n"
+        "print(c2rviz.clients.connection.default_address())\n"
         "print(sorted(m for m in ('pinocchio', 'viser', 'numpy') if m in sys.modules))"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
@@ -937,5 +932,5 @@ def test_repl_reconnects_when_the_server_restarts(c2rviz_process, terminal):
     assert term.finish()[0] == 0
 
 
-def test_client_module_names_the_bundled_commands_dir():
-    assert (client_module.COMMANDS_DIR / "motoman.txt").is_file()
+def test_connection_module_names_the_bundled_commands_dir():
+    assert (dialing.COMMANDS_DIR / "motoman.txt").is_file()

@@ -8,8 +8,8 @@ import asyncio
 import pytest
 
 from c2rviz import AsyncClient, CommandError
-from c2rviz.clients.arm_calls import clear_faults, fault, read_faults
 from c2rviz.clients.errors import ArgumentError
+from c2rviz.clients.task_calls import clear_faults, fault, read_faults
 from c2rviz.errors import C2rvizError
 from c2rviz.testing.server import TestServer
 

@@ -9,7 +9,7 @@ import pytest
 
 from c2rviz import AsyncClient, CommandError
 from c2rviz.clients.errors import ArgumentError
-from c2rviz.clients.scene_calls import PartState, Score, add_part, goal, read_parts, read_score
+from c2rviz.clients.task_calls import PartState, Score, add_part, goal, read_parts, read_score
 
 
 def test_part_lines():

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from c2rviz.clients.arm_calls import clear_faults, fault
 from c2rviz.clients.errors import ArgumentError
+from c2rviz.clients.task_calls import clear_faults, fault
 
 
 @pytest.mark.parametrize(

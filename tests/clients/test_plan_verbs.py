@@ -7,8 +7,8 @@ import asyncio
 import pytest
 
 from c2rviz import AsyncClient, Client, CommandError
-from c2rviz.clients.arm_calls import PlanSummary
 from c2rviz.clients.errors import ArgumentError
+from c2rviz.clients.task_calls import PlanSummary
 
 
 def test_planning_around_an_object_through_the_client(server) -> None:

@@ -7,7 +7,7 @@ import pinocchio as pin
 import pytest
 from support import load_robot
 
-from c2rviz.app.robot_options import gripper_from
+from c2rviz.app.ini_world import gripper_from
 from c2rviz.errors import ConfigError
 from c2rviz.robot.catalogue import example_robots
 from c2rviz.robot.model import Robot

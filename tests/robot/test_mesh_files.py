@@ -105,8 +105,9 @@ print("trimesh loaded:", "trimesh" in sys.modules)
 
 def example_meshes(*robots: str) -> list[Path]:
     """The .dae files the visuals of these example robots (``--robot NAME``) name."""
-    from c2rviz.app.config import find_ini, load_settings
+    from c2rviz.app.config import load_settings
     from c2rviz.app.members import members
+    from c2rviz.ini import find_ini
     from c2rviz.robot.urdf_elements import read_links
 
     found: set[Path] = set()
@@ -216,7 +217,8 @@ def test_a_robot_of_stl_obj_and_dae_meshes_builds_without_trimesh() -> None:
 
 BUILD_EXAMPLE = """
 import sys
-from c2rviz.app.config import find_ini, load_settings
+from c2rviz.app.config import load_settings
+from c2rviz.ini import find_ini
 from c2rviz.app.members import members
 from c2rviz.robot.visuals import load_link_geometry
 (member,), _ = members(load_settings(find_ini(None), {"robot": "ur5"}))

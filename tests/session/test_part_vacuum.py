@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 from support import ROBOTS, ROOT, Client, ServerLimits, ServerThread
 
-from c2rviz.app.robot_options import gripper_from
+from c2rviz.app.ini_world import gripper_from
 from c2rviz.robot.model import Robot
 from c2rviz.world.part_rules import is_vacuum, make_vacuum
 from c2rviz.world.virtual_clock import VirtualClock

@@ -11,11 +11,10 @@ from hypothesis import given
 from hypothesis import strategies as st
 from support import ROBOTS, load_robot
 
-from c2rviz import tolerance
-from c2rviz.errors import JointLimitError
+from c2rviz import errors
+from c2rviz.errors import LIMIT_TOLERANCE, JointLimitError, limit_text, texts_apart, within_limit
 from c2rviz.protocol import replies
 from c2rviz.session import Services, Session
-from c2rviz.tolerance import LIMIT_TOLERANCE, limit_text, texts_apart, within_limit
 from c2rviz.world.world import World
 
 
@@ -52,14 +51,14 @@ def test_a_limit_printed_with_10_digits_is_within_it(name: str) -> None:
 
 
 def test_the_session_accepts_what_within_limit_accepts(monkeypatch: pytest.MonkeyPatch) -> None:
-    """One tolerance: Session.to_si follows tolerance.within_limit, whatever its slack."""
+    """One tolerance: Session.to_si follows errors.within_limit, whatever its slack."""
     robot = load_robot()
     session = Session(Services(World(robot)))
     upper = robot.upper[1]
     assert session.to_si([1], [upper * (1 + 5e-10)]) == [upper]  # at the limit
     with pytest.raises(JointLimitError):
         session.to_si([1], [upper * (1 + 5e-4)])
-    monkeypatch.setattr(tolerance, "LIMIT_TOLERANCE", 1e-3)
+    monkeypatch.setattr(errors, "LIMIT_TOLERANCE", 1e-3)
     assert session.to_si([1], [upper * (1 + 5e-4)]) == [upper]
 
 
@@ -100,7 +99,7 @@ def test_a_refused_value_never_looks_inside_the_printed_limits(lower, width, pas
 
 
 def test_the_module_is_light() -> None:
-    code = "import sys, c2rviz.tolerance; print(sorted(m for m in sys.modules if 'numpy' in m))"
+    code = "import sys, c2rviz.errors; print(sorted(m for m in sys.modules if 'numpy' in m))"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
     assert LIMIT_TOLERANCE == 1e-9

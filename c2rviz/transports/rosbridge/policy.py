@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ...errors import C2rvizError
-from ...origins import LOOPBACK_HOSTS, normalize_origin, token_ok
+from ...ini import LOOPBACK_HOSTS, normalize_origin, token_ok
 from ...protocol.limits import below_floor, default
 
 

@@ -14,8 +14,7 @@ from crcl_support import DONE, CrclClient, command
 from support import ROOT, Process, load_robot
 
 from c2rviz.app.config import Settings, load_settings
-from c2rviz.app.crcl_door import open_crcl
-from c2rviz.app.doors import OPENERS, close_doors
+from c2rviz.app.doors import OPENERS, close_doors, open_crcl
 from c2rviz.app.members import Member
 from c2rviz.errors import ConfigError
 from c2rviz.motion.planner import motion_limits

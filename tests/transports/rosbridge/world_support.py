@@ -25,7 +25,7 @@ import roslibpy
 from support import Client
 
 from c2rviz.app.config import Settings
-from c2rviz.app.rosbridge_door import RosbridgeDoor
+from c2rviz.app.doors import RosbridgeDoor
 from c2rviz.robot.model import Robot
 from c2rviz.session import Services
 from c2rviz.transports.rosbridge import COMMAND_SERVICE_TYPE
