@@ -11,14 +11,14 @@ beside it that it re-exports) reaches inside viser, and no other module does:
   origin and token checks, a frame and a client limit, a screen on every frame
   (``accept_input`` registers the inputs the page may set).
 * fast sends (``queue_pose``, ``PoseBatch``, ``set_gui_value``, ``set_chart_data``,
-  in ``viser_sends.py``): a pose, a slider value or a chart's data, cheaply.
+  in ``viser_internals.py``): a pose, a slider value or a chart's data, cheaply.
 * a purge of removal records (``purge_removed``): viser keeps a record of each
   removed scene node until a new tab connects.
 * a stop in bounded time (``stop``), even with a tab that never reads.
 
 ``check()`` (``viser_internals.py``) looks for every private name listed in
 ``INTERNALS`` (a test checks that the list names every private attribute used here and
-in ``viser_sends.py``) and raises ``ViserInternalsError`` if one is gone, so a viser
+there) and raises ``ViserInternalsError`` if one is gone, so a viser
 upgrade fails loudly at start instead of freezing the page. Functions run on the
 caller's thread unless they say otherwise.
 """
@@ -43,11 +43,14 @@ from .policy import DoorPolicy
 from .viser_internals import (
     INTERNALS,
     WRITTEN_FOR,
+    PoseBatch,
     ViserInternalsError,
     check,
     missing_internals,
+    queue_pose,
+    set_chart_data,
+    set_gui_value,
 )
-from .viser_sends import PoseBatch, queue_pose, set_chart_data, set_gui_value
 from .ws_guard import Door, GrabCallback, GuardedConnection, HandleCallback, InputCallback
 
 __all__ = [  # the view's one way to viser's internals

@@ -3,7 +3,7 @@
 ``read_commands`` streams the command file the recorder wrote (``radians``,
 ``motion off``, then ``joints``, ``sleep``, ``mark``, ``color``, ``marker``,
 ``clear`` and, when a recording holds them, ``object``, ``part`` and ``grip`` lines) in
-``record_rows.CHUNK_BYTES`` pieces. Most of a long recording is ``joints`` and
+``record_frames.CHUNK_BYTES`` pieces. Most of a long recording is ``joints`` and
 ``sleep`` lines: a piece with nothing else in it costs a regular-expression pass
 to add up its sleeps. The rest is parsed line by line (``protocol.parse_line``).
 
@@ -32,7 +32,7 @@ from ..protocol.verbs.markers import Clear, Color, Mark, MarkerShape
 from ..protocol.verbs.parts import PartEdit
 from ..protocol.verbs.queries import Sleep
 from ..protocol.verbs.workcell import ObjectEdit
-from .record_rows import CHUNK_BYTES
+from .record_frames import CHUNK_BYTES
 
 __all__ = [
     "MAX_HTML_MARKS",

@@ -23,15 +23,13 @@ if TYPE_CHECKING:
 
     from ..session.services import Services
     from ..world.world import World
-    from .camera_layer import CameraLayer
+    from .cell_layers import CameraLayer, PartsLayer, TrailLayer, WorkcellLayer
     from .handle import ToolHandles
     from .instruments import Instruments
     from .markers import MarkerLayer
     from .page_input import PageInput
     from .panel import RobotPanel, StatePanel
-    from .parts_layer import PartsLayer
     from .robot_view import RobotView
-    from .workcell_layer import TrailLayer, WorkcellLayer
 
 __all__ = ["SLICE_S", "SceneSends"]
 

@@ -43,20 +43,18 @@ from ..world.effects import Marker, Scene
 from ..world.goals import Goal
 from ..world.parts import Part
 from . import adapter, scene_send
-from .camera_layer import CameraLayer
+from .cell_layers import CameraLayer, PartsLayer, TrailLayer, WorkcellLayer
 from .handle import ToolHandles
 from .instruments import Instruments
 from .markers import MarkerLayer
 from .page_cell import fault_banner
 from .page_input import PageInput
 from .panel import RECENT_COMMANDS, RobotPanel, StatePanel
-from .parts_layer import PartsLayer
 from .policy import DoorPolicy
 from .robot_view import RobotView, node_name
 from .scene_send import SceneSends
 from .scheduler import SendScheduler
 from .timeline import Timeline
-from .workcell_layer import TrailLayer, WorkcellLayer
 
 __all__ = ["RECENT_COMMANDS", "STOP_TIMEOUT_S", "ViserScene"]
 
