@@ -1,7 +1,7 @@
 """Browser origins, as the doors that browsers reach check them (pure, standard library).
 
 Browsers send ``Origin`` with every websocket they open and do not hold websockets to the
-same-origin rule, so the page's door (``view.policy``) and rosbridge's
+same-origin rule, so the page's door (``view.door_rules``) and rosbridge's
 (``transports.rosbridge.policy``) both compare it with the origins they allow, spelled
 one way by ``normalize_origin``, and both read a URL's token with ``token_ok``. A host
 name that resolves to 127.0.0.1 is not enough (DNS rebinding): the loopback names are fixed.

@@ -39,7 +39,7 @@ from typing import Any
 import viser
 import websockets.asyncio.server
 
-from .policy import DoorPolicy
+from .door_rules import DoorPolicy
 from .viser_internals import (
     INTERNALS,
     WRITTEN_FOR,

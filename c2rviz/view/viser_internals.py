@@ -31,7 +31,7 @@ from viser import _messages
 from viser.infra import ClientId
 
 from ..errors import C2rvizError
-from .page_messages import CAMERA_FIELDS, Click
+from .door_rules import CAMERA_FIELDS, Click
 
 log = logging.getLogger("c2rviz.view")
 
