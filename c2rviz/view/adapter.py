@@ -40,39 +40,18 @@ import viser
 import websockets.asyncio.server
 
 from .door_rules import DoorPolicy
-from .viser_internals import (
-    INTERNALS,
-    WRITTEN_FOR,
-    PoseBatch,
-    ViserInternalsError,
-    check,
-    missing_internals,
-    queue_pose,
-    set_chart_data,
-    set_gui_value,
-)
-from .ws_guard import Door, GrabCallback, GuardedConnection, HandleCallback, InputCallback
 
-__all__ = [  # the view's one way to viser's internals
-    "INTERNALS",
-    "LIGHTINGS",
-    "PoseBatch",
-    "WRITTEN_FOR",
-    "ViserInternalsError",
-    "accept_click",
-    "accept_handle",
-    "accept_input",
-    "buffered_messages",
-    "check",
-    "door",
-    "missing_internals",
-    "purge_removed",
-    "queue_pose",
-    "set_chart_data",
-    "set_gui_value",
-    "start",
-    "stop",
-]
+# The view's one way to viser's internals: what it needs of viser_internals, re-exported.
+from .viser_internals import INTERNALS as INTERNALS
+from .viser_internals import WRITTEN_FOR as WRITTEN_FOR
+from .viser_internals import PoseBatch as PoseBatch
+from .viser_internals import ViserInternalsError as ViserInternalsError
+from .viser_internals import check as check
+from .viser_internals import missing_internals as missing_internals
+from .viser_internals import queue_pose as queue_pose
+from .viser_internals import set_chart_data as set_chart_data
+from .viser_internals import set_gui_value as set_gui_value
+from .ws_guard import Door, GrabCallback, GuardedConnection, HandleCallback, InputCallback
 
 log = logging.getLogger("c2rviz.view")
 

@@ -38,8 +38,6 @@ from .door_rules import RateLimitedLog
 from .page_input import Handoff
 from .robot_view import wxyz
 
-__all__ = ["DEGREE", "HANDLE_SCALE", "ToolHandles", "moveto_line"]
-
 log = logging.getLogger("c2rviz.view")
 
 HANDLE_SCALE = 0.2  # the gizmo's size [m]

@@ -36,13 +36,10 @@ from .ghost import RobotGhost
 from .history import RobotHistory
 from .markers import MarkerLayer
 from .page_input import PageInput
-from .panel import RobotPanel
+from .panel import RobotPanel, RobotReadout
 from .plots import RobotPlots
-from .readout import RobotReadout
 from .robot_view import RobotView
 from .timeline import Timeline
-
-__all__ = ["Instruments"]
 
 
 class Instruments:

@@ -39,8 +39,6 @@ from .page_frame import MirrorClock, MirrorWorld, _Path
 from .page_snapshot import Hello, MirrorCell, Snapshot
 from .viser_scene import ViserScene
 
-__all__ = ["REST_PER_WORK", "SLICE_S", "ForwardingSession", "MirrorWorld", "PageProcess", "main"]
-
 log = logging.getLogger("c2rviz.view")
 
 REST_PER_WORK = 0.25

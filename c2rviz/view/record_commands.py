@@ -34,16 +34,6 @@ from ..protocol.verbs.queries import Sleep
 from ..protocol.verbs.workcell import ObjectEdit
 from .record_frames import CHUNK_BYTES
 
-__all__ = [
-    "MAX_HTML_MARKS",
-    "MAX_HTML_OBJECTS",
-    "PART_RGB",
-    "Commands",
-    "ObjectVersion",
-    "PartShape",
-    "read_commands",
-]
-
 MAX_HTML_MARKS = 100_000
 """Most marker changes (a mark, a clear) the page holds; later ones are left out."""
 MAX_HTML_OBJECTS = 256

@@ -54,8 +54,6 @@ from .robot_view import RobotView, node_name
 from .scene_send import SceneSends, SendScheduler
 from .timeline import Timeline
 
-__all__ = ["RECENT_COMMANDS", "STOP_TIMEOUT_S", "ViserScene"]
-
 log = logging.getLogger("c2rviz.view")
 
 STOP_TIMEOUT_S = 0.5  # longest wait for viser to stop [s]; it goes on stopping after

@@ -56,14 +56,6 @@ from ..errors import shown
 from . import door_rules as frames
 from .door_rules import DoorPolicy, RateLimitedLog
 
-__all__ = [
-    "Door",
-    "GuardedConnection",
-    "GrabCallback",
-    "HandleCallback",
-    "InputCallback",
-]
-
 log = logging.getLogger("c2rviz.view")
 
 InputCallback = Callable[[int, "bool | float | str"], None]
