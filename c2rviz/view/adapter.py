@@ -7,7 +7,7 @@ beside it that it re-exports) reaches inside viser, and no other module does:
 * a door on the websocket (``start``): viser builds its websockets server on
   its own thread with fixed settings (50 MiB frames, no origin check, every
   page message applied). While viser starts, ``start`` lets viser's call of
-  ``websockets.asyncio.server.serve`` through with a ``door.Door`` in front:
+  ``websockets.asyncio.server.serve`` through with a ``ws_guard.Door`` in front:
   origin and token checks, a frame and a client limit, a screen on every frame
   (``accept_input`` registers the inputs the page may set).
 * fast sends (``queue_pose``, ``PoseBatch``, ``set_gui_value``, ``set_chart_data``,
