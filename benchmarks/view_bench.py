@@ -35,7 +35,7 @@ import viser
 
 from c2rviz.robot.model import Robot
 from c2rviz.view import adapter
-from c2rviz.view.policy import DoorPolicy
+from c2rviz.view.door_rules import DoorPolicy
 
 ROOT = Path(__file__).resolve().parent.parent
 

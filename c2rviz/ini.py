@@ -7,7 +7,7 @@ a client finds the server's address without loading any robot. Every problem is 
 ``ConfigError`` that names the file and what it accepts.
 
 Browsers send ``Origin`` with every websocket they open and do not hold websockets to the
-same-origin rule, so the page's door (``view.policy``) and rosbridge's
+same-origin rule, so the page's door (``view.door_rules``) and rosbridge's
 (``transports.rosbridge.policy``) both compare it with the origins they allow (the ini's
 ``viewer_origins``, the flags), spelled one way by ``normalize_origin``, and both read a
 URL's token with ``token_ok``. A host name that resolves to 127.0.0.1 is not enough (DNS

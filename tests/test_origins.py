@@ -6,7 +6,7 @@ import pytest
 
 from c2rviz.ini import token_ok
 from c2rviz.transports.rosbridge.policy import RosbridgePolicy
-from c2rviz.view.policy import DoorPolicy
+from c2rviz.view.door_rules import DoorPolicy
 
 
 @pytest.mark.parametrize(

@@ -92,7 +92,7 @@ def _open_scene(
             settings.viewer_lighting,
         )
         return PageLink(services, config, spawned)
-    from ..view.policy import DoorPolicy
+    from ..view.door_rules import DoorPolicy
     from ..view.viser_scene import ViserScene  # viser is heavy: import only when it is used
 
     policy = DoorPolicy(settings.viewer_origins, token, settings.max_viewers)
@@ -135,7 +135,7 @@ async def serve(
     """Run the viewer and a command server per robot until ``quit``, SIGINT or SIGTERM.
 
     ``page_process``: the page runs in a process of its own (``--page-process``,
-    docs/page.md), started here unless ``spawned`` (``page_start.early``), stopped last.
+    docs/page.md), started here unless ``spawned`` (``page_start.fork``), stopped last.
 
     ``members`` are the robots, each by the name the user chose (``--robot kuka_lwr``,
     or a cell's member name), which the banner and ``names`` say. Every command port

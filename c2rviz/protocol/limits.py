@@ -2,7 +2,7 @@
 
 Each door has one limits object, built from its rows here: the text port's
 ``session.services.ServerLimits``, CRCL's ``transports.crcl.server.CrclLimits``, rosbridge's
-``transports.rosbridge.policy.RosbridgePolicy`` and the page's ``view.policy.DoorPolicy``.
+``transports.rosbridge.policy.RosbridgePolicy`` and the page's ``view.door_rules.DoorPolicy``.
 A row gives a limit's default and the lowest (and, where the ini and flags set it, the
 highest) value allowed; the objects take their defaults with ``default`` and those that
 check themselves find the first value below its floor with ``below_floor``. docs/limits.md

@@ -343,7 +343,7 @@ class TestServer:
             self._stop.set()
 
     def _open_viewer(self) -> Scene:
-        from ..view.policy import DoorPolicy
+        from ..view.door_rules import DoorPolicy
         from ..view.viser_scene import ViserScene
 
         settings = self.settings

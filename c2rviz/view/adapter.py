@@ -7,18 +7,18 @@ beside it that it re-exports) reaches inside viser, and no other module does:
 * a door on the websocket (``start``): viser builds its websockets server on
   its own thread with fixed settings (50 MiB frames, no origin check, every
   page message applied). While viser starts, ``start`` lets viser's call of
-  ``websockets.asyncio.server.serve`` through with a ``door.Door`` in front:
+  ``websockets.asyncio.server.serve`` through with a ``ws_guard.Door`` in front:
   origin and token checks, a frame and a client limit, a screen on every frame
   (``accept_input`` registers the inputs the page may set).
 * fast sends (``queue_pose``, ``PoseBatch``, ``set_gui_value``, ``set_chart_data``,
-  in ``viser_sends.py``): a pose, a slider value or a chart's data, cheaply.
+  in ``viser_internals.py``): a pose, a slider value or a chart's data, cheaply.
 * a purge of removal records (``purge_removed``): viser keeps a record of each
   removed scene node until a new tab connects.
 * a stop in bounded time (``stop``), even with a tab that never reads.
 
 ``check()`` (``viser_internals.py``) looks for every private name listed in
 ``INTERNALS`` (a test checks that the list names every private attribute used here and
-in ``viser_sends.py``) and raises ``ViserInternalsError`` if one is gone, so a viser
+there) and raises ``ViserInternalsError`` if one is gone, so a viser
 upgrade fails loudly at start instead of freezing the page. Functions run on the
 caller's thread unless they say otherwise.
 """
@@ -39,37 +39,19 @@ from typing import Any
 import viser
 import websockets.asyncio.server
 
-from .policy import DoorPolicy
-from .viser_internals import (
-    INTERNALS,
-    WRITTEN_FOR,
-    ViserInternalsError,
-    check,
-    missing_internals,
-)
-from .viser_sends import PoseBatch, queue_pose, set_chart_data, set_gui_value
-from .ws_guard import Door, GrabCallback, GuardedConnection, HandleCallback, InputCallback
+from .door_rules import DoorPolicy
 
-__all__ = [  # the view's one way to viser's internals
-    "INTERNALS",
-    "LIGHTINGS",
-    "PoseBatch",
-    "WRITTEN_FOR",
-    "ViserInternalsError",
-    "accept_click",
-    "accept_handle",
-    "accept_input",
-    "buffered_messages",
-    "check",
-    "door",
-    "missing_internals",
-    "purge_removed",
-    "queue_pose",
-    "set_chart_data",
-    "set_gui_value",
-    "start",
-    "stop",
-]
+# The view's one way to viser's internals: what it needs of viser_internals, re-exported.
+from .viser_internals import INTERNALS as INTERNALS
+from .viser_internals import WRITTEN_FOR as WRITTEN_FOR
+from .viser_internals import PoseBatch as PoseBatch
+from .viser_internals import ViserInternalsError as ViserInternalsError
+from .viser_internals import check as check
+from .viser_internals import missing_internals as missing_internals
+from .viser_internals import queue_pose as queue_pose
+from .viser_internals import set_chart_data as set_chart_data
+from .viser_internals import set_gui_value as set_gui_value
+from .ws_guard import Door, GrabCallback, GuardedConnection, HandleCallback, InputCallback
 
 log = logging.getLogger("c2rviz.view")
 

@@ -27,8 +27,6 @@ import viser
 
 from .robot_view import RobotView
 
-__all__ = ["PATH_POINTS", "PATH_RGB", "REFUSED_RGBA", "REFUSED_S", "RobotGhost", "tool_path"]
-
 PATH_POINTS = 256
 """Points of a drawn path at most."""
 PATH_RGB = (0.15, 0.45, 1.0)

@@ -34,11 +34,9 @@ from ..robot.frames import in_base, se3_pose, wxyz_se3
 from ..session.session import Session
 from ..world.state import RobotState
 from . import adapter
-from .handoff import Handoff
-from .ratelog import RateLimitedLog
+from .door_rules import RateLimitedLog
+from .page_input import Handoff
 from .robot_view import wxyz
-
-__all__ = ["DEGREE", "HANDLE_SCALE", "ToolHandles", "moveto_line"]
 
 log = logging.getLogger("c2rviz.view")
 

@@ -41,15 +41,6 @@ import pinocchio as pin
 from ..collision.workcell import WorkcellObject
 from ..world.state import MAX_MARKERS, Marker, RobotState
 
-__all__ = [
-    "HISTORY_S",
-    "MAX_MARKER_EVENTS",
-    "MAX_OBJECT_EVENTS",
-    "MAX_SAMPLES",
-    "RobotHistory",
-    "Window",
-]
-
 HISTORY_S = 300.0
 """How far back the live page can look [s of the world's clock]."""
 MAX_SAMPLES = 30_000

@@ -31,18 +31,15 @@ from ..collision.workcell import WorkcellObject
 from ..errors import C2rvizError, PathCollides
 from ..world.state import Marker
 from ..world.world import World
+from .cell_layers import WorkcellLayer
 from .ghost import RobotGhost
 from .history import RobotHistory
 from .markers import MarkerLayer
 from .page_input import PageInput
-from .panel import RobotPanel
+from .panel import RobotPanel, RobotReadout
 from .plots import RobotPlots
-from .readout import RobotReadout
 from .robot_view import RobotView
 from .timeline import Timeline
-from .workcell_layer import WorkcellLayer
-
-__all__ = ["Instruments"]
 
 
 class Instruments:

@@ -19,8 +19,6 @@ import pinocchio as pin
 
 from ..robot.model import Robot
 
-__all__ = ["LinkTree", "TreeLink"]
-
 
 @dataclasses.dataclass(frozen=True)
 class TreeLink:

@@ -22,8 +22,6 @@ import numpy as np
 
 from ..errors import C2rvizError
 
-__all__ = ["MAX_MESSAGE", "ChannelError", "FrameReader", "encode"]
-
 MAX_MESSAGE = 64 << 20
 """Largest message either side accepts [bytes] (a snapshot of many robots' markers)."""
 

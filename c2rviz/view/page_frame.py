@@ -1,20 +1,29 @@
 """What one frame to the page process carries: the notes the world's effects leave, and
-the ``frame`` message made of them (``--page-process``; ``page_link`` sends it).
+the ``frame`` message made of them (``--page-process``; ``page_link`` sends it); and the
+world those frames pose in the page process (``MirrorWorld``).
 
 ``FrameNotes`` is the scene the world tells (``Scene``): each effect is noted in O(1)
 (a joint sample, a robot changed, an event in order, parts, goals or cameras changed, a
 robot's faults changed) and asks for a frame (``request``). ``frame`` then makes one
 message: each changed robot's samples and state, then the events, then the newest lines
 said since the last frame (as many as the 'last commands' readout keeps: every line is
-counted, but a flood of them is not a flood of events), then the parts, goals,
-cameras and fault banners as rows (``page_cell``) when they changed, the ghost's path
-when it changed, and the trails when one was turned on or off or cleared.
+counted, but a flood of them is not a flood of events), then the parts, goals, cameras and
+fault banners as rows (``page_snapshot``) when they changed, the ghost's path when it
+changed, and the trails when one was turned on or off or cleared.
+
+``MirrorWorld`` is the world of the command process as the page process sees it: a
+``World`` built from a ``page_snapshot.Snapshot``: the same robots, placed and posed as
+they are, with the same limits. It never moves on its own: the frames that follow
+(``page_process``) pose it, say which robots move and how long they have left
+(``_Travels``), and hand it the ghost's path as joint rows (``_Path``). Its clock
+(``MirrorClock``) is the command process's, as last heard of.
 """
 
 from __future__ import annotations
 
 import itertools
 import pickle
+import time
 from collections import deque
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -27,12 +36,13 @@ from ..errors import C2rvizError, PathCollides
 from ..session.services import Services
 from ..session.session import Session
 from ..world.cameras import Camera
-from ..world.observer import Marker, Scene
-from ..world.part_rules import Goal
+from ..world.clock import Clock
+from ..world.effects import Marker, Scene
+from ..world.goals import Goal
 from ..world.parts import Part
-from .page_cell import camera_rows, fault_banner, goal_rows, part_rows
-
-__all__ = ["PATH_ROWS", "SAMPLES_KEPT", "FrameNotes", "path_rows", "trail_state"]
+from ..world.state import RobotState
+from ..world.world import World
+from .page_snapshot import Snapshot, camera_rows, fault_banner, goal_rows, part_rows, trail_state
 
 SAMPLES_KEPT = 256
 """Joint samples of one robot kept for one frame (the newest; a flood of ``joints``
@@ -218,11 +228,6 @@ class FrameNotes(Scene):
         return ["frame", world.clock.now(), robots, events]
 
 
-def trail_state(services: Services) -> list[list[Any]]:
-    """The robots whose trail is on, each with how often it was cleared: [name, clears]."""
-    return [[name, trail.clears] for name, trail in sorted(services.trails.trails.items())]
-
-
 def path_rows(path: Any, now: float) -> list[list[float]] | None:
     """The joint rows of a ghost's path (``ghost.tool_path`` draws them), or None."""
     if path is None:
@@ -234,3 +239,82 @@ def path_rows(path: Any, now: float) -> list[list[float]] | None:
         times = np.linspace(now, max(float(path.arrival), now), PATH_ROWS)
         rows = [path.sample(float(t)) for t in times]
     return np.asarray(rows, dtype=float).tolist()  # type: ignore[no-any-return]
+
+
+class MirrorClock(Clock):
+    """The command process's clock, as last heard of, running on at real speed."""
+
+    def __init__(self, t: float) -> None:
+        self.offset = t - time.monotonic()
+
+    def now(self) -> float:
+        return time.monotonic() + self.offset
+
+    def heard(self, t: float) -> None:
+        """The command process's clock read ``t`` just now."""
+        self.offset = t - time.monotonic()
+
+
+class _Path:
+    """A ghost's path as the command process sent it: joint rows (``ghost.tool_path``)."""
+
+    def __init__(self, rows: list[list[float]]) -> None:
+        self.joint_path = np.asarray(rows, dtype=float)
+        self.arrival = 0.0
+
+
+class _Travel:
+    """A robot's motion as the command process last said: moving or not, its path."""
+
+    def __init__(self) -> None:
+        self.active = False
+        self.path: _Path | None = None
+        self.seconds_left = 0.0
+
+
+class _Travels:
+    """Stands in for ``world.moves.Travels``: what the page reads of it."""
+
+    def __init__(self, names: Sequence[str]) -> None:
+        self.by_robot = {name: _Travel() for name in names}
+
+    def seconds_left(self, state: RobotState) -> float:
+        return self.by_robot[state.name].seconds_left
+
+    def now(self, state: RobotState) -> tuple[float, ...]:
+        return state.q
+
+    def stop_all(self) -> None:
+        pass
+
+
+class MirrorWorld(World):
+    """The world of the command process, as the frames tell it; see the module docstring.
+
+    Attributes:
+        objects: Each robot's workcell objects (there is no collision model here).
+    """
+
+    def __init__(self, snap: Snapshot, hz: float) -> None:
+        super().__init__(
+            {name: r.robot for name, r in snap.robots.items()},
+            clock=MirrorClock(snap.t),
+            hz=1.0 / snap.frame_s,
+            origins={name: r.origin for name, r in snap.robots.items()},
+            limits={name: r.limits for name, r in snap.robots.items()},
+        )
+        self.travels = _Travels(list(snap.robots))  # type: ignore[assignment]
+        self.observers = []  # no collision checks here: the scene, and a trail when on
+        self.objects: dict[str, list[WorkcellObject]] = {}
+        for name, r in snap.robots.items():
+            state = self.robots[name]
+            state.q, state.target, state.opening = r.q, r.target, r.opening
+            state.tool, state.ghost = r.tool, r.ghost
+            state.markers.extend(r.markers)
+            self.objects[name] = list(r.objects)
+            self.moved(name, r.moving, r.seconds_left)
+
+    def moved(self, name: str, moving: bool, seconds_left: float) -> None:
+        travel = self.travels.by_robot[name]
+        travel.active = moving
+        travel.seconds_left = seconds_left  # type: ignore[attr-defined]

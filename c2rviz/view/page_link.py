@@ -38,13 +38,11 @@ from typing import Any
 from ..errors import C2rvizError, MotionInterrupted
 from ..session.services import Services
 from ..session.session import Session
+from .door_rules import RateLimitedLog
 from .page_channel import ChannelError, FrameReader, encode
-from .page_frame import SAMPLES_KEPT, FrameNotes
+from .page_frame import FrameNotes
 from .page_snapshot import Hello, PageConfig, snapshot
 from .page_start import PageProcessHandle, Spawned, spawn
-from .ratelog import RateLimitedLog
-
-__all__ = ["BACKLOG", "IN_FLIGHT", "SAMPLES_KEPT", "PageLink"]
 
 log = logging.getLogger("c2rviz.view")
 

@@ -33,20 +33,17 @@ from ..errors import C2rvizError, PathCollides
 from ..session.services import Services
 from ..session.session import Reply, Session
 from ..world.state import Marker
-from .mirror_world import MirrorClock, MirrorWorld, _Path
-from .page_cell import MirrorCell
+from .door_rules import DoorPolicy
 from .page_channel import FrameReader, encode
-from .page_snapshot import Hello, Snapshot
-from .policy import DoorPolicy
+from .page_frame import MirrorClock, MirrorWorld, _Path
+from .page_snapshot import Hello, MirrorCell, Snapshot
 from .viser_scene import ViserScene
-
-__all__ = ["REST_PER_WORK", "SLICE_S", "ForwardingSession", "MirrorWorld", "PageProcess", "main"]
 
 log = logging.getLogger("c2rviz.view")
 
 REST_PER_WORK = 0.25
 """The page's sends leave its loop this much time per second of work (the program's
-page leaves 1.0, ``scheduler.REST_PER_WORK``, for its clients' lines): here the loop
+page leaves 1.0, ``scene_send.REST_PER_WORK``, for its clients' lines): here the loop
 serves no client, only the channel, whose frames wait in the socket meanwhile."""
 SLICE_S = 0.03
 """The longest slice of a send here [s] (the program's page: ``scene_send.SLICE_S``):

@@ -28,17 +28,6 @@ import time
 import traceback
 from typing import Protocol
 
-__all__ = [
-    "SCHEDULING",
-    "Forked",
-    "PageProcessHandle",
-    "Spawned",
-    "behind_commands",
-    "close",
-    "fork",
-    "spawn",
-]
-
 SCHEDULING = getattr(os, "SCHED_BATCH", None)
 """The page process's scheduling policy (Linux's ``SCHED_BATCH``): it keeps its fair share
 of a CPU, but waking (a frame arrived, viser's thread has bytes to send) it never

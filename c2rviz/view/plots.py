@@ -31,19 +31,8 @@ import viser.uplot as uplot
 from ..robot.model import Robot
 from . import adapter
 from .history import RobotHistory
-from .page_values import within
 from .panel import short_label
-
-__all__ = [
-    "COLORS",
-    "DEFAULT_WINDOW_S",
-    "PLOT_HZ",
-    "PLOTS_PER_S",
-    "PLOT_POINTS",
-    "WINDOW_RANGE_S",
-    "RobotPlots",
-    "thin",
-]
+from .timeline import within
 
 WINDOW_RANGE_S = (5.0, 120.0)
 """Shortest and longest plot window [s]."""

@@ -3,7 +3,7 @@
 ``read_commands`` streams the command file the recorder wrote (``radians``,
 ``motion off``, then ``joints``, ``sleep``, ``mark``, ``color``, ``marker``,
 ``clear`` and, when a recording holds them, ``object``, ``part`` and ``grip`` lines) in
-``record_rows.CHUNK_BYTES`` pieces. Most of a long recording is ``joints`` and
+``record_frames.CHUNK_BYTES`` pieces. Most of a long recording is ``joints`` and
 ``sleep`` lines: a piece with nothing else in it costs a regular-expression pass
 to add up its sleeps. The rest is parsed line by line (``protocol.parse_line``).
 
@@ -28,19 +28,9 @@ import pinocchio as pin
 from ..errors import C2rvizError
 from ..protocol.grammar import MARKER_SHAPES, parse_line
 from ..protocol.verbs.parts import PartEdit
-from ..protocol.verbs.scene import ObjectEdit
-from ..protocol.verbs.seed import Clear, Color, Mark, MarkerShape, Sleep, Units
-from .record_rows import CHUNK_BYTES
-
-__all__ = [
-    "MAX_HTML_MARKS",
-    "MAX_HTML_OBJECTS",
-    "PART_RGB",
-    "Commands",
-    "ObjectVersion",
-    "PartShape",
-    "read_commands",
-]
+from ..protocol.verbs.queries import Sleep
+from ..protocol.verbs.workcell import ObjectEdit
+from .record_frames import CHUNK_BYTES
 
 MAX_HTML_MARKS = 100_000
 """Most marker changes (a mark, a clear) the page holds; later ones are left out."""

@@ -5,17 +5,24 @@ live page draws it, a batched node per marker shape, a hidden node per object
 the recording places), built in a private offline viser server and serialized
 by viser, and our player (``record_player.js`` and ``.css``, next to this
 module), which poses the arm from the recording's frames in the browser
-(``record_kinematics``: Pinocchio's numbers), shows the markers and objects at
+(``record_frames.chain_kinematics``: Pinocchio's numbers), shows the markers and objects at
 their times, backwards too, moves the parts to each frame's poses, and gives
 play/pause, seek, speed (0.25x to 4x), a frame back and on, the time shown, a readout
 and plots that follow the time
 shown.
 
-Building it streams NAME.csv and NAME.txt (``record_rows``, ``record_commands``):
+Building it streams NAME.csv and NAME.txt (``record_frames``, ``record_commands``):
 its memory does not grow with the recording's length, and the page keeps at most
 ``HTML_HZ`` frames a second (``MAX_HTML_FRAMES`` in all: a longer run is thinned
 more). A recording whose files disagree, or that was cut short, opens with what
 was good and a sentence saying what was not, never a blank or frozen page.
+
+The parts (``add_parts``): each part NAME.csv has poses for (``Frames.parts``) gets a
+node at ``/parts/robot/NAME`` in the world frame, its shape, size and colour from the
+first NAME.txt line that added it (``Commands.parts``), with its name as a label over it,
+as the live page draws parts (``cell_layers.PartsLayer``). It is placed at its first
+frame's pose (hidden while it is not there); the player (``record_player.js``) moves it
+to each frame's pose. A part with poses but no ``part`` line is left out, and said.
 """
 
 from __future__ import annotations
@@ -40,15 +47,11 @@ from ..robot.model import Robot
 from ..robot.visuals import load_link_geometry
 from ..world.state import RobotState
 from . import adapter
-from .marker_meshes import marker_mesh
+from .cell_layers import add_object
+from .markers import marker_mesh
 from .record_commands import Commands, read_commands
-from .record_kinematics import chain_kinematics
-from .record_parts import add_parts, placement_list
-from .record_rows import HTML_HZ, MAX_HTML_FRAMES, Frames, read_frames
-from .robot_view import RobotView, node_name
-from .workcell_layer import add_object
-
-__all__ = ["HTML_HZ", "MAX_HTML_FRAMES", "write_html"]
+from .record_frames import POSE_COLUMNS, Frames, chain_kinematics, read_frames
+from .robot_view import RobotView, node_name, wxyz
 
 log = logging.getLogger("c2rviz.record")
 
@@ -257,3 +260,42 @@ def _asset(name: str) -> str:
     if "</script" in text.lower():  # it is inlined in a <script> element
         raise ValueError(f"{name} must not hold '</script'")
     return text
+
+
+def placement_list(placement: pin.SE3) -> list[float]:
+    """``placement`` as x, y, z, qw, qx, qy, qz (the player's form)."""
+    return [*map(float, placement.translation), *map(float, wxyz(placement.rotation))]
+
+
+def add_parts(
+    scene: Any, name: str, frames: Frames, commands: Commands, n: int, base: pin.SE3
+) -> tuple[list[dict[str, Any]], list[str]]:
+    """Add a node per part of ``frames`` (``n`` joints; ``base``: the base frame in the
+    world) to ``scene``; return the player's description of each and the problems."""
+    parts, problems = [], []
+    for k, part in enumerate(frames.parts):
+        column = n + len(POSE_COLUMNS) * (k + 1)
+        shape = commands.parts.get(part)
+        if shape is None:
+            problems.append(f"{name}.txt never adds part {part!r}: it is not drawn")
+            parts.append({"name": part, "column": column, "node": None})
+            continue
+        node = f"/parts/{_SEGMENT}/{node_name(part)}"
+        common: dict[str, Any] = {"color": shape.rgb, "cast_shadow": False}
+        if shape.shape == "box":
+            handle = scene.add_box(node, dimensions=shape.size, **common)
+        elif shape.shape == "cylinder":
+            handle = scene.add_cylinder(node, radius=shape.size[0], height=shape.size[1], **common)
+        else:
+            handle = scene.add_icosphere(node, radius=shape.size[0], **common)
+        scene.add_label(f"{node}/label", part, anchor="bottom-left")
+        pose = frames.values[0, column : column + 6] if len(frames.times) else None
+        if pose is not None and np.isfinite(pose).all():
+            x, y, z, roll, pitch, yaw = map(float, pose)
+            at = base * pin.SE3(pin.rpy.rpyToMatrix(roll, pitch, yaw), np.array([x, y, z]))
+            handle.position = at.translation
+            handle.wxyz = wxyz(at.rotation)
+        else:
+            handle.visible = False
+        parts.append({"name": part, "column": column, "node": node})
+    return parts, problems

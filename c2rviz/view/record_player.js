@@ -67,7 +67,7 @@
   function unit(j) { return meta.joints[j].prismatic ? "m" : "\u00b0"; }
   function fmt(v, digits) { return (Math.round(v * Math.pow(10, digits)) / Math.pow(10, digits)).toFixed(digits); }
 
-  // ---------- the chain's forward kinematics (record_kinematics.py's numbers)
+  // ---------- the chain's forward kinematics (record_frames.py's numbers)
 
   function qmul(a, b) {
     return [a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],

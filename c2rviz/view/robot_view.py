@@ -32,8 +32,6 @@ from ..robot.visuals import DEFAULT_RGBA, LinkGeometry, Shape
 from . import adapter
 from .link_tree import LinkTree
 
-__all__ = ["GHOST_OPACITY", "RobotView", "node_name", "wxyz"]
-
 GHOST_OPACITY = 0.3
 GHOST_GREY = (0.7, 0.7, 0.72)  # for a mesh that brings colours of its own
 _WXYZ_ORDER = [0, 1, 2, 6, 3, 4, 5]  # pin.SE3ToXYZQUAT's x y z qx qy qz qw as x y z w x y z

@@ -11,8 +11,12 @@ becomes live again on reaching now; live returns at once. Like every
 control of the page, the timeline is the page's: all tabs look back together.
 
 Everything here is pure bookkeeping on the clock's times (``seek``, ``step``,
-``tick``); ``page_values.PageValueError`` refuses a time outside the history or
-a speed outside 0.25..4, and the page then shows the true value again.
+``tick``); ``PageValueError`` refuses a time outside the history or a speed outside
+0.25..4, and the page then shows the true value again.
+
+Every value the page's own controls set (a plot's window, the timeline's time and speed)
+is checked so (``within``): one out of range is refused with a message naming the range,
+and the control goes back to the true value.
 """
 
 from __future__ import annotations
@@ -23,10 +27,8 @@ from typing import Any
 
 import viser
 
+from ..errors import C2rvizError
 from . import adapter
-from .page_values import within
-
-__all__ = ["SPEED_RANGE", "Timeline"]
 
 SPEED_RANGE = (0.25, 4.0)
 """Slowest and fastest replay of the history."""
@@ -193,3 +195,24 @@ class Timeline:
             text = f"{self.shown_s - self.origin_s:.2f} s ({ago:.2f} s ago)"
             text += f", playing {self.speed:g}x" if self.playing else ""
         self.readout.value = text
+
+
+class PageValueError(C2rvizError):
+    """A page control set to a value it does not take."""
+
+    def __init__(self, control: str, value: float, valid: str) -> None:
+        self.control = control
+        self.value = value
+        self.valid = valid
+        super().__init__(f"{control} {value:g} is not {valid}")
+
+
+def within(control: str, value: float, low: float, high: float, unit: str = "") -> float:
+    """``value`` if it is a finite number in ``low..high``.
+
+    Raises:
+        PageValueError: naming ``control`` and the range (in ``unit``).
+    """
+    if not (math.isfinite(value) and low <= value <= high):
+        raise PageValueError(control, value, f"within {low:g}..{high:g}{unit}")
+    return float(value)

@@ -4,21 +4,20 @@
 each in its own module: a ``RobotView`` per robot (``robot_view``), the
 ``MarkerLayer`` (``markers``), the panel (``panel``), the plots, readouts,
 ghosts, history and timeline (``instruments``), the page's input
-(``page_input``) and the ``SendScheduler`` (``scheduler``). viser runs behind
+(``page_input``) and the ``SendScheduler`` (``scene_send``). viser runs behind
 the door of ``adapter`` (origins, token, client and frame limits; all use of
 viser's internals is there).
 
 The world calls the scene on every accepted change, possibly hundreds of
-thousands of times a second; each call only records what changed and asks
-for a send. A send, at most one per frame (``1/hz``), draws the latest state:
-each changed robot's links (Pinocchio FK), its target ghost and path while it
-moves, its panel, the markers, the workcell objects and collisions, the trails
-(``workcell_layer``), the parts, goals and cameras (``parts_layer``,
-``camera_layer``), the plots and readouts when due; or, while the timeline looks
-back, every robot as it was at that time (``scene_send``, which holds the sends). A
-send of many robots comes in slices of ``scene_send.SLICE_S`` (each an atomic batch),
-the loop taking a turn between them, and the scheduler paces sends by their cost
-(docs/page.md, "Many robots").
+thousands of times a second; each call only records what changed and asks for a send. A
+send, at most one per frame (``1/hz``), draws the latest state: each changed robot's links
+(Pinocchio FK), its target ghost and path while it moves, its panel, the markers, the
+workcell objects and collisions, the trails, the parts, goals and cameras
+(``cell_layers``), the plots and readouts when due; or, while the timeline looks back,
+every robot as it was at that time (``scene_send``, which holds the sends). A send of many
+robots comes in slices of ``scene_send.SLICE_S`` (each an atomic batch), the loop taking a
+turn between them, and the scheduler paces sends by their cost (docs/page.md, "Many
+robots").
 """
 
 from __future__ import annotations
@@ -43,22 +42,17 @@ from ..world.observer import Marker, Scene
 from ..world.part_rules import Goal
 from ..world.parts import Part
 from . import adapter, scene_send
-from .camera_layer import CameraLayer
+from .cell_layers import CameraLayer, PartsLayer, TrailLayer, WorkcellLayer
+from .door_rules import DoorPolicy
 from .handle import ToolHandles
 from .instruments import Instruments
 from .markers import MarkerLayer
-from .page_cell import fault_banner
 from .page_input import PageInput
+from .page_snapshot import fault_banner
 from .panel import RECENT_COMMANDS, RobotPanel, StatePanel
-from .parts_layer import PartsLayer
-from .policy import DoorPolicy
 from .robot_view import RobotView, node_name
-from .scene_send import SceneSends
-from .scheduler import SendScheduler
+from .scene_send import SceneSends, SendScheduler
 from .timeline import Timeline
-from .workcell_layer import TrailLayer, WorkcellLayer
-
-__all__ = ["RECENT_COMMANDS", "STOP_TIMEOUT_S", "ViserScene"]
 
 log = logging.getLogger("c2rviz.view")
 
@@ -295,7 +289,7 @@ class ViserScene(SceneSends, Scene):
 
     def show_faults(self, robot: str, banner: str) -> None:
         """Show ``banner`` (markdown, "" for none) as ``robot``'s fault banner (the page
-        process is told the command process's, ``page_cell.fault_banner``)."""
+        process is told the command process's, ``page_snapshot.fault_banner``)."""
         panel = self.panels.get(robot)
         if panel is not None:
             panel.show_faults(banner)

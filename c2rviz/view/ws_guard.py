@@ -6,7 +6,7 @@ to the same-origin rule), and viser applies whatever fields a page sends. The
 adapter (``view.adapter``) puts a ``Door`` in front of viser's websocket server:
 
 * the opening handshake (``process_request``): a websocket only from one of
-  the viewer's origins (``policy.DoorPolicy.origins``); a request without
+  the viewer's origins (``door_rules.DoorPolicy.origins``); a request without
   ``Origin`` is not from a browser and is let on. With a token set, the
   websocket and the page both need ``?token=...``. Refused: HTTP 403.
 * the page itself (``retitle``): viser's page is titled "Viser"; with
@@ -53,17 +53,8 @@ from websockets.frames import CloseCode
 from websockets.http11 import Request, Response
 
 from ..errors import shown
-from . import page_messages as frames
-from .policy import DoorPolicy
-from .ratelog import RateLimitedLog
-
-__all__ = [
-    "Door",
-    "GuardedConnection",
-    "GrabCallback",
-    "HandleCallback",
-    "InputCallback",
-]
+from . import door_rules as frames
+from .door_rules import DoorPolicy, RateLimitedLog
 
 log = logging.getLogger("c2rviz.view")
 

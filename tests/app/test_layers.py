@@ -56,7 +56,7 @@ flags = {"robot_flag": False, "port_flag": False, "urdf_flag": False, "motion_fl
 robots, _ = members(load_settings(find_ini(None), flags))
 links = load_link_geometry(robots[0].robot.source)
 assert sum(len(g.visual) for g in links.values()) > 5, links
-from c2rviz.view.marker_meshes import marker_mesh
+from c2rviz.view.markers import marker_mesh
 print("marker faces:", len(marker_mesh("arrow")[1]))
 heavy = ("trimesh", "scipy", "rosbags", "yourdfpy", "networkx")
 print("loaded:", ",".join(m for m in heavy if m in sys.modules) or "none")

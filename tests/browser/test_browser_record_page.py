@@ -19,7 +19,7 @@ import pytest
 from browser_support import ARTIFACTS, LINK_NODE_JS, in_root, wait_until
 from support import ServerThread, load_robot
 
-from c2rviz.view.record_rows import HTML_HZ, MAX_HTML_FRAMES
+from c2rviz.view.record_frames import HTML_HZ, MAX_HTML_FRAMES
 
 pytestmark = pytest.mark.browser
 

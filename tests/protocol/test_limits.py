@@ -13,7 +13,7 @@ from c2rviz.session.services import ServerLimits
 from c2rviz.transports.crcl.documents import MAX_DOCUMENT_BYTES
 from c2rviz.transports.crcl.server import CrclLimits
 from c2rviz.transports.rosbridge.policy import PolicyError, RosbridgePolicy
-from c2rviz.view.policy import DoorPolicy, DoorPolicyError
+from c2rviz.view.door_rules import DoorPolicy, DoorPolicyError
 
 OBJECTS = {
     "text": ServerLimits,

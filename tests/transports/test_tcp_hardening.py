@@ -32,7 +32,7 @@ from c2rviz.protocol.grammar import _MAX_INDEX_DIGITS
 from c2rviz.transports import tcp_text as server_module
 from c2rviz.transports.tcp_reading import LINGER_S, LOOK_AHEAD_BYTES, TURN_S
 from c2rviz.transports.tcp_server import CommandServer
-from c2rviz.view.policy import DoorPolicy
+from c2rviz.view.door_rules import DoorPolicy
 
 # A state away from home (so a stray home or joints shows) with long `where` replies.
 START_Q = (0.123456789, -0.234567891, 0.345678912, -0.456789123, 0.567891234, -0.678912345, 0.0)

@@ -8,7 +8,7 @@ import pytest
 import trimesh
 
 from c2rviz.protocol.grammar import MARKER_SHAPES
-from c2rviz.view.marker_meshes import MARKER_SIZE_M, marker_mesh
+from c2rviz.view.markers import MARKER_SIZE_M, marker_mesh
 
 
 def trimesh_marker(shape: str, size: float = MARKER_SIZE_M) -> trimesh.Trimesh:

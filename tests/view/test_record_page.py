@@ -21,9 +21,14 @@ from support import ROOT, load_robot
 from c2rviz.observers.recorder import Recorded
 from c2rviz.robot.model import Robot
 from c2rviz.view.record_commands import MAX_HTML_MARKS, read_commands
-from c2rviz.view.record_kinematics import chain_kinematics, pose_links
+from c2rviz.view.record_frames import (
+    HTML_HZ,
+    MAX_HTML_FRAMES,
+    chain_kinematics,
+    pose_links,
+    read_frames,
+)
 from c2rviz.view.record_page import write_html
-from c2rviz.view.record_rows import HTML_HZ, MAX_HTML_FRAMES, read_frames
 from c2rviz.world.state import RobotState
 
 TREE = ROOT / "tests" / "data" / "tree_robot" / "tree.urdf"

@@ -30,15 +30,14 @@ from websockets.exceptions import ConnectionClosed, InvalidStatus
 from websockets.sync.client import ClientConnection, connect
 
 from c2rviz.app.config import LIGHTINGS
+from c2rviz.origins import normalize_origin
 from c2rviz.view import adapter
-from c2rviz.view.policy import DoorPolicy, DoorPolicyError, normalize_origin
-from c2rviz.view.ratelog import RateLimitedLog
+from c2rviz.view.door_rules import DoorPolicy, DoorPolicyError, RateLimitedLog
 
 VERSION = f"viser-v{viser.__version__}"
-# the modules that reach inside viser: the adapter and the two it re-exports
+# the modules that reach inside viser: the adapter and the one it re-exports
 ADAPTER_SOURCES = [
-    Path(adapter.__file__).with_name(name)
-    for name in ("adapter.py", "viser_sends.py", "viser_internals.py")
+    Path(adapter.__file__).with_name(name) for name in ("adapter.py", "viser_internals.py")
 ]
 
 

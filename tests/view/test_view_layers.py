@@ -13,7 +13,7 @@ from support import load_robot
 from viewer_tabs import Harness
 
 from c2rviz.session import Services, Session
-from c2rviz.view.workcell_layer import COLLISION_RGBA
+from c2rviz.view.cell_layers import COLLISION_RGBA
 from c2rviz.world.world import World
 
 RED = tuple(int(round(255 * c)) for c in COLLISION_RGBA[:3])

@@ -20,9 +20,9 @@ from support import load_robot
 from viewer_tabs import Harness, Tab
 
 from c2rviz.view import adapter, scene_send, viser_scene
+from c2rviz.view.panel import READOUT_HZ, READOUTS_PER_S
 from c2rviz.view.plots import PLOT_HZ, PLOTS_PER_S
-from c2rviz.view.readout import READOUT_HZ, READOUTS_PER_S
-from c2rviz.view.scheduler import REST_PER_WORK, SendScheduler
+from c2rviz.view.scene_send import REST_PER_WORK, SendScheduler
 from c2rviz.world.world import World
 
 ROBOTS = 12

@@ -28,8 +28,8 @@ from c2rviz.robot.model import Robot
 from c2rviz.session import Services, Session, SessionDefaults
 from c2rviz.transports.tcp_server import CommandServer
 from c2rviz.view import adapter
+from c2rviz.view.door_rules import DoorPolicy
 from c2rviz.view.panel import MAX_LABEL_CHARS, short_label
-from c2rviz.view.policy import DoorPolicy
 from c2rviz.view.viser_scene import ViserScene
 from c2rviz.world.observer import MAX_MARKERS
 from c2rviz.world.world import World
