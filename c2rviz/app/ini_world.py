@@ -65,7 +65,7 @@ from ..robot.gripper import Gripper, make_gripper
 from ..robot.model import Robot
 from ..world.cameras import DEFAULT_FOV_RAD, DEFAULT_RANGE_M, MAX_RATE_HZ, Camera
 from ..world.faults import Fault, to_fault
-from ..world.grasp import make_vacuum
+from ..world.part_rules import make_vacuum
 from ..world.world import World
 
 IniObject = tuple[str, str, list[float], pin.SE3, "tuple[float, ...] | None", "Path | None"]

@@ -19,8 +19,8 @@ from collections import deque
 from collections.abc import AsyncIterator
 
 from ..protocol.framing import Line, LineFramer
-from ..protocol.verbs.cell import RobotChoice
-from ..protocol.verbs.joints import Units
+from ..protocol.verbs.arm import RobotChoice
+from ..protocol.verbs.seed import Units
 from .connection import MAX_REPLY_BYTES, LineState, ServerUnavailable
 from .errors import CommandError, ConnectionLost, ReplyTimeout, ReplyTooLong
 from .records import Event, State, read_stream_line

@@ -16,10 +16,9 @@ from typing import Any, Generic, TypeVar
 
 from ..errors import BadArguments, C2rvizError
 from ..protocol.grammar import MARKER_SHAPES, parse_line
-from ..protocol.verbs.cell import RobotChoice
-from ..protocol.verbs.joints import Units
-from ..protocol.verbs.motion import MOTION_MODES
-from ..protocol.verbs.observe import TRAIL_ACTIONS
+from ..protocol.verbs.arm import MOTION_MODES, RobotChoice
+from ..protocol.verbs.scene import TRAIL_ACTIONS
+from ..protocol.verbs.seed import Units
 from . import errors as check
 from . import records as read
 from .errors import ArgumentError, CommandError, UnexpectedReply

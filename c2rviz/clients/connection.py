@@ -27,8 +27,8 @@ from pathlib import Path
 
 from ..errors import C2rvizError
 from ..ini import INI_NAME, PROJECT_DIR, address, find_ini, read_ini
-from ..protocol.verbs.cell import RobotChoice
-from ..protocol.verbs.joints import Units
+from ..protocol.verbs.arm import RobotChoice
+from ..protocol.verbs.seed import Units
 from .errors import CommandError, UnexpectedReply
 
 COMMANDS_DIR = PROJECT_DIR / "commands"

@@ -20,7 +20,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from ..errors import C2rvizError, JointCountError, JointLimitError, within_limit
-from ..protocol.verbs.motion import MOTION_MODES
+from ..protocol.verbs.arm import MOTION_MODES
 from .client import Client
 
 

@@ -35,7 +35,7 @@ from typing import TextIO
 from ..errors import C2rvizError, LineTooLong
 from ..protocol.framing import Line, LineFramer
 from ..protocol.grammar import parse_line
-from ..protocol.verbs.observe import Watch
+from ..protocol.verbs.scene import Watch
 from .connection import ServerUnavailable
 from .errors import CommandError, ConnectionLost, ReplyTooLong, UnexpectedReply
 from .records import Event, State, read_stream_line

@@ -39,7 +39,7 @@ import viser
 from ..collision.workcell import WorkcellObject
 from ..observers.trail import TrailKeeper
 from ..world.cameras import Camera
-from ..world.goals import Goal
+from ..world.part_rules import Goal
 from ..world.parts import Part
 from .robot_view import RobotView, node_name, wxyz
 

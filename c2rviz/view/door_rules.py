@@ -37,7 +37,7 @@ from urllib.parse import quote
 import msgspec
 
 from ..errors import C2rvizError, shown
-from ..origins import LOOPBACK_HOSTS, normalize_origin, token_ok
+from ..ini import LOOPBACK_HOSTS, normalize_origin, token_ok
 from ..protocol.limits import below_floor, default, default_s
 
 WILDCARD_HOSTS = ("", "0.0.0.0", "::", "[::]")

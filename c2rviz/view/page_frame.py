@@ -37,10 +37,10 @@ from ..session.services import Services
 from ..session.session import Session
 from ..world.cameras import Camera
 from ..world.clock import Clock
-from ..world.effects import Marker, Scene
-from ..world.goals import Goal
+from ..world.observer import Scene
+from ..world.part_rules import Goal
 from ..world.parts import Part
-from ..world.state import RobotState
+from ..world.state import Marker, RobotState
 from ..world.world import World
 from .page_snapshot import Snapshot, camera_rows, fault_banner, goal_rows, part_rows, trail_state
 

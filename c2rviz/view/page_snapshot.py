@@ -38,9 +38,8 @@ from ..motion.limits import MotionLimits
 from ..robot.model import Robot
 from ..session.services import Services, SessionDefaults
 from ..session.session import Session
-from ..session.settings import SessionDefaults
 from ..world.cameras import Camera, Cameras
-from ..world.goals import Goal
+from ..world.part_rules import Goal
 from ..world.parts import Part, Parts
 from ..world.state import Marker
 from ..world.world import World

@@ -40,8 +40,7 @@ import viser
 from ..errors import limit_text
 from ..robot.frames import se3_pose
 from ..robot.model import Robot
-from ..tolerance import limit_text
-from ..world.effects import Marker
+from ..world.state import Marker
 from ..world.world import RobotState
 from . import adapter
 

@@ -28,8 +28,8 @@ import pinocchio as pin
 from ..errors import C2rvizError
 from ..protocol.grammar import MARKER_SHAPES, parse_line
 from ..protocol.verbs.parts import PartEdit
-from ..protocol.verbs.queries import Sleep
-from ..protocol.verbs.workcell import ObjectEdit
+from ..protocol.verbs.scene import ObjectEdit
+from ..protocol.verbs.seed import Clear, Color, Mark, MarkerShape, Sleep, Units
 from .record_frames import CHUNK_BYTES
 
 MAX_HTML_MARKS = 100_000

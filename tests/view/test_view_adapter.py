@@ -30,7 +30,7 @@ from websockets.exceptions import ConnectionClosed, InvalidStatus
 from websockets.sync.client import ClientConnection, connect
 
 from c2rviz.app.config import LIGHTINGS
-from c2rviz.origins import normalize_origin
+from c2rviz.ini import normalize_origin
 from c2rviz.view import adapter
 from c2rviz.view.door_rules import DoorPolicy, DoorPolicyError, RateLimitedLog
 

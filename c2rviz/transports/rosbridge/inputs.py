@@ -40,7 +40,7 @@ from functools import partial
 
 import numpy as np
 
-from ...errors import ArmMoved, C2rvizError, JointLimitError
+from ...errors import ArmMoved, C2rvizError, JointLimitError, within_limit
 from ...motion.trajectory import PlannedTrajectory, plan_trajectory
 from ...protocol import replies
 from ...protocol.registry import Reply
@@ -48,7 +48,6 @@ from ...robot.model import Robot
 from ...session.calls import MAX_TRAJECTORY_CHECKS
 from ...session.services import Services
 from ...session.session import Session
-from ...tolerance import within_limit
 from .messages import JointPositions, JointTrajectory
 
 # Text command lines.

@@ -64,8 +64,8 @@ from ...ros.messages import (
 )
 from ...ros.tf_tree import TfTree, Transform
 from ...world.cameras import Camera, Seen
-from ...world.observer import Observer
 from ...world.faults import RobotFaults
+from ...world.observer import Observer
 from ...world.state import Marker
 from ...world.world import World, sight
 from .bridge import TopicHub
