@@ -14,7 +14,7 @@ import pinocchio as pin
 
 from ..collision.model import CollisionModel
 from ..errors import C2rvizError, ConfigError
-from ..motion.planner import MotionLimits
+from ..motion.limits import MotionLimits
 from ..robot.frames import pose_se3
 from ..robot.model import Robot
 from ..world.world import World

@@ -29,7 +29,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import C2rvizError, ConfigError
-from ..motion.planner import MotionLimits, motion_limits
+from ..motion.limits import MotionLimits, motion_limits
 from ..robot.gripper import Gripper, make_gripper
 from ..robot.model import Robot
 from ..world.grasp import make_vacuum

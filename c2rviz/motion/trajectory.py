@@ -30,10 +30,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .limits import MotionLimits
-from .trajectory_check import (
+from .limits import (
     LIMIT_SLACK,
     SAMPLES_PER_SEGMENT,
+    MotionLimits,
     TrajectoryError,
     check_limits,
     evaluate,

@@ -12,7 +12,7 @@ import pinocchio as pin
 
 from ..app.config import MOTION_FLAGS, Settings, find_ini, load_settings
 from ..app.members import Member, members
-from ..motion.planner import motion_limits
+from ..motion.limits import motion_limits
 from ..robot.model import Robot
 from ..world.clock import Clock
 
