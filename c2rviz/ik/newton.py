@@ -24,8 +24,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import pinocchio as pin
 
-from .chain import IkChain
-from .target import Goal
+from .chain import Goal, IkChain
 
 __all__ = ["Descent", "NewtonDescent"]
 

@@ -16,7 +16,7 @@ import numpy as np
 import pinocchio as pin
 
 from c2rviz.ik import IkSolver, Target
-from c2rviz.ik.target import goal_in_world
+from c2rviz.ik.chain import goal_in_world
 
 __all__ = ["DISTINCT_RAD", "goal_candidates"]
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from ..collision.model import segment
 from ..errors import ArmMoved, C2rvizError, NoGripper, PathCollides
-from ..ik.target import Target
+from ..ik.chain import Target
 from ..motion.path_play import TrajectoryPlay
 from ..motion.trajectory import PlannedTrajectory
 from ..planning import MoveChecker, MoveRequest, first_blocked, path_points

@@ -15,8 +15,8 @@ from typing import Protocol
 import numpy as np
 
 from ..errors import ArmMoved
+from ..ik.chain import Target
 from ..ik.line import StraightLine, plan_line
-from ..ik.target import Target
 from ..motion.path_play import LinePlay, brake_limits, ramp_limits
 from ..protocol import replies
 from ..protocol.registry import Reply

@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from ...errors import UnknownMarker
-from ...ik.target import PointTarget, Target
+from ...ik.chain import PointTarget, Target
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
 from ...protocol.verbs.cartesian import Ik, LinearSpeed, MoveL, MoveTo, PoseValues, Tool

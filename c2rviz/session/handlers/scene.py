@@ -19,7 +19,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from ...errors import BadArguments, JointCountError
-from ...ik.target import PointTarget, Target
+from ...ik.chain import PointTarget, Target
 from ...planning import MAX_TIMEOUT_S, goal_candidates, time_path
 from ...planning.edge_resolution import RANGES
 from ...planning.errors import checked_setting
