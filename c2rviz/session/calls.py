@@ -21,7 +21,7 @@ from ..ik.chain import Target
 from ..motion.path_play import TrajectoryPlay
 from ..motion.trajectory import PlannedTrajectory
 from ..planning import MoveChecker, MoveRequest, first_blocked, path_points
-from ..planning.cancel import STOPPED
+from ..planning.errors import STOPPED
 from ..protocol import replies
 from ..protocol.registry import Reply
 from ..world.grasp import SUCTION_BELOW, is_vacuum

@@ -44,7 +44,7 @@ from ..planning import (
     TimedPath,
     time_path,
 )
-from ..planning.cancel import Cancel
+from ..planning.errors import Cancel
 from ..protocol import replies
 from ..world.moves import Travel
 from ..world.state import RobotState

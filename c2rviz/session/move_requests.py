@@ -15,7 +15,7 @@ import numpy as np
 from ..collision.batch import PlacedShape
 from ..collision.other_robots import placed_shapes
 from ..planning import EdgeResolution, MoveRequest
-from ..planning.cancel import Cancel
+from ..planning.errors import Cancel
 from ..planning.guarded_move import OtherAt
 from ..world.world import World
 

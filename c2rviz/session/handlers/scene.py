@@ -21,8 +21,8 @@ from typing import TYPE_CHECKING
 from ...errors import BadArguments, JointCountError
 from ...ik.chain import PointTarget, Target
 from ...planning import MAX_TIMEOUT_S, goal_candidates, time_path
-from ...planning.edge_resolution import RANGES
 from ...planning.errors import checked_setting
+from ...planning.validity import RANGES
 from ...protocol import replies
 from ...protocol.registry import Reply, handler, usage
 from ...protocol.verbs.cell import RobotChoice, RobotsList
