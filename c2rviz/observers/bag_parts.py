@@ -13,7 +13,7 @@ from collections.abc import Sequence
 
 import pinocchio as pin
 
-from ..ros import markers as mk
+from ..ros import messages as mk
 from ..ros.messages import INT32, Msg, tf_message, transforms
 from ..world.parts import Part
 

@@ -45,10 +45,9 @@ from typing import TYPE_CHECKING
 
 import pinocchio as pin
 
-from ..ros import markers as mk
-from ..ros.bag_writer import BagWriter
+from ..ros import messages as mk
+from ..ros.bag_writer import BagRobot, BagWriter
 from ..ros.messages import INT32, Msg, tf_message, transforms
-from ..ros.robot_bag import BagRobot
 from ..world.cameras import Camera, Seen
 from ..world.effects import Observer
 from ..world.parts import Part

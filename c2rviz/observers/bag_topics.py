@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 import pinocchio as pin
 
-from ..ros import markers as mk
+from ..ros import messages as mk
 from ..ros.bag_writer import BagWriter
 from ..ros.messages import Msg
 from ..world.clock import Clock, Timer

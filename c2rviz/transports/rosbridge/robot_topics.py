@@ -21,8 +21,19 @@ import pinocchio as pin
 
 from ...collision.workcell import WorkcellObject
 from ...robot.model import Robot
-from ...ros.markers import SHAPES, delete_all, delete_marker, marker, object_marker
-from ...ros.messages import JOINT_STATE, Msg, frame_prefix, joint_state, topic, transform
+from ...ros.messages import (
+    JOINT_STATE,
+    SHAPES,
+    Msg,
+    delete_all,
+    delete_marker,
+    frame_prefix,
+    joint_state,
+    marker,
+    object_marker,
+    topic,
+    transform,
+)
 from ...ros.tf_tree import TfTree, Transform
 from ...world.state import Marker
 from .messages import JOINT_TRAJECTORY, STRING

@@ -38,8 +38,7 @@ import pinocchio as pin
 from ...collision.workcell import WorkcellObject
 from ...observers.bag_parts import part_items
 from ...observers.watch import WatchHub
-from ...ros.markers import marker_array
-from ...ros.messages import Msg, string, tf_message, transforms
+from ...ros.messages import Msg, marker_array, string, tf_message, transforms
 from ...world.clock import Timer
 from ...world.effects import MAX_MARKERS, Marker, Observer
 from ...world.parts import Part
