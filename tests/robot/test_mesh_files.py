@@ -107,7 +107,7 @@ def example_meshes(*robots: str) -> list[Path]:
     """The .dae files the visuals of these example robots (``--robot NAME``) name."""
     from c2rviz.app.config import find_ini, load_settings
     from c2rviz.app.members import members
-    from c2rviz.robot.urdf_elements import read_links
+    from c2rviz.robot.visuals import read_links
 
     found: set[Path] = set()
     for name in robots:

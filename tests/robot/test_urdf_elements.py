@@ -12,7 +12,7 @@ import pytest
 import yourdfpy
 
 from c2rviz.robot.catalogue import example_robot_data_dir, example_robots
-from c2rviz.robot.urdf_elements import Element, read_links
+from c2rviz.robot.visuals import Element, read_links
 
 ROOT = Path(__file__).resolve().parents[2]
 FILES = sorted((ROOT / "robots").glob("*/robot.urdf")) + sorted(
