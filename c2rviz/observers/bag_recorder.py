@@ -53,8 +53,15 @@ from ..world.effects import Observer
 from ..world.parts import Part
 from ..world.state import MAX_MARKERS, Marker, RobotState
 from ..world.world import World
-from .bag_parts import PartFrames, part_transforms
-from .bag_topics import TextLines, marker_message, namespaces, object_message, xyz_xyzw
+from .bag_topics import (
+    PartFrames,
+    TextLines,
+    marker_message,
+    namespaces,
+    object_message,
+    part_transforms,
+    xyz_xyzw,
+)
 from .camera_feed import CAMERA_TOPIC, POSE_ARRAY, CameraFeed, camera_items, pose_array
 
 if TYPE_CHECKING:

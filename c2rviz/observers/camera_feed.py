@@ -33,7 +33,7 @@ from ..ros.messages import Msg, header
 from ..world.camera_sight import sight
 from ..world.cameras import Camera, Seen
 from ..world.clock import Timer
-from .bag_parts import xyz_xyzw
+from .bag_topics import xyz_xyzw
 
 if TYPE_CHECKING:
     from ..world.cameras import Seen

@@ -36,7 +36,7 @@ from functools import partial
 import pinocchio as pin
 
 from ...collision.workcell import WorkcellObject
-from ...observers.bag_parts import part_items
+from ...observers.bag_topics import part_items
 from ...observers.watch import WatchHub
 from ...ros.messages import Msg, marker_array, string, tf_message, transforms
 from ...world.clock import Timer
