@@ -25,8 +25,6 @@ from ..errors import C2rvizError
 from .chain import Goal, PointTarget, Target, goal_in_world
 from .solver import IkSolver
 
-__all__ = ["LineBlocked", "LineWaypoint", "StraightLine", "interpolate", "plan_line"]
-
 
 class LineBlocked(C2rvizError):
     """The tool cannot follow the straight line all the way.

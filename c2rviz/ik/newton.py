@@ -26,8 +26,6 @@ import pinocchio as pin
 
 from .chain import Goal, IkChain
 
-__all__ = ["Descent", "NewtonDescent"]
-
 # A descent stalls when its cost is not ``stall_ratio`` of 3 steps before (after 5 steps).
 _STALL_AFTER, _STALL_LAG = 5, 3
 _EXACT = 1e-13  # a converged descent takes more steps while its cost is above this [m] ...

@@ -69,10 +69,8 @@ from ruckig import (
 )
 
 from ..errors import JointCountError
-from .limits import MotionLimitError, MotionLimits, MotionPlanError, motion_limits
+from .limits import MotionLimitError, MotionLimits, MotionPlanError
 from .path_play import LineBrake, line_brake
-
-__all__ = ["Motion", "MotionLimitError", "MotionLimits", "MotionPlanError", "motion_limits"]
 
 State = tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]
 Plan = tuple[tuple[float, "Trajectory | LineBrake"], ...]  # (start time [s], plan), in order

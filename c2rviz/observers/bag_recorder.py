@@ -17,7 +17,7 @@ or for several robots of a cell at once:
   ``MAX_MARKERS`` deletes the oldest, ``clear`` deletes each one) and the
   workcell objects (namespace ``workcell``, one id per object name: ADD when set
   or changed, DELETE when removed), in the frames the page shows them in;
-- the parts (``bag_parts``): each one's frame ``parts/NAME`` on ``/tf`` as they move,
+- the parts (``bag_topics``): each one's frame ``parts/NAME`` on ``/tf`` as they move,
   and a marker of it (namespace ``parts``) on the first robot's marker topic;
 - each logical camera's reports (``camera_feed``): ``/c2rviz/cameras/NAME``
   (``geometry_msgs/msg/PoseArray`` in the frame ``cameras/NAME``) at its rate on the
@@ -68,7 +68,6 @@ if TYPE_CHECKING:
     from ..collision.workcell import WorkcellObject
     from .recorder import Recorder
 
-__all__ = ["WORLD_FRAME", "BagRecorder"]
 
 log = logging.getLogger("c2rviz.record")
 

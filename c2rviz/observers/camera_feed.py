@@ -39,19 +39,6 @@ if TYPE_CHECKING:
     from ..world.cameras import Seen
     from ..world.world import World
 
-__all__ = [
-    "CAMERA_FRAME",
-    "CAMERA_TOPIC",
-    "CameraFeed",
-    "CameraSignature",
-    "POSE_ARRAY",
-    "Report",
-    "camera_changes",
-    "camera_items",
-    "camera_signature",
-    "pose_array",
-]
-
 
 Report = Callable[[str, float, "Sequence[Seen]"], None]
 """``report(camera, t, seen)``: what ``camera`` sees at clock time ``t`` [s]."""

@@ -44,25 +44,6 @@ from ..world.faults import RobotFaults, at_once, replay_line
 from ..world.parts import Part, Parts
 from ..world.world import World
 
-__all__ = [
-    "FaultLines",
-    "HELD",
-    "PartSignature",
-    "SLIPPED",
-    "csv_columns",
-    "csv_poses",
-    "exact",
-    "fault_line",
-    "object_lines",
-    "opening_lines",
-    "part_changes",
-    "part_line",
-    "signature",
-    "slip_outcome",
-    "workcell_lines",
-]
-
-
 PartSignature = dict[str, tuple[object, ...]]
 """What identifies each part in a recording (name to shape, size, type, colour)."""
 

@@ -13,21 +13,6 @@ from typing import Protocol
 
 from ..errors import C2rvizError
 
-__all__ = [
-    "AlreadyRecording",
-    "FrameSink",
-    "LinkedName",
-    "NameInUse",
-    "NotABagFolder",
-    "NotRecording",
-    "NotYourRecording",
-    "RecordFolderError",
-    "Recorded",
-    "RecordingError",
-    "RecordingExists",
-    "header",
-]
-
 
 @dataclass(frozen=True)
 class Recorded:

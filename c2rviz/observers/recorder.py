@@ -62,8 +62,6 @@ from .record_cell import (
 from .record_files import RecordFiles, body_tally, cut_to_line, join_body
 from .recorded import FrameSink, Recorded, header
 
-__all__ = ["BUFFER_BYTES", "FLUSH_S", "FrameSink", "Recorded", "Recorder"]
-
 log = logging.getLogger("c2rviz.recorder")
 
 BUFFER_BYTES = 1 << 18

@@ -62,7 +62,6 @@ from .validity import EdgeResolution, ValidityChecker, coarse_first
 
 log = logging.getLogger("c2rviz.planning")
 
-__all__ = ["MAX_TIMEOUT_S", "SEEDS", "EdgeCheck", "PlannedPath", "plan_for", "plan_path"]
 
 MAX_TIMEOUT_S = 60.0  # [s] longest search accepted
 _MIN_TIMEOUT_S = 1e-3  # [s]

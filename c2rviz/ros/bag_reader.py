@@ -45,8 +45,6 @@ from .errors import (
     UnknownTopic,
 )
 
-__all__ = ["JOINT_STATE_TYPES", "JointStateBag"]
-
 JOINT_STATE_TYPES = ("sensor_msgs/msg/JointState", "sensor_msgs/JointState")
 _SUFFIXES = (".mcap", ".db3", ".bag")
 _KINDS = "a rosbag2 folder (with metadata.yaml), an .mcap or .db3 file, or a ROS 1 .bag"
