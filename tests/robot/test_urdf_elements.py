@@ -1,4 +1,4 @@
-"""The URDF's visual and collision elements as ``urdf_elements`` reads them are what yourdfpy
+"""The URDF's visual and collision elements as ``robot.visuals`` reads them are what yourdfpy
 reads (the library the program used before, kept as the judge) on every bundled robot,
 every example robot and the test robots; a hostile document expands nothing."""
 
