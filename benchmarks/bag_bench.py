@@ -52,8 +52,7 @@ sys.path.insert(0, str(ROOT))
 
 from c2rviz.robot import Robot  # noqa: E402
 from c2rviz.ros.bag_reader import JointStateBag  # noqa: E402
-from c2rviz.ros.bag_writer import BagWriter  # noqa: E402
-from c2rviz.ros.robot_bag import BagRobot  # noqa: E402
+from c2rviz.ros.bag_writer import BagRobot, BagWriter  # noqa: E402
 
 __all__ = ["main"]
 

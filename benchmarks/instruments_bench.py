@@ -196,7 +196,7 @@ import json, math, os, resource, sys, time
 from pathlib import Path
 import numpy as np
 from c2rviz.app.program import write_page
-from c2rviz.observers.record_finish import finish
+from c2rviz.observers.recordings import finish
 from c2rviz.view import record_page  # viser loaded, as in a program with its page open
 from c2rviz.world.clock import Clock
 from c2rviz.world.world import World

@@ -33,7 +33,8 @@ import ruckig
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from c2rviz.motion.planner import Motion, motion_limits  # noqa: E402
+from c2rviz.motion.limits import motion_limits  # noqa: E402
+from c2rviz.motion.planner import Motion  # noqa: E402
 from c2rviz.robot.model import Robot  # noqa: E402
 
 ROBOTS = {

@@ -59,7 +59,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import C2rvizError, ConfigError
-from ..motion.planner import MotionLimits, motion_limits
+from ..motion.limits import MotionLimits, motion_limits
 from ..protocol.verbs.faults import FaultVerb
 from ..robot.gripper import Gripper, make_gripper
 from ..robot.model import Robot

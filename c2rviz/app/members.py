@@ -40,7 +40,7 @@ import pinocchio as pin
 from ..collision.model import CollisionModel
 from ..errors import C2rvizError, ConfigError
 from ..ini import read_ini
-from ..motion.planner import MotionLimits
+from ..motion.limits import MotionLimits
 from ..robot.catalogue import CatalogueEntry, find_robot
 from ..robot.frames import pose_se3
 from ..robot.model import Robot

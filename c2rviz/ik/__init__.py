@@ -1,13 +1,13 @@
 """Inverse kinematics: a damped Newton descent over Pinocchio (``newton``) from ranked seeds
-(``seeds``), refused early beyond the arm's reach (``chain``), pink and daqp only to find
+(``solver``), refused early beyond the arm's reach (``chain``), pink and daqp only to find
 a refused target's closest pose (``closest``); targets with or without an
-orientation and the refusal of one (``target``); and the straight tool line (``line``).
+orientation and the refusal of one (``chain``); and the straight tool line (``line``).
 Pure: no asyncio, no clock.
 """
 
+from .chain import PointTarget, Target, Unreachable
 from .line import LineBlocked, StraightLine, plan_line
 from .solver import IkSettings, IkSolver
-from .target import PointTarget, Target, Unreachable
 
 __all__ = [
     "IkSettings",

@@ -18,9 +18,8 @@ import pinocchio as pin
 from pink.limits import ConfigurationLimit
 from pink.tasks import PostureTask, Task
 
-from .chain import TOOL_FRAME, IkChain
+from .chain import TOOL_FRAME, Goal, IkChain
 from .newton import Descent, NewtonDescent
-from .target import Goal
 
 _STALL_AFTER, _STALL_LAG, _STALL_RATIO = 5, 3, 0.999  # descend to the bottom
 

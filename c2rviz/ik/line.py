@@ -22,10 +22,8 @@ import numpy as np
 import pinocchio as pin
 
 from ..errors import C2rvizError
+from .chain import Goal, PointTarget, Target, goal_in_world
 from .solver import IkSolver
-from .target import Goal, PointTarget, Target, goal_in_world
-
-__all__ = ["LineBlocked", "LineWaypoint", "StraightLine", "interpolate", "plan_line"]
 
 
 class LineBlocked(C2rvizError):

@@ -24,10 +24,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import pinocchio as pin
 
-from .chain import IkChain
-from .target import Goal
-
-__all__ = ["Descent", "NewtonDescent"]
+from .chain import Goal, IkChain
 
 # A descent stalls when its cost is not ``stall_ratio`` of 3 steps before (after 5 steps).
 _STALL_AFTER, _STALL_LAG = 5, 3

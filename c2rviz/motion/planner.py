@@ -68,25 +68,15 @@ from ruckig import (
     Trajectory,
 )
 
-from ..errors import C2rvizError, JointCountError
-from .limits import MotionLimitError, MotionLimits, motion_limits
-from .line_brake import LineBrake, line_brake
-
-__all__ = ["Motion", "MotionLimitError", "MotionLimits", "MotionPlanError", "motion_limits"]
+from ..errors import JointCountError
+from .limits import MotionLimitError, MotionLimits, MotionPlanError
+from .path_play import LineBrake, line_brake
 
 State = tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]
 Plan = tuple[tuple[float, "Trajectory | LineBrake"], ...]  # (start time [s], plan), in order
 
 _TOLERANCE = 1e-6  # [rad or m] an overshoot up to this (rounding) is only clamped
 _TIGHTER = (1.0, 1 - 1e-12, 1 - 1e-9)  # acceleration/jerk limit factors ruckig is retried with
-
-
-class MotionPlanError(C2rvizError):
-    """ruckig could not plan the motion (numbers beyond its numerical range)."""
-
-    def __init__(self, detail: str) -> None:
-        self.detail = detail
-        super().__init__(f"cannot plan the motion: {detail}")
 
 
 def _position_range(profile: Profile) -> tuple[float, float]:

@@ -30,24 +30,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .limits import MotionLimits
-from .trajectory_check import (
-    LIMIT_SLACK,
-    SAMPLES_PER_SEGMENT,
+from .limits import (
+    MotionLimits,
     TrajectoryError,
     check_limits,
     evaluate,
 )
-
-__all__ = [
-    "LIMIT_SLACK",
-    "SAMPLES_PER_SEGMENT",
-    "START_TOLERANCE",
-    "PlannedTrajectory",
-    "TrajectoryError",
-    "Values",
-    "plan_trajectory",
-]
 
 START_TOLERANCE = 1e-3
 """How far [rad or m] a point at time 0 may be from where the arm is."""

@@ -17,7 +17,7 @@ or for several robots of a cell at once:
   ``MAX_MARKERS`` deletes the oldest, ``clear`` deletes each one) and the
   workcell objects (namespace ``workcell``, one id per object name: ADD when set
   or changed, DELETE when removed), in the frames the page shows them in;
-- the parts (``bag_parts``): each one's frame ``parts/NAME`` on ``/tf`` as they move,
+- the parts (``bag_topics``): each one's frame ``parts/NAME`` on ``/tf`` as they move,
   and a marker of it (namespace ``parts``) on the first robot's marker topic;
 - each logical camera's reports (``camera_feed``): ``/c2rviz/cameras/NAME``
   (``geometry_msgs/msg/PoseArray`` in the frame ``cameras/NAME``) at its rate on the
@@ -45,24 +45,29 @@ from typing import TYPE_CHECKING
 
 import pinocchio as pin
 
-from ..ros import markers as mk
-from ..ros.bag_writer import BagWriter
+from ..ros import messages as mk
+from ..ros.bag_writer import BagRobot, BagWriter
 from ..ros.messages import INT32, Msg, tf_message, transforms
-from ..ros.robot_bag import BagRobot
 from ..world.cameras import Camera, Seen
 from ..world.observer import Observer
 from ..world.parts import Part
 from ..world.state import MAX_MARKERS, Marker, RobotState
 from ..world.world import World
-from .bag_parts import PartFrames, part_transforms
-from .bag_topics import TextLines, marker_message, namespaces, object_message, xyz_xyzw
+from .bag_topics import (
+    PartFrames,
+    TextLines,
+    marker_message,
+    namespaces,
+    object_message,
+    part_transforms,
+    xyz_xyzw,
+)
 from .camera_feed import CAMERA_TOPIC, POSE_ARRAY, CameraFeed, camera_items, pose_array
 
 if TYPE_CHECKING:
     from ..collision.workcell import WorkcellObject
     from .recorder import Recorder
 
-__all__ = ["WORLD_FRAME", "BagRecorder"]
 
 log = logging.getLogger("c2rviz.record")
 

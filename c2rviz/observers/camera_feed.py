@@ -33,24 +33,11 @@ from ..ros.messages import Msg, header
 from ..world.cameras import Camera, Seen
 from ..world.clock import Timer
 from ..world.world import sight
-from .bag_parts import xyz_xyzw
+from .bag_topics import xyz_xyzw
 
 if TYPE_CHECKING:
     from ..world.cameras import Seen
     from ..world.world import World
-
-__all__ = [
-    "CAMERA_FRAME",
-    "CAMERA_TOPIC",
-    "CameraFeed",
-    "CameraSignature",
-    "POSE_ARRAY",
-    "Report",
-    "camera_changes",
-    "camera_items",
-    "camera_signature",
-    "pose_array",
-]
 
 
 Report = Callable[[str, float, "Sequence[Seen]"], None]

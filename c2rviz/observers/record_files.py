@@ -29,17 +29,6 @@ import shutil
 from pathlib import Path
 from typing import TextIO
 
-__all__ = [
-    "FINAL_SUFFIXES",
-    "RecordFiles",
-    "body_tally",
-    "cut_to_line",
-    "existing",
-    "is_bag_folder",
-    "join_body",
-    "links",
-]
-
 FINAL_SUFFIXES = (".txt", ".csv", ".html", "")
 """The names a recording takes: NAME.txt, NAME.csv, NAME.html and the bag folder NAME/."""
 log = logging.getLogger("c2rviz.record")

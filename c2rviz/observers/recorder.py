@@ -47,22 +47,22 @@ from ..world.observer import Marker, Observer
 from ..world.parts import Part
 from ..world.world import World
 from .camera_feed import CameraSignature, camera_changes, camera_signature
-from .record_cell import (
+from .record_files import RecordFiles, body_tally, cut_to_line, join_body
+from .recorded import (
     FaultLines,
+    FrameSink,
     PartSignature,
+    Recorded,
     csv_columns,
     csv_poses,
     exact,
+    header,
     object_lines,
     opening_lines,
     part_changes,
     signature,
     workcell_lines,
 )
-from .record_files import RecordFiles, body_tally, cut_to_line, join_body
-from .recorded import FrameSink, Recorded, header
-
-__all__ = ["BUFFER_BYTES", "FLUSH_S", "FrameSink", "Recorded", "Recorder"]
 
 log = logging.getLogger("c2rviz.recorder")
 
@@ -195,7 +195,7 @@ class Recorder(Observer):
 
     def on_part_event(self, robot: str | None, text: str) -> None:
         """A grasp that drew for a slip: its outcome goes before its ``grip`` line, so the
-        replay makes the same grasp (record_cell)."""
+        replay makes the same grasp (recorded.py)."""
         if robot == self.robot and not self.closed:
             line = self._faults.outcome(self.world.faults.of(robot), text)
             if line is not None:

@@ -8,24 +8,25 @@ NAME.csv when the world has one robot), and one bag NAME/ holding every robot's
 topics. A recording is stopped for one of its robots (``stop``), which stops it
 whole; the session refuses a ``record stop`` for a robot not recorded.
 
-Stopping returns a future that is done when the files are complete and in
-place: in a thread the bag is ended, each command file put together, each
-exporter the app gave (the page NAME.html) run, and every file renamed from its
-private name (``record_files``) to its own. Two recordings of the same name
-finish one after the other, in the order they stopped, so ``record NAME
-overwrite`` racing a ``record stop`` of NAME loses neither: each is complete when
-its ``record stop`` is answered, and the later one holds the names. A name whose
-files are symbolic links is refused. ``close`` stops every recording and waits
-for every one still finishing (the program's exit).
+Stopping returns a future that is done when the files are complete and in place: in a
+thread (``finish``) the bag is ended, each command file put together, each exporter the
+app gave (the page NAME.html) run, and every file renamed from its private name
+(``record_files``) to its own. Two recordings of the same name finish one after the other,
+in the order they stopped, so ``record NAME overwrite`` racing a ``record stop`` of NAME
+loses neither: each is complete when its ``record stop`` is answered, and the later one
+holds the names. A name whose files are symbolic links is refused. ``close`` stops every
+recording and waits for every one still finishing (the program's exit).
 """
 
 from __future__ import annotations
 
 import asyncio
 import logging
+import os
 import re
 import shutil
 from collections.abc import Callable, Coroutine, Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -34,7 +35,6 @@ from ..world.observer import Observer
 from ..world.state import RobotState
 from ..world.world import World
 from .record_files import RecordFiles, existing, is_bag_folder, links
-from .record_finish import Exporter, Recording, finish
 from .recorded import (
     AlreadyRecording,
     LinkedName,
@@ -44,31 +44,16 @@ from .recorded import (
     NotYourRecording,
     Recorded,
     RecordFolderError,
-    RecordingError,
     RecordingExists,
 )
 from .recorder import Recorder
 
-if TYPE_CHECKING:  # rosbags is loaded at the first recording, not at start
+if TYPE_CHECKING:
     from .bag_recorder import BagRecorder
+
 
 log = logging.getLogger("c2rviz.record")
 
-__all__ = [
-    "DEFAULT_FOLDER",
-    "AlreadyRecording",
-    "Exporter",
-    "LinkedName",
-    "NameInUse",
-    "NotABagFolder",
-    "NotRecording",
-    "NotYourRecording",
-    "RecordFolderError",
-    "Recording",
-    "RecordingError",
-    "RecordingExists",
-    "Recordings",
-]
 
 DEFAULT_FOLDER = Path("recordings")
 """Where recordings go unless told (``--record-dir``, ini ``record_dir``)."""
@@ -306,3 +291,77 @@ class Recordings:
                 if isinstance(result, list):
                     finished.extend(result)
         return finished
+
+
+Exporter = Callable[[Recorded, RobotState], Path]
+"""Writes one more file from a finished recording (blocking, run in a thread) next to its
+CSV and returns its path, such as ``view.record_page.write_html``'s NAME.html."""
+
+
+@dataclass(eq=False)
+class Recording:
+    """One running recording: its name, a recorder per robot, and the bag."""
+
+    name: str
+    recorders: dict[str, Recorder]
+    bag: BagRecorder | None
+    bag_files: RecordFiles
+    t0: float
+
+    @property
+    def stems(self) -> set[str]:
+        """The names its files take (NAME, and NAME.ROBOT for each robot of a cell's)."""
+        return {self.name, *(r.name for r in self.recorders.values())}
+
+
+def finish(
+    recording: Recording, states: dict[str, RobotState], exporters: Sequence[Exporter]
+) -> list[Recorded]:
+    """End the bag, put each command file together, run the exporters, and put every file
+    in place (blocking: for a thread). What cannot be written is reported in ``error``."""
+    bag: Path | None = None
+    bag_error: str | None = None
+    if recording.bag is not None:
+        try:
+            bag_error = recording.bag.close()
+            bag = recording.bag_files.publish_bag()
+        except Exception as exc:  # the txt and csv stand whatever the bag does
+            bag_error = bag_error or f"the bag: {exc}"
+            log.warning("recording %s: the bag is not in place: %s", recording.name, exc)
+    out = []
+    for robot, recorder in recording.recorders.items():
+        recorded = recorder.finish()
+        files = recorder.files
+        html = None
+        for export in exporters:
+            try:
+                _fresh(files, ".html")
+                html = export(recorded, states[robot])
+            except Exception as exc:  # the txt and csv stand; the rest is a bonus
+                files.discard(".html")
+                why = exc.strerror or exc if isinstance(exc, OSError) else exc
+                log.warning(
+                    "recording %s: no page written (%s.html): %s; its other files stand",
+                    recorded.name,
+                    recorded.name,
+                    why,
+                )
+        try:
+            txt = files.publish(recorded.txt) if recorded.txt is not None else None
+            csv = files.publish(recorded.csv)
+            if html is not None and html.name.startswith(files.stem):
+                html = files.publish(html)
+        except OSError as exc:
+            why = f"cannot put it in place: {exc.strerror or exc}"
+            log.warning("recording %s: %s (its files are %s.*)", recorded.name, why, files.stem)
+            out.append(replace(recorded, error=recorded.error or why, bag=bag))
+            continue
+        error = recorded.error or (f"bag {bag_error}" if bag_error else None)
+        out.append(replace(recorded, txt=txt, csv=csv, html=html, bag=bag, error=error))
+    return out
+
+
+def _fresh(files: RecordFiles, suffix: str) -> None:
+    """Create the private file an exporter writes (so it opens a new file of ours, never a
+    link someone put there)."""
+    os.close(files.create(suffix))

@@ -29,8 +29,6 @@ from ..world.observer import Observer
 from ..world.state import RobotState
 from ..world.world import World
 
-__all__ = ["DEFAULT_TRAIL_POINTS", "MIN_TRAIL_POINTS", "RobotTrail", "TrailKeeper"]
-
 DEFAULT_TRAIL_POINTS = 20_000
 """Points a trail keeps at most (``trail_points`` in the ini)."""
 MIN_TRAIL_POINTS = 16

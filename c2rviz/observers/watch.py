@@ -54,18 +54,6 @@ from ..world.state import RobotState
 from ..world.world import World, seen_text
 from .camera_feed import CameraFeed
 
-__all__ = [
-    "MAX_EVENTS",
-    "EventListener",
-    "STREAM_ALLOWANCE_BYTES",
-    "STREAM_HIGH_BYTES",
-    "NotAConnection",
-    "Sink",
-    "Watcher",
-    "WatchHub",
-    "WatchStream",
-]
-
 MAX_EVENTS = 256
 """Events a stream holds for a reader that does not take them; past it the oldest go."""
 STREAM_HIGH_BYTES = 16 * 1024

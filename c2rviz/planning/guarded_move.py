@@ -29,12 +29,20 @@ that leaves a contact goes; but once such a pair is apart, touching again blocks
 the move like any other pair. So a guard that let the arm end touching something
 (a new object put on it) does not refuse every move after, only the ones that
 push on.
+
+Several IK solutions of one tool pose (``goal_candidates``), for a planner to choose the
+one it can reach (``plan pose``): a redundant arm, or one with elbow and wrist flips, puts
+its tool at a pose in several ways; the one nearest the arm may sit behind an obstacle
+while another is free and reachable. ``goal_candidates`` gives the solver's own answer
+(the one ``ik`` and ``moveto`` use) first, then distinct answers from the solver's
+restarts (its stored seed configurations closest to the target), nearest the arm first.
+Use it on the solver's thread.
 """
 
 from __future__ import annotations
 
 import time
-from collections.abc import Collection, Hashable
+from collections.abc import Collection, Hashable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,23 +50,12 @@ import pinocchio as pin
 
 from c2rviz.collision import CheckGeometry, CollisionModel, Pair, PlacedShape
 from c2rviz.errors import PathCollides
+from c2rviz.ik import IkSolver, Target
+from c2rviz.ik.chain import goal_in_world
 
-from .cancel import Cancel
-from .edge_resolution import EdgeResolution, coarse_first
-from .errors import GoalCollides, NoPathFound, NoWayAround, PlanningError
+from .errors import Cancel, GoalCollides, NoPathFound, NoWayAround, PlanningError
 from .ompl_planner import PlannedPath, plan_for
-from .validity import ValidityChecker
-
-__all__ = [
-    "CheckedMove",
-    "MoveChecker",
-    "MoveRequest",
-    "OtherAt",
-    "PLAN_MODES",
-    "first_blocked",
-    "path_points",
-]
-
+from .validity import EdgeResolution, ValidityChecker, coarse_first
 
 PLAN_MODES = ("never", "blocked", "always")
 
@@ -281,3 +278,43 @@ def first_blocked(
         if again.size:
             found.append((cleared + int(again[0]), pair))
     return min(found) if found else None
+
+
+DISTINCT_RAD = 1e-3  # [rad or m] answers closer than this on every joint are one answer
+
+
+def goal_candidates(
+    solver: IkSolver,
+    target: Target,
+    near: Sequence[float],
+    tool: pin.SE3 | None = None,
+    count: int = 6,
+) -> list[tuple[float, ...]]:
+    """Up to ``count`` distinct chain values [rad or m] that put the tool at ``target``.
+
+    Args:
+        solver: The robot's IK solver.
+        target: Tool pose in the base frame, or a point (``ik.PointTarget``).
+        near: The arm's chain values now [rad or m].
+        tool: Tool offset from the end-effector link.
+        count: Most answers returned.
+
+    Raises:
+        Unreachable: the solver's own answer fails (beyond reach, or no attempt got there).
+    """
+    first = solver.solve(target, near, tool)
+    found = [np.array(first)]
+    settings = solver.settings
+    solver.chain.set_tool(tool)
+    goal = goal_in_world(target, solver.chain.base_placement)
+    for start in solver.seeds.ranked(goal, settings.max_attempts):
+        if len(found) >= count:
+            break
+        descent = solver.newton.descend(start, goal, settings.max_iterations)
+        if not descent.ok:
+            continue
+        q = np.array(solver.chain.to_chain(descent.q, near))
+        if all(np.max(np.abs(q - other)) > DISTINCT_RAD for other in found):
+            found.append(q)
+    rest = sorted(found[1:], key=lambda q: float(np.linalg.norm(q - np.asarray(near))))
+    return [tuple(float(x) for x in q) for q in (found[0], *rest)]

@@ -48,10 +48,9 @@ from ompl import base as ob
 from ompl import geometric as og
 from ompl import util as ou
 
-from .cancel import Cancel
-from .edge_resolution import EdgeResolution, coarse_first
 from .errors import (
     BadPlanningSetting,
+    Cancel,
     GoalCollides,
     NoPathFound,
     OutOfLimits,
@@ -59,11 +58,10 @@ from .errors import (
     StartCollides,
     checked_setting,
 )
-from .validity import ValidityChecker
+from .validity import EdgeResolution, ValidityChecker, coarse_first
 
 log = logging.getLogger("c2rviz.planning")
 
-__all__ = ["MAX_TIMEOUT_S", "SEEDS", "EdgeCheck", "PlannedPath", "plan_for", "plan_path"]
 
 MAX_TIMEOUT_S = 60.0  # [s] longest search accepted
 _MIN_TIMEOUT_S = 1e-3  # [s]

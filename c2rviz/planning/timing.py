@@ -33,8 +33,6 @@ from c2rviz.motion import MotionLimits
 
 from .errors import BadPlanningSetting, PlanningError
 
-__all__ = ["TimedPath", "TimingFailed", "time_path"]
-
 State = tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]]
 
 

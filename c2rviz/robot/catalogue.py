@@ -21,16 +21,6 @@ from typing import Protocol
 
 from ..errors import ConfigError
 
-__all__ = [
-    "EXAMPLE_ROBOTS",
-    "CatalogueEntry",
-    "catalogue",
-    "example_robot_data_dir",
-    "example_robots",
-    "find_robot",
-    "listing",
-]
-
 # name -> (URDF under example-robot-data's robots/ folder, base link, end-effector link).
 # The ends are the arm's: the flange or tool frame its maker or its SRDF names.
 EXAMPLE_ROBOTS: dict[str, tuple[str, str, str]] = {

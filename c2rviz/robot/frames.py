@@ -33,17 +33,6 @@ from collections.abc import Sequence
 import numpy as np
 import pinocchio as pin
 
-__all__ = [
-    "canonical_rpy",
-    "in_base",
-    "in_world",
-    "pose_se3",
-    "se3_pose",
-    "se3_wxyz",
-    "wxyz_rotation",
-    "wxyz_se3",
-]
-
 
 def pose_se3(pose: Sequence[float]) -> pin.SE3:
     """``x, y, z, roll, pitch, yaw`` [m, rad] as a placement."""

@@ -21,8 +21,6 @@ import pinocchio as pin
 
 from ..errors import RobotError
 
-__all__ = ["FINGER_WORD", "Gripper", "find_fingers", "make_gripper"]
-
 FINGER_WORD = "finger"
 """A joint off the chain whose name holds this (any case) is a finger of the URDF's gripper."""
 

@@ -22,8 +22,6 @@ from ..errors import RobotError
 from .gripper import Gripper, find_fingers
 from .sources import RobotSource, load_source
 
-__all__ = ["CONTINUOUS_LIMIT", "ChainJoint", "Robot"]
-
 _UNBOUNDED = 1e10  # Pinocchio's stand-in for "no limit" is a huge number.
 
 CONTINUOUS_LIMIT = 1e6

@@ -33,20 +33,6 @@ from urllib.parse import unquote
 from ..errors import ConfigError, RobotError
 from .xacro import expand_xacro, parse_xacro_args
 
-__all__ = [
-    "MissingMesh",
-    "RobotSource",
-    "MAX_JOINTS",
-    "MAX_LINKS",
-    "MAX_MESH_BYTES",
-    "MAX_URDF_BYTES",
-    "check_size",
-    "check_urdf_root",
-    "load_source",
-    "parse_xacro_args",
-    "split_package_path",
-]
-
 MAX_URDF_BYTES = 16 << 20
 """Longest robot description (the URDF, or a xacro file's expansion) [bytes]."""
 MAX_JOINTS = 128

@@ -14,8 +14,6 @@ from pathlib import Path
 
 from ..errors import ConfigError, RobotError
 
-__all__ = ["expand_xacro", "parse_xacro_args"]
-
 _xacro_lock = threading.Lock()  # xacro keeps module-level state
 
 

@@ -7,16 +7,17 @@ MCAP storage out; rosbag2 folders, bare ``.mcap``/``.db3`` files and ROS 1
 the player drive these pieces.
 
 - ``messages``: builders of JointState, TFMessage and String dicts, stamps,
-  namespaces and frame prefixes; ``markers``: MarkerArray dicts (markers and
-  workcell objects);
-- ``cdr``: ``CdrEncoder``, dict -> CDR bytes, compiled once per type;
+  namespaces and frame prefixes, and MarkerArray dicts (markers and workcell
+  objects);
+- ``cdr``: ``CdrEncoder``, dict -> CDR bytes, compiled once per type, and
+  ``JointStateDecoder``, a serialized JointState read quickly;
 - ``tf_tree``: ``TfTree``, a robot's joint states and transforms as
   robot_state_publisher gives them;
-- ``bag_writer``: ``BagWriter``, one rosbag2 MCAP bag being written;
-  ``bag_repair``: ending a bag whose writing stopped half-way;
-- ``robot_bag``: ``BagRobot``, one robot's topics in a bag;
+- ``bag_writer``: ``BagWriter``, one rosbag2 MCAP bag being written, and
+  ``BagRobot``, one robot's topics in it; ``bag_repair``: ending a bag whose
+  writing stopped half-way;
 - ``bag_reader``: ``JointStateBag``, a bag's JointState samples, checked, streamed
-  (``joint_state_bytes`` decodes them);
+  (``cdr`` decodes them);
 - ``errors``: the door's errors (all ``C2rvizError``).
 
 Importing the package is cheap (a rosbridge door needs ``messages`` alone); the
@@ -63,7 +64,7 @@ __all__ = [
 ]
 
 _HOME = {
-    "BagRobot": "robot_bag",
+    "BagRobot": "bag_writer",
     "BagWriter": "bag_writer",
     "JointStateBag": "bag_reader",
     "TfTree": "tf_tree",

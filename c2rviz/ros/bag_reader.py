@@ -31,6 +31,7 @@ from typing import Any
 
 from rosbags.highlevel import AnyReader
 
+from .cdr import JointStateDecoder
 from .errors import (
     AmbiguousTopic,
     BadSample,
@@ -43,9 +44,6 @@ from .errors import (
     StampsBackwards,
     UnknownTopic,
 )
-from .joint_state_bytes import JointStateDecoder
-
-__all__ = ["JOINT_STATE_TYPES", "JointStateBag"]
 
 JOINT_STATE_TYPES = ("sensor_msgs/msg/JointState", "sensor_msgs/JointState")
 _SUFFIXES = (".mcap", ".db3", ".bag")

@@ -26,8 +26,6 @@ from rosbags.interfaces import ConnectionExtRosbag2, Qos
 from rosbags.rosbag2 import Reader
 from rosbags.typesys.store import Typestore
 
-__all__ = ["MAGIC", "end_bag", "end_mcap", "ended", "qos_dict", "write_metadata"]
-
 MAGIC = b"\x89MCAP0\r\n"
 _HEADER, _FOOTER, _DATA_END = 0x01, 0x02, 0x0F
 _RECORD = struct.Struct("<BQ")  # opcode, length

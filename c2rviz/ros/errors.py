@@ -10,22 +10,6 @@ from collections.abc import Sequence
 
 from ..errors import C2rvizError
 
-__all__ = [
-    "AmbiguousTopic",
-    "BadSample",
-    "BagCorrupted",
-    "BagError",
-    "DescriptionError",
-    "EmptySpan",
-    "MessageError",
-    "MissingJoint",
-    "NoJointStateTopic",
-    "NotABag",
-    "RosError",
-    "StampsBackwards",
-    "UnknownTopic",
-]
-
 _LISTED = 12  # names listed in a message before "and N more"
 
 

@@ -31,8 +31,6 @@ import pinocchio as pin
 from ..robot import Robot
 from .errors import DescriptionError
 
-__all__ = ["MOVING_KINDS", "TfTree", "Transform", "UrdfJoint", "urdf_joints"]
-
 MOVING_KINDS = ("revolute", "continuous", "prismatic")
 """Joint types that move, are named in JointState and published on ``/tf``."""
 _STATIC_KINDS = ("fixed", "planar")

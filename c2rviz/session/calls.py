@@ -23,12 +23,12 @@ import numpy as np
 
 from ..collision.model import segment
 from ..errors import ArmMoved, C2rvizError, NoGripper, PathCollides
+from ..ik.chain import Target
 from ..ik.line import StraightLine, plan_line
-from ..ik.target import Target
 from ..motion.path_play import LinePlay, TrajectoryPlay, brake_limits, ramp_limits
 from ..motion.trajectory import PlannedTrajectory
 from ..planning import MoveChecker, MoveRequest, first_blocked, path_points
-from ..planning.cancel import STOPPED
+from ..planning.errors import STOPPED
 from ..protocol import replies
 from ..protocol.registry import Reply
 from ..robot.model import Robot

@@ -41,7 +41,7 @@ from ..collision.model import CollisionModel, Pair
 from ..collision.other_robots import first_hit_between, placed_shapes
 from ..motion.path_play import PathPlay
 from ..planning import EdgeResolution, MoveChecker, MoveRequest, first_blocked
-from ..planning.cancel import Cancel
+from ..planning.errors import Cancel
 from ..planning.guarded_move import OtherAt
 from ..world.clock import Hold
 from ..world.observer import Observer

@@ -13,7 +13,7 @@ With ``guard on`` (or ``plan``) a joint-space move goes like this:
    planned around when the straight path is blocked; ``plan``: always planned, the
    direct edge first) searches on its plan lane, in a process of its own, where
    ``stop``, the client closing or a newer move of the session cancel it
-   (``planning.cancel``; ``plan_process``).
+   (``planning.errors``; ``plan_process``).
 3. Back on the loop the world may have changed meanwhile: the workcell must be the
    one checked (its revision), and every other robot that stood still stand where
    it stood; else the move is checked again, up to ``TRIES`` times, and then
@@ -44,7 +44,7 @@ from ..planning import (
     TimedPath,
     time_path,
 )
-from ..planning.cancel import Cancel
+from ..planning.errors import Cancel
 from ..protocol import replies
 from ..world.moves import Travel
 from ..world.state import RobotState

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..errors import C2rvizError, MotionInterrupted
-from ..planning.cancel import SUPERSEDED, WENT_AWAY, Cancel, PlanCancelled
+from ..planning.errors import SUPERSEDED, WENT_AWAY, Cancel, PlanCancelled
 
 
 class WorkerBusy(C2rvizError):

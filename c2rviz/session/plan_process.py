@@ -33,8 +33,7 @@ import warnings
 from collections.abc import Callable
 from typing import Any, TypeVar
 
-from ..planning.cancel import Cancel, PlanCancelled
-from ..planning.errors import NoPathFound, NoWayAround
+from ..planning.errors import Cancel, NoPathFound, NoWayAround, PlanCancelled
 from ..planning.guarded_move import CheckedMove, MoveChecker, MoveRequest
 from ..planning.ompl_planner import fork_lock
 

@@ -24,7 +24,7 @@ from typing import TypeVar
 import numpy as np
 
 from ..errors import C2rvizError
-from ..ik.target import Target
+from ..ik.chain import Target
 from ..motion.trajectory import PlannedTrajectory
 from ..planning import EdgeResolution, edge_resolution
 from ..protocol import replies

@@ -43,7 +43,7 @@ from collections.abc import Callable, Hashable
 from typing import Any, TypeVar
 
 from ..ik.solver import IkSolver
-from ..planning.cancel import Cancel, PlanCancelled
+from ..planning.errors import Cancel, PlanCancelled
 from ..world.state import RobotState
 from .lanes import Job, Lane
 

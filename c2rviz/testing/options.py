@@ -13,7 +13,7 @@ import pinocchio as pin
 from ..app.config import MOTION_FLAGS, Settings, load_settings
 from ..app.members import Member, members
 from ..ini import find_ini
-from ..motion.planner import motion_limits
+from ..motion.limits import motion_limits
 from ..robot.model import Robot
 from ..world.clock import Clock
 

@@ -24,7 +24,7 @@ import logging
 from typing import Final
 
 from ..errors import C2rvizError
-from ..planning.cancel import STOPPED
+from ..planning.errors import STOPPED
 from ..protocol import replies
 from ..protocol.framing import Line, LineFramer
 from ..protocol.grammar import parse_line

@@ -23,7 +23,7 @@ from typing import Protocol
 
 from ..errors import C2rvizError, LineTooLong
 from ..observers.watch import STREAM_ALLOWANCE_BYTES
-from ..planning.cancel import WENT_AWAY
+from ..planning.errors import WENT_AWAY
 from ..protocol import replies
 from ..protocol.framing import Line, LineFramer
 from ..protocol.grammar import ForeignProtocol

@@ -8,7 +8,7 @@ longer than ``MAX_HTML_FRAMES`` frames at that rate), and the last row. Kept row
 are parsed whole and checked: the header names the robot's joints, every row has
 its number of values, all finite, and time never goes back. After the tool pose the
 header may name parts' poses (``NAME.x`` .. ``NAME.yaw``, six columns a part: the
-recorder's ``observers.record_cell.csv_columns``); a part's empty cells (it was
+recorder's ``observers.recorded.csv_columns``); a part's empty cells (it was
 removed) are read as NaN. Anything wrong ends
 the reading there, with a sentence in ``problems`` that the page shows: the page
 opens with what was good and says what was not, never blank or frozen.

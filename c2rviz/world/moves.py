@@ -16,8 +16,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 from ..errors import MotionInterrupted
+from ..motion.limits import MotionLimits
 from ..motion.path_play import PathPlay
-from ..motion.planner import Motion, MotionLimits
+from ..motion.planner import Motion
 from ..protocol import replies
 from .clock import Clock, Timer
 from .state import MoveRules, RobotState

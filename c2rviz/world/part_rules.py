@@ -38,7 +38,7 @@ import coal
 import numpy as np
 import pinocchio as pin
 
-from ..collision.part_geometry import contains, extent, signed_distance
+from ..collision.geometry import contains, extent, signed_distance
 from ..errors import C2rvizError
 from ..robot.gripper import FINGER_WORD, Gripper
 from ..robot.model import Robot

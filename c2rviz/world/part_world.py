@@ -20,8 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from ..collision.geometry import robot_geometry
-from ..collision.part_geometry import Obstacle, drop, signed_distance
+from ..collision.geometry import Obstacle, drop, robot_geometry, signed_distance
 from .part_rules import (
     Goal,
     GoalBook,

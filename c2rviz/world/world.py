@@ -23,7 +23,7 @@ import pinocchio as pin
 from ..collision.model import CollisionModel, Pair
 from ..collision.workcell import MAX_OBJECTS
 from ..errors import C2rvizError, UnknownRobot
-from ..motion.planner import MotionLimits, motion_limits
+from ..motion.limits import MotionLimits, motion_limits
 from ..protocol import replies
 from ..robot.frames import se3_pose, se3_wxyz
 from ..robot.model import Robot

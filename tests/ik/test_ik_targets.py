@@ -15,7 +15,7 @@ import pytest
 from test_ik import BENT_ELBOW, BUNDLED, EXAMPLE_ARMS, errors, solver, within_limits
 
 from c2rviz.ik import IkSolver, PointTarget, Unreachable, plan_line
-from c2rviz.ik.target import goal_in_world
+from c2rviz.ik.chain import goal_in_world
 from c2rviz.robot import Robot
 from c2rviz.robot.frames import canonical_rpy
 

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from support import load_robot
 
+from c2rviz.motion.limits import motion_limits
 from c2rviz.motion.path_play import LinePlay, ramp_limits
-from c2rviz.motion.planner import motion_limits
 
 DT = 1e-3  # sampling step [s]
 LIMITS = motion_limits(load_robot("motoman_sia20d"))

@@ -30,14 +30,11 @@ from c2rviz.motion.limits import (
     DEFAULT_PRISMATIC_VELOCITY,
     DEFAULT_REVOLUTE_VELOCITY,
     JERK_PER_VELOCITY,
-)
-from c2rviz.motion.planner import (
-    Motion,
     MotionLimitError,
     MotionLimits,
-    _position_range,
     motion_limits,
 )
+from c2rviz.motion.planner import Motion, _position_range
 from c2rviz.robot.model import CONTINUOUS_LIMIT, Robot
 
 TREE = ROOT / "tests" / "data" / "tree_robot" / "tree.urdf"

@@ -6,9 +6,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from c2rviz.motion.limits import MotionLimits
-from c2rviz.motion.trajectory import SAMPLES_PER_SEGMENT, TrajectoryError, plan_trajectory
-from c2rviz.motion.trajectory_check import CHUNK, FIRST_CHUNK, evaluate
+from c2rviz.motion.limits import (
+    CHUNK,
+    FIRST_CHUNK,
+    SAMPLES_PER_SEGMENT,
+    MotionLimits,
+    TrajectoryError,
+    evaluate,
+)
+from c2rviz.motion.trajectory import plan_trajectory
 
 LIMITS = MotionLimits((2.0, 1.0), (4.0, 2.0), (40.0, 20.0), (-3.0, -0.5), (3.0, 2.0))
 NAMES = ("shoulder", "slide")

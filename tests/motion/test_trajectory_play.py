@@ -7,10 +7,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from c2rviz.motion.limits import MotionLimits
+from c2rviz.motion.limits import MotionLimits, evaluate
 from c2rviz.motion.path_play import TrajectoryPlay
 from c2rviz.motion.trajectory import START_TOLERANCE, TrajectoryError, plan_trajectory
-from c2rviz.motion.trajectory_check import evaluate
 
 LIMITS = MotionLimits((2.0, 1.0), (4.0, 2.0), (40.0, 20.0), (-3.0, -0.5), (3.0, 2.0))
 NAMES = ("shoulder", "slide")

@@ -22,7 +22,7 @@ from c2rviz.app import cli
 from c2rviz.app.config import ServerLimits, load_settings
 from c2rviz.errors import ConfigError, RobotError
 from c2rviz.ini import find_ini
-from c2rviz.motion.planner import motion_limits
+from c2rviz.motion.limits import motion_limits
 from c2rviz.robot.catalogue import EXAMPLE_ROBOTS, example_robot_data_dir, example_robots
 from c2rviz.robot.model import CONTINUOUS_LIMIT, Robot
 

@@ -108,7 +108,7 @@ def example_meshes(*robots: str) -> list[Path]:
     from c2rviz.app.config import load_settings
     from c2rviz.app.members import members
     from c2rviz.ini import find_ini
-    from c2rviz.robot.urdf_elements import read_links
+    from c2rviz.robot.visuals import read_links
 
     found: set[Path] = set()
     for name in robots:

@@ -1,4 +1,4 @@
-"""The URDF's visual and collision elements as ``urdf_elements`` reads them are what yourdfpy
+"""The URDF's visual and collision elements as ``robot.visuals`` reads them are what yourdfpy
 reads (the library the program used before, kept as the judge) on every bundled robot,
 every example robot and the test robots; a hostile document expands nothing."""
 
@@ -12,7 +12,7 @@ import pytest
 import yourdfpy
 
 from c2rviz.robot.catalogue import example_robot_data_dir, example_robots
-from c2rviz.robot.urdf_elements import Element, read_links
+from c2rviz.robot.visuals import Element, read_links
 
 ROOT = Path(__file__).resolve().parents[2]
 FILES = sorted((ROOT / "robots").glob("*/robot.urdf")) + sorted(

@@ -14,11 +14,10 @@ from rosbags.highlevel import AnyReader
 from rosbags.interfaces import QosDurability
 from test_ros_tf_tree import close, link_poses
 
-from c2rviz.ros import markers as mk
 from c2rviz.ros import messages as m
-from c2rviz.ros.bag_writer import BagWriter
+from c2rviz.ros import messages as mk
+from c2rviz.ros.bag_writer import BagRobot, BagWriter
 from c2rviz.ros.errors import BagError, MessageError
-from c2rviz.ros.robot_bag import BagRobot
 
 FRAMES = 150
 LATCHED = {

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from ros_helpers import HUMBLE, JOINT_STATE, NOETIC, humble_joint_state
 
-from c2rviz.ros.joint_state_bytes import JointStateDecoder
+from c2rviz.ros.cdr import JointStateDecoder
 
 NAMES = [
     ("a",),

@@ -9,8 +9,8 @@ from typing import Any
 import pytest
 from ros_helpers import HUMBLE, as_plain
 
-from c2rviz.ros import markers as mk
 from c2rviz.ros import messages as m
+from c2rviz.ros import messages as mk
 from c2rviz.ros.cdr import CdrEncoder
 from c2rviz.ros.errors import MessageError
 

@@ -24,7 +24,7 @@ from rosbags.interfaces import QosDurability
 from support import Client, ServerThread
 from test_ros_tf_tree import close, link_poses
 
-from c2rviz.ros import markers as mk
+from c2rviz.ros import messages as mk
 from c2rviz.ros.tf_tree import TfTree
 
 TYPES = {

@@ -22,8 +22,7 @@ from rosbags.highlevel import AnyReader
 
 from c2rviz.ros import messages as m
 from c2rviz.ros.bag_repair import end_bag, end_mcap
-from c2rviz.ros.bag_writer import BagWriter
-from c2rviz.ros.robot_bag import BagRobot
+from c2rviz.ros.bag_writer import BagRobot, BagWriter
 
 
 def read_stamps(path: Path) -> list[tuple[str, int]]:

@@ -10,7 +10,7 @@ import pinocchio as pin
 import pytest
 from support import ROBOTS, ServerThread, load_robot
 
-from c2rviz.motion.planner import motion_limits
+from c2rviz.motion.limits import motion_limits
 
 
 def pose_of(reply: str) -> pin.SE3:

@@ -17,7 +17,7 @@ import pytest
 from support import Client, ServerThread
 
 from c2rviz.errors import C2rvizError
-from c2rviz.planning.cancel import STOPPED, SUPERSEDED, WENT_AWAY, Cancel, PlanCancelled
+from c2rviz.planning.errors import STOPPED, SUPERSEDED, WENT_AWAY, Cancel, PlanCancelled
 from c2rviz.session import Session
 from c2rviz.session.lanes import Superseded, WorkerBusy
 from c2rviz.session.worker import MAX_PER_OWNER, Worker

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from support import Client, ServerThread, load_robot
 
-from c2rviz.motion.planner import motion_limits
+from c2rviz.motion.limits import motion_limits
 from c2rviz.session import ServerLimits
 from c2rviz.world.virtual_clock import VirtualClock
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from c2rviz.planning import NoPathFound
-from c2rviz.planning.cancel import STOPPED, Cancel, PlanCancelled
+from c2rviz.planning.errors import STOPPED, Cancel, PlanCancelled
 from c2rviz.session import plan_process
 from c2rviz.session.plan_process import ParentGone, run_forked
 

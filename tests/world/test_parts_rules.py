@@ -11,8 +11,8 @@ import pinocchio as pin
 import pytest
 from support import load_robot
 
+from c2rviz.collision.geometry import drop, extent
 from c2rviz.collision.other_robots import placed_shapes
-from c2rviz.collision.part_geometry import drop, extent
 from c2rviz.collision.workcell import collision_geometry, make_object
 from c2rviz.robot.gripper import Gripper
 from c2rviz.world.part_rules import Goal, Jaws, opening_for, score, take

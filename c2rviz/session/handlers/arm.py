@@ -9,8 +9,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from ...errors import UnknownMarker
-from ...ik.target import PointTarget
-from ...ik.target import Target as ToolTarget  # (Target here is the `target` verb)
+from ...ik.chain import PointTarget
+from ...ik.chain import Target as ToolTarget
 from ...protocol import replies
 from ...protocol.registry import Reply, handler
 from ...protocol.verbs.arm import (

@@ -19,11 +19,11 @@ import asyncio
 from typing import TYPE_CHECKING
 
 from ...errors import BadArguments, JointCountError
-from ...ik.target import PointTarget, Target
+from ...ik.chain import PointTarget, Target
 from ...observers.recorded import Recorded
 from ...planning import MAX_TIMEOUT_S, goal_candidates, time_path
-from ...planning.edge_resolution import RANGES
 from ...planning.errors import checked_setting
+from ...planning.validity import RANGES
 from ...protocol import replies
 from ...protocol.registry import Reply, handler, usage
 from ...protocol.verbs.scene import (

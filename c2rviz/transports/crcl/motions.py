@@ -27,7 +27,7 @@ from collections.abc import Sequence
 
 import pinocchio as pin
 
-from ...ik.target import Target
+from ...ik.chain import Target
 from .controller import Controller, Job, Refused
 from .primitives import Pose
 from .units import pose_to_matrix

@@ -50,13 +50,17 @@ import pinocchio as pin
 from ...collision.workcell import WorkcellObject
 from ...observers.camera_feed import CAMERA_TOPIC, POSE_ARRAY, CameraFeed, camera_items, pose_array
 from ...robot.model import Robot
-from ...ros.markers import SHAPES, delete_all, delete_marker, marker, object_marker
 from ...ros.messages import (
     JOINT_STATE,
+    SHAPES,
     Msg,
+    delete_all,
+    delete_marker,
     frame_prefix,
     header,
     joint_state,
+    marker,
+    object_marker,
     tf_message,
     topic,
     transform,

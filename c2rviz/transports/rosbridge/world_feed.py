@@ -11,7 +11,7 @@ that changed and only for topics someone reads:
 
 * ``[NS]/joint_states``: stamped with the world's clock time of the change;
 * ``/tf``: every robot's moving joints and every part's frame ``parts/NAME``
-  (``observers.bag_parts``; one message holds them all, so a slow subscriber that
+  (``observers.bag_topics``; one message holds them all, so a slow subscriber that
   keeps only the latest loses no robot), stamped likewise;
 * ``[NS]/visualization_marker_array``: markers added (and those pushed out past
   ``MAX_MARKERS`` deleted; all deleted after a ``clear``, or when more went than
@@ -36,10 +36,9 @@ from functools import partial
 import pinocchio as pin
 
 from ...collision.workcell import WorkcellObject
-from ...observers.bag_parts import part_items
+from ...observers.bag_topics import part_items
 from ...observers.watch import WatchHub
-from ...ros.markers import marker_array
-from ...ros.messages import Msg, string, tf_message, transforms
+from ...ros.messages import Msg, marker_array, string, tf_message, transforms
 from ...world.clock import Timer
 from ...world.observer import MAX_MARKERS, Marker, Observer
 from ...world.parts import Part

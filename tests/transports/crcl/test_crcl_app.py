@@ -17,7 +17,7 @@ from c2rviz.app.config import Settings, load_settings
 from c2rviz.app.doors import OPENERS, close_doors, open_crcl
 from c2rviz.app.members import Member
 from c2rviz.errors import ConfigError
-from c2rviz.motion.planner import motion_limits
+from c2rviz.motion.limits import motion_limits
 from c2rviz.session import Services
 from c2rviz.transports.crcl.server import DEFAULT_PORT
 from c2rviz.world.world import World
