@@ -3,8 +3,8 @@
 A ROS-free re-creation of NIST's "text based command and control of a ROS RViz
 visualization": clients send one-line commands over TCP (port 31000) and the
 arm moves in a viser page. A controller talks to it with ``Client`` (blocking) or
-``AsyncClient`` (asyncio): one typed method per verb (docs/testing.md). The parts, each
-usable alone:
+``AsyncClient`` (asyncio): a method per verb, typed or ``robot.VERB(*words)``
+(docs/testing.md). The parts, each usable alone:
 
 - ``protocol``: the pure parser (line -> frozen command), the verbs and the replies;
 - ``robot``: the Pinocchio model and its serial chain, and where its URDF and meshes

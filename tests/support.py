@@ -8,6 +8,7 @@ path because the root ``conftest.py`` lives there.
 from __future__ import annotations
 
 import contextlib
+import inspect
 import socket
 import subprocess
 import sys
@@ -163,3 +164,14 @@ class Process:
 
     def wait(self, timeout: float = 60.0) -> int:
         return self.popen.wait(timeout=timeout)
+
+
+def typed_verbs(cls: type) -> dict[str, list[str]]:
+    """Each verb that ``cls`` (``Client`` or ``AsyncClient``) has a typed method for, and
+    those methods (the ones tagged ``@speaks(verb)``); any other verb is ``robot.VERB(*words)``."""
+    found: dict[str, list[str]] = {}
+    for name, member in inspect.getmembers(cls, callable):
+        verb = getattr(member, "__c2rviz_verb__", None)
+        if verb is not None:
+            found.setdefault(verb, []).append(name)
+    return found

@@ -66,6 +66,7 @@ class AsyncSceneVerbs:
         """The tool's trail: ``on`` (a fresh one), ``off`` or ``clear``."""
         return await self.call(calls.trail(action))
 
+    @speaks("trail")
     async def trail_status(self) -> TrailStatus:
         """Whether the trail is on, and its points."""
         return await self.call(calls.TRAIL_STATUS)
@@ -76,10 +77,12 @@ class AsyncSceneVerbs:
         server's recording folder."""
         return await self.call(calls.record(name, overwrite))
 
+    @speaks("record")
     async def record_stop(self) -> RecordingResult:
         """End the recording; returns when its files are complete."""
         return await self.call(calls.RECORD_STOP)
 
+    @speaks("record")
     async def recording(self) -> RecordingStatus | None:
         """The recording running (None: none)."""
         return await self.call(calls.RECORDING)
@@ -95,10 +98,12 @@ class AsyncSceneVerbs:
         ``pose`` x, y, z [m], roll, pitch, yaw [rad, or deg] (a sphere: x, y, z)."""
         return await self.call(calls.add_object(name, shape, size, pose))
 
+    @speaks("object")
     async def remove_object(self, name: str) -> None:
         """Remove workcell object ``name``."""
         return await self.call(calls.remove_object(name))
 
+    @speaks("object")
     async def remove_objects(self) -> None:
         """Remove every workcell object."""
         return await self.call(calls.REMOVE_OBJECTS)

@@ -1,4 +1,4 @@
-"""``Client``: a controller's blocking connection to c2rviz, one typed method per verb.
+"""``Client``: a controller's blocking connection to c2rviz, a method per verb.
 
 ::
 
@@ -9,13 +9,13 @@
         robot.joints([0.5, 0, 0, 0, 0, 0, 0])   # [rad]; returns when the arm arrives
         print(robot.where(), robot.pose())
 
-Every verb of the command language (``protocol.registry.VERBS``) has a method here
-(``speaks`` tags it) taking typed arguments and returning a typed result (``records``);
-the methods are written once, for ``AsyncClient`` (below; ``aio_verbs``,
-``aio_scene_verbs``),
-and ``scripts/unasync_clients.py`` writes their blocking twins (``verbs``,
-``scene_verbs``). A verb of the registry with no typed method yet is still a method:
-``robot.VERB(*words)`` sends the line and returns its ``ok`` reply, as ``send`` does.
+Every verb of the command language (``protocol.registry.VERBS``) is a method here.
+The typed ones (``speaks`` tags each with its verb) take typed arguments and return a
+typed result (``records``); they are written once, for ``AsyncClient`` (below;
+``aio_verbs``, ``aio_scene_verbs``), and ``scripts/unasync_clients.py`` writes their
+blocking twins (``verbs``, ``scene_verbs``). A verb of the registry with no typed
+method is a method all the same: ``robot.VERB(*words)`` sends the line and returns its
+``ok`` reply, as ``send`` does (a new verb needs no client code: docs/architecture.md).
 Angles are radians, lengths metres, unless the connection chose degrees (``degrees()``
 or ``Client(degrees=True)``): then angles are degrees, both ways. Arguments are checked
 before anything is sent (``calls``); an ``error:`` reply raises ``CommandError`` with

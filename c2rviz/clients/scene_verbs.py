@@ -63,6 +63,7 @@ class SceneVerbs:
         """The tool's trail: ``on`` (a fresh one), ``off`` or ``clear``."""
         return self.call(calls.trail(action))
 
+    @speaks("trail")
     def trail_status(self) -> TrailStatus:
         """Whether the trail is on, and its points."""
         return self.call(calls.TRAIL_STATUS)
@@ -73,10 +74,12 @@ class SceneVerbs:
         server's recording folder."""
         return self.call(calls.record(name, overwrite))
 
+    @speaks("record")
     def record_stop(self) -> RecordingResult:
         """End the recording; returns when its files are complete."""
         return self.call(calls.RECORD_STOP)
 
+    @speaks("record")
     def recording(self) -> RecordingStatus | None:
         """The recording running (None: none)."""
         return self.call(calls.RECORDING)
@@ -92,10 +95,12 @@ class SceneVerbs:
         ``pose`` x, y, z [m], roll, pitch, yaw [rad, or deg] (a sphere: x, y, z)."""
         return self.call(calls.add_object(name, shape, size, pose))
 
+    @speaks("object")
     def remove_object(self, name: str) -> None:
         """Remove workcell object ``name``."""
         return self.call(calls.remove_object(name))
 
+    @speaks("object")
     def remove_objects(self) -> None:
         """Remove every workcell object."""
         return self.call(calls.REMOVE_OBJECTS)

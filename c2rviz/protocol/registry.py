@@ -2,7 +2,8 @@
 
 A verb is declared once, on the frozen dataclass its parser returns::
 
-    @verb("move", "i[,j,...] vi[,vj,...]", "set the listed joints; ...")
+    @verb("move", "i[,j,...] vi[,vj,...]", "set the listed joints; ...",
+          examples=("move 0 1", "move 0,1 90,-90"))
     @dataclass(frozen=True, slots=True)
     class Move:
         indices: tuple[int, ...]
@@ -16,9 +17,11 @@ and handled once, by a function on the session side::
     @handler(Move)
     def move(session: Session, command: Move) -> Reply: ...
 
-``help``, the command table (docs/commands.md) and the parser tests are all made from
-``VERBS``. This module has no I/O and imports nothing heavy: the clients use it
-(through ``protocol.parse_line``) without loading Pinocchio.
+``help``, the command table (docs/commands.md), the parser tests (each verb's
+``examples`` must parse to its class) and the clients' ``robot.VERB(*words)`` are all
+made from ``VERBS``: a new verb is its entry, its handler and its row of the table.
+This module has no I/O and imports nothing heavy: the clients use it (through
+``protocol.parse_line``) without loading Pinocchio.
 """
 
 from __future__ import annotations
@@ -48,6 +51,9 @@ class Verb:
         aliases: Other spellings of the verb.
         page: The docs page that tells of it (``help VERB`` names it), from the
             project's root.
+        examples: Lines that use it, each one that parses to ``command``
+            (``help VERB`` shows them; ``tests/protocol/test_registry.py`` parses them
+            and asks every verb for one).
     """
 
     name: str
@@ -57,6 +63,7 @@ class Verb:
     parse: Callable[[str, list[str]], Any]
     aliases: tuple[str, ...] = ()
     page: str = "docs/commands.md"
+    examples: tuple[str, ...] = ()
 
     @property
     def usage(self) -> str:
@@ -82,17 +89,20 @@ def verb(
     aliases: tuple[str, ...] = (),
     parse: Callable[[str, list[str]], Any] | None = None,
     page: str = "docs/commands.md",
+    examples: tuple[str, ...] = (),
 ) -> Callable[[C], C]:
     """Register the decorated command class as verb ``name`` (stackable).
 
     ``parse`` defaults to the class's own ``parse``; a class with no fields and
     no ``parse`` takes no arguments. ``page`` is the docs page that tells of the verb
     (docs/commands.md, which lists every verb, unless a page of its own does).
+    ``examples`` are lines of the verb, as a user types them: ``help VERB`` shows
+    them, and the registry test parses each and wants at least one per verb.
     """
 
     def register(cls: C) -> C:
         chosen = parse or getattr(cls, "parse", None) or _no_args(cls)
-        entry = Verb(name, args, summary, cls, chosen, aliases, page)
+        entry = Verb(name, args, summary, cls, chosen, aliases, page, examples)
         for word in (name, *aliases):
             if word in LOOKUP:
                 raise ValueError(f"verb {word!r} is registered twice")

@@ -9,32 +9,80 @@ import inspect
 import math
 import threading
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from support import typed_verbs
 
 from c2rviz import AsyncClient, Client, CommandError, ConnectionLost, Event, JointLimit, Pose, State
 from c2rviz.clients.errors import ArgumentError, ArgumentTypeError
 from c2rviz.clients.records import MotionStatus, RobotNames, TrailStatus
-from c2rviz.protocol.registry import VERBS
-
-
-def verb_methods(cls: type) -> dict[str, list[str]]:
-    """Each verb and the methods of ``cls`` tagged as sending it."""
-    found: dict[str, list[str]] = {}
-    for name, member in inspect.getmembers(cls, callable):
-        verb = getattr(member, "__c2rviz_verb__", None)
-        if verb is not None:
-            found.setdefault(verb, []).append(name)
-    return found
+from c2rviz.errors import BadArguments
+from c2rviz.protocol import replies
+from c2rviz.protocol.registry import HANDLERS, LOOKUP, VERBS, handler, usage, verb
 
 
 @pytest.mark.parametrize("cls", [Client, AsyncClient], ids=["Client", "AsyncClient"])
-def test_every_verb_of_the_registry_has_a_client_method(cls):
-    tagged = verb_methods(cls)
-    missing = sorted(set(VERBS) - set(tagged))
-    assert not missing, f"{cls.__name__} has no method for {missing}: add one (calls.py too)"
-    assert set(tagged) <= set(VERBS), "a method speaks a verb the registry does not know"
+def test_every_typed_method_speaks_a_verb_of_the_registry(cls):
+    typed = typed_verbs(cls)
+    assert typed, f"{cls.__name__} has no method tagged @speaks(verb)"
+    assert set(typed) <= set(VERBS), "a method speaks a verb the registry does not know"
+    assert typed == typed_verbs(Client), "the two clients type different verbs"
+
+
+@pytest.fixture
+def a_verb_with_no_method():
+    """A verb registered for this test alone, entry and handler, as a new verb would be
+    (and taken out again): the clients have no typed method for it."""
+
+    @verb("echo_words", "WORD...", "reply the words", examples=("echo_words a B c",))
+    @dataclass(frozen=True)
+    class EchoWords:
+        words: tuple[str, ...]
+
+        @staticmethod
+        def parse(verb: str, words: list[str]) -> EchoWords:
+            if not words:
+                raise BadArguments(verb, "needs a word", usage(verb))
+            return EchoWords(tuple(words))
+
+    @handler(EchoWords)
+    def echo_words(session: object, command: EchoWords) -> str:
+        return replies.ok(" ".join(command.words))
+
+    yield VERBS["echo_words"]
+    del VERBS["echo_words"], LOOKUP["echo_words"], HANDLERS[EchoWords]
+
+
+def test_a_verb_with_no_typed_method_is_a_method_by_name_of_both_clients(
+    server, a_verb_with_no_method
+):
+    """Every verb of the registry without a typed method (here at least the test's own)
+    is ``robot.VERB(*words)`` in both clients: each of its examples, sent by name, gets
+    the reply that ``send`` gets for the line."""
+    untyped = [v for v in VERBS.values() if v.name not in typed_verbs(Client)]
+    assert a_verb_with_no_method in untyped
+    sent = [(v.name, line, line.split()[1:]) for v in untyped for line in v.examples]
+    assert len(sent) >= len(untyped)  # every verb has an example (test_registry asks)
+    with Client(server.host, server.port) as robot:
+        assert robot.echo_words("a", "B", 3) == "ok a B 3"
+        for name, line, words in sent:
+            assert getattr(robot, name)(*words) == robot.send(line), line
+        with pytest.raises(CommandError, match="echo_words: needs a word"):
+            robot.echo_words()  # an error reply raises, as from send
+        with pytest.raises(AttributeError):
+            robot.no_such_verb  # noqa: B018 (a name the registry lacks is no method)
+
+    async def main() -> None:
+        async with AsyncClient(server.host, server.port) as robot:
+            assert await robot.echo_words("x") == "ok x"
+            for name, line, words in sent:
+                assert await getattr(robot, name)(*words) == await robot.send(line), line
+            with pytest.raises(AttributeError):
+                robot.no_such_verb  # noqa: B018
+
+    asyncio.run(main())
 
 
 def test_the_async_client_mirrors_the_blocking_one():
@@ -54,12 +102,12 @@ def test_the_async_client_mirrors_the_blocking_one():
 
 def test_every_method_says_its_units():
     """A method that takes or gives angles or lengths names the unit in its docstring."""
-    for verb, names in verb_methods(Client).items():
+    for spoken, names in typed_verbs(Client).items():
         for name in names:
             doc = getattr(Client, name).__doc__ or ""
             signature = str(inspect.signature(getattr(Client, name)))
             if any(word in signature for word in ("float", "Pose", "JointLimit")):
-                assert "[" in doc, f"{name} ({verb}) states no unit"
+                assert "[" in doc, f"{name} ({spoken}) states no unit"
 
 
 def same_pose(a: Pose, b: Pose) -> bool:

@@ -13,6 +13,7 @@ from support import ROOT
 
 from c2rviz.errors import BadArguments, LineError, UnknownCommand
 from c2rviz.protocol.grammar import ForeignProtocol, parse_line
+from c2rviz.protocol.registry import VERBS
 from c2rviz.protocol.verbs.arm import (
     Ik,
     LinearSpeed,
@@ -248,6 +249,15 @@ def test_good_lines(line, expected):
     assert got == expected
     if isinstance(got, Color):  # compare channels as numbers, not float bit patterns
         assert got.rgb == pytest.approx(expected.rgb)
+
+
+EXAMPLES = [(line, verb.command) for verb in VERBS.values() for line in verb.examples]
+"""Each verb's example lines, from its registry entry (``@verb(..., examples=...)``)."""
+
+
+@pytest.mark.parametrize(("line", "command"), EXAMPLES, ids=[line for line, _ in EXAMPLES])
+def test_each_verbs_examples_parse(line, command):
+    assert type(parse_line(line)) is command
 
 
 BAD = [

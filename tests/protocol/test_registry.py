@@ -23,10 +23,18 @@ def test_every_verb_has_one_handler_and_parses_to_its_class():
         assert verb.name == word or word in verb.aliases
 
 
-def test_the_parser_tables_cover_every_verb():
-    tested = {line.split()[0].lower() for line, command, _ in GOOD if command is not None}
-    missing = {v.name for v in VERBS.values()} - tested
-    assert not missing, f"tests/test_parser.py GOOD has no line for {sorted(missing)}"
+def test_every_verb_carries_examples_that_parse_to_its_class():
+    """A verb's example lines live in its entry (``@verb(..., examples=...)``): at least
+    one each, each a line of that verb (name or alias) that parses to its class
+    (``test_parser.test_each_verbs_examples_parse`` runs them one by one too)."""
+    for verb in VERBS.values():
+        assert verb.examples, f"{verb.name} has no examples: @verb(..., examples=(LINE, ...))"
+        for line in verb.examples:
+            assert LOOKUP[line.split()[0].lower()] is verb, f"{line!r} is not a {verb.name} line"
+            assert type(parse_line(line)) is verb.command, line
+
+
+def test_the_parser_table_lines_parse_to_their_verbs_class():
     for line, command, _ in GOOD:
         if command is not None:
             assert LOOKUP[line.split()[0].lower()].command is type(parse_line(line))
@@ -46,7 +54,8 @@ def test_help_verb_gives_its_line_and_a_docs_page_that_tells_of_it():
         command = parse_line(f"help {word}")
         text = command.reply_text()
         line = next(item for item in lines if item.split()[0].split("|")[0] == entry.name)
-        assert text.startswith(f"{line}: {entry.summary}; see docs/"), text
+        examples = ", ".join(f"`{example}`" for example in entry.examples)
+        assert text.startswith(f"{line}: {entry.summary}; e.g. {examples}; see docs/"), text
         page = ROOT / text.rsplit("; see ", 1)[1]
         assert page.is_file(), page
         said = page.read_text()
@@ -58,6 +67,7 @@ def test_help_verb_through_a_server(server, connect):
     assert client.ask("help") == replies.help_reply()  # alone: the list, as ever
     reply = client.ask("help moveto")
     assert reply.startswith("ok moveto x,y,z[,roll,pitch,yaw] | marker N: go to that tool pose")
+    assert "; e.g. `moveto 0.5,0,0.8,0,90,0`, `moveto 0.5,0,0.8`, `moveto marker 3`; " in reply
     assert reply.endswith("; see docs/cartesian.md")
     assert client.ask("help movto") == (
         "error: help: no verb 'movto': did you mean 'moveto'? (usage: help [VERB])"

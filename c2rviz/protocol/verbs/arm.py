@@ -44,6 +44,7 @@ def _target(verb: str, words: list[str]) -> PoseValues:
     "the tool point (TCP) relative to the end-effector link, for this robot (every "
     "connection); alone, reply it; default the robot's ini `tool`, else none",
     page="docs/cartesian.md",
+    examples=("tool", "tool 0,0,0.1,0,0,0"),
 )
 @dataclass(frozen=True, slots=True)
 class Tool:
@@ -67,6 +68,7 @@ class Tool:
     "that pose (`x,y,z` alone: that point, any orientation), nearest the arm's "
     "configuration; nothing moves",
     page="docs/cartesian.md",
+    examples=("ik 0.5,0,0.8,0,90,0", "ik 0.5,0,0.8"),
 )
 @dataclass(frozen=True, slots=True)
 class Ik:
@@ -85,6 +87,7 @@ class Ik:
     "go to that tool pose (`x,y,z` alone: that point, any orientation; or marker N, 1 the "
     "oldest) through joint space, like `joints` with the IK solution",
     page="docs/cartesian.md",
+    examples=("moveto 0.5,0,0.8,0,90,0", "moveto 0.5,0,0.8", "moveto marker 3"),
 )
 @dataclass(frozen=True, slots=True)
 class MoveTo:
@@ -109,6 +112,7 @@ class MoveTo:
     "alone: orientation free) at this connection's `lspeed`, slower where a joint cannot "
     "keep up; the whole line is checked first; with `motion off` only its end is shown",
     page="docs/cartesian.md",
+    examples=("movel 0.5,0,0.8,0,90,0",),
 )
 @dataclass(frozen=True, slots=True)
 class MoveL:
@@ -126,6 +130,7 @@ class MoveL:
     "[V]",
     "this connection's `movel` tool speed, m/s (0.001..5; default 0.25); alone, reply it",
     page="docs/cartesian.md",
+    examples=("lspeed", "lspeed 0.1"),
 )
 @dataclass(frozen=True, slots=True)
 class LinearSpeed:
@@ -153,6 +158,7 @@ _NAME = re.compile(r"[A-Za-z0-9_.-]+")
     "drive robot NAME of the cell from now on (units, speed and marker style stay); "
     "alone, reply the robot this connection drives",
     page="docs/cells.md",
+    examples=("robot", "robot right_arm"),
 )
 @dataclass(frozen=True, slots=True)
 class RobotChoice:
@@ -175,6 +181,7 @@ class RobotChoice:
     "",
     "reply the cell's robots and their command ports: `ok left:31000,...`",
     page="docs/cells.md",
+    examples=("robots",),
 )
 @dataclass(frozen=True, slots=True)
 class RobotsList:
@@ -191,6 +198,7 @@ MOTION_MODES = ("off", "on", "follow")
     "`on` travel at the joints' limits, `ok` when the arm arrives; `follow` travel, `ok` "
     "at once (streamed setpoints); alone, reply the mode",
     page="docs/motion.md",
+    examples=("motion", "motion on", "motion follow"),
 )
 @dataclass(frozen=True, slots=True)
 class MotionMode:
@@ -216,6 +224,7 @@ class MotionMode:
     "this connection's moves at P % (1..100) of each joint's velocity limit (acceleration "
     "and jerk scaled to match); alone, reply it",
     page="docs/motion.md",
+    examples=("speed", "speed 10"),
 )
 @dataclass(frozen=True, slots=True)
 class Speed:
@@ -239,13 +248,14 @@ class Speed:
     "the arm decelerates to rest within its limits (any connection); a connection waiting "
     "for an arrival gets `error: motion stopped by ...`; the reply comes at rest",
     page="docs/motion.md",
+    examples=("stop",),
 )
 @dataclass(frozen=True, slots=True)
 class Stop:
     """Bring the arm to rest."""
 
 
-@verb("wait", "", "reply when the arm is at rest", page="docs/motion.md")
+@verb("wait", "", "reply when the arm is at rest", page="docs/motion.md", examples=("wait",))
 @dataclass(frozen=True, slots=True)
 class Wait:
     """Reply once the arm is at rest."""
@@ -256,6 +266,7 @@ class Wait:
     "",
     "reply the joint values the arm is moving to (or stands at)",
     page="docs/motion.md",
+    examples=("target",),
 )
 @dataclass(frozen=True, slots=True)
 class Target:
@@ -263,7 +274,11 @@ class Target:
 
 
 @verb(
-    "status", "", "reply `ok idle`, or `ok moving S` with the seconds left", page="docs/motion.md"
+    "status",
+    "",
+    "reply `ok idle`, or `ok moving S` with the seconds left",
+    page="docs/motion.md",
+    examples=("status",),
 )
 @dataclass(frozen=True, slots=True)
 class Status:

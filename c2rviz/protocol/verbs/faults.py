@@ -234,6 +234,7 @@ def _time(word: str, what: str) -> float:
     "from now: `estop`, `protective`, `stall JOINT`, `noise SIGMA`, `latency MS[,JITTER]`, "
     "`disconnect`, `drop [PART]`, `slip P` (docs/faults.md); `clear` ends one kind (or all, "
     "scheduled ones too)",
+    examples=("fault estop", "fault stall joint_l", "fault at 2.5 estop", "fault clear"),
 )
 @dataclass(frozen=True, slots=True)
 class FaultVerb:
@@ -273,6 +274,7 @@ class FaultVerb:
     "",
     "reply this robot's faults: `ok none`, or `ok ` and each active one (`KIND [ARGS] since "
     "T`) and scheduled one (`KIND [ARGS] at T`), `; ` between",
+    examples=("faults",),
 )
 @dataclass(frozen=True, slots=True)
 class Faults:
@@ -284,6 +286,7 @@ class Faults:
     "",
     "lift this robot's protective stop, or its emergency stop once `fault clear estop` "
     "released it; moves are accepted again",
+    examples=("reset",),
 )
 @dataclass(frozen=True, slots=True)
 class Reset:

@@ -19,6 +19,7 @@ from ..registry import usage, verb
     "the gripper to S, 0 closed .. 1 open, travelling as `motion` says (a robot with no "
     "gripper gets an error); closing on a part grasps it and replies the opening where the "
     "fingers stop, opening releases it (docs/parts.md); alone, reply its opening",
+    examples=("grip", "grip 0.25"),
 )
 @dataclass(frozen=True, slots=True)
 class Grip:
@@ -141,6 +142,11 @@ verb(
     "docs/parts.md), remove it (`part all remove`: every one), or alone reply its pose and "
     "state: `ok x,y,z,roll,pitch,yaw free|held|resting on OBJECT`",
     parse=_parse_part,
+    examples=(
+        "part p1 box 0.03,0.03,0.03 0.5,0,0.015,0,0,0 type=cube color=1,0,0",
+        "part p1",
+        "part p1 remove",
+    ),
 )(PartEdit)
 
 
@@ -148,6 +154,7 @@ verb(
     "parts",
     "",
     "reply every part: `ok NAME:x,y,z,roll,pitch,yaw:STATE;...` (base frame; `ok none`)",
+    examples=("parts",),
 )
 @dataclass(frozen=True, slots=True)
 class PartsQuery:
@@ -197,6 +204,7 @@ verb(
     "say where a part (or any part of a type) should end (base frame; tolerances default "
     "to 5 mm and 5 degrees); `score` tells how far each is",
     parse=_parse_goal,
+    examples=("goal p1 0.5,0,0.015,0,0,0", "goal all remove"),
 )(GoalEdit)
 
 
@@ -205,6 +213,7 @@ verb(
     "",
     "reply how many goals are met and how far off the others are: "
     "`ok 3/4 met; p2 12.1 mm 3.0 deg off; p4 missing` (`ok no goals`)",
+    examples=("score",),
 )
 @dataclass(frozen=True, slots=True)
 class Score:
@@ -289,6 +298,7 @@ verb(
     "docs/cameras.md), remove it, set how often `watch` reports it or its noise, or alone "
     "reply what it sees now: `ok p1:TYPE:x,y,z,roll,pitch,yaw;...` in its frame (`ok none`)",
     parse=_parse_camera,
+    examples=("camera top 0,0,1,0,90,0", "camera top", "camera top rate 5"),
 )(CameraEdit)
 
 
@@ -297,6 +307,7 @@ verb(
     "",
     "reply every camera: `ok NAME:x,y,z,roll,pitch,yaw:h_fov,v_fov,range:RATE;...` "
     "(world frame; `ok none`)",
+    examples=("cameras",),
 )
 @dataclass(frozen=True, slots=True)
 class CamerasQuery:

@@ -30,6 +30,7 @@ GHOST_ACTIONS = ("on", "off")
     "are checked), `event record-stopped ...`, `event dropped N`); "
     "replies still come one line each, in order",
     page="docs/watch.md",
+    examples=("watch", "watch 20"),
 )
 @dataclass(frozen=True, slots=True)
 class Watch:
@@ -50,7 +51,13 @@ class Watch:
         return Watch(hz)
 
 
-@verb("unwatch", "", "stop this connection's `watch` stream", page="docs/watch.md")
+@verb(
+    "unwatch",
+    "",
+    "stop this connection's `watch` stream",
+    page="docs/watch.md",
+    examples=("unwatch",),
+)
 @dataclass(frozen=True, slots=True)
 class Unwatch:
     """Stop the stream."""
@@ -62,6 +69,7 @@ class Unwatch:
     "a line following the tool point as the arm moves: `on` starts a fresh one, `off` "
     "removes it, `clear` empties it; alone, reply `ok on N` (its points) or `ok off`",
     page="docs/watch.md",
+    examples=("trail", "trail on", "trail clear"),
 )
 @dataclass(frozen=True, slots=True)
 class Trail:
@@ -88,6 +96,7 @@ class Trail:
     "ghost and a `movel` or planned path as a line: `off` hides both, `on` shows them "
     "(the default); alone, reply `ok on` or `ok off`",
     page="docs/page.md",
+    examples=("ghost", "ghost on"),
 )
 @dataclass(frozen=True, slots=True)
 class Ghost:
@@ -121,6 +130,7 @@ separators, no leading dot)."""
     "recording, `all` records every robot at once (NAME.ROBOT.txt, .csv, .html each, one bag "
     "NAME/); `stop` ends this robot's; alone, reply `ok recording NAME S` or `ok not recording`",
     page="docs/recording.md",
+    examples=("record", "record demo_1", "record demo_1 overwrite", "record stop"),
 )
 @dataclass(frozen=True, slots=True)
 class Record:
@@ -231,10 +241,20 @@ verb(
     "removes every one",
     parse=_parse_object,
     page="docs/workcell.md",
+    examples=(
+        "object table box 1,0.6,0.05 0.6,0,-0.03,0,0,90",
+        "object ball sphere 0.1 1,2,3",
+        "object table remove",
+    ),
 )(ObjectEdit)
 
 
-@verb("objects", "", "reply the workcell objects' names: `ok table,fixture` (or `ok none`)")
+@verb(
+    "objects",
+    "",
+    "reply the workcell objects' names: `ok table,fixture` (or `ok none`)",
+    examples=("objects",),
+)
 @dataclass(frozen=True, slots=True)
 class Objects:
     """Ask for the objects' names."""
@@ -245,6 +265,7 @@ class Objects:
     "",
     "reply the colliding pairs now: `ok none`, or `ok link_t~table,link_b~link_s`",
     page="docs/workcell.md",
+    examples=("collisions",),
 )
 @dataclass(frozen=True, slots=True)
 class Collisions:
@@ -260,6 +281,7 @@ class Collisions:
     "`guard plan`: joint-space moves go around what their "
     "straight path would hit instead (docs/planning.md); alone, reply it",
     page="docs/workcell.md",
+    examples=("guard", "guard on", "guard plan"),
 )
 @dataclass(frozen=True, slots=True)
 class Guard:
@@ -293,6 +315,7 @@ PLAN_FORMS = ("joints", "pose", "timeout", "resolution")
     "connection's search limit [s] and check steps (a joint's angle, the tool's travel [m]) "
     "(docs/planning.md)",
     page="docs/planning.md",
+    examples=("plan joints 1,2,-3", "plan pose 0.5,0,1.2,0,90,0", "plan", "plan timeout 0.25"),
 )
 @dataclass(frozen=True, slots=True)
 class Plan:

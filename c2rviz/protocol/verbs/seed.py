@@ -15,14 +15,17 @@ from ..grammar import MARKER_SHAPES, check_pose, indices, numbers, numbers_arg, 
 from ..registry import LOOKUP, usage, verb
 
 
-@verb("rand", "", "every chain joint to a random value within its limits")
+@verb("rand", "", "every chain joint to a random value within its limits", examples=("rand",))
 @dataclass(frozen=True, slots=True)
 class Rand:
     """Move every chain joint to a random value within its limits."""
 
 
 @verb(
-    "home", "", "every chain joint to 0 (or its nearest limit, for a joint whose range excludes 0)"
+    "home",
+    "",
+    "every chain joint to 0 (or its nearest limit, for a joint whose range excludes 0)",
+    examples=("home",),
 )
 @dataclass(frozen=True, slots=True)
 class Home:
@@ -35,6 +38,7 @@ class Home:
     "angles of this connection, sent and received, in radians (the default)",
     aliases=("radian",),
     parse=lambda verb, words: Units.parse(verb, words, degrees=False),
+    examples=("radians",),
 )
 @verb(
     "degrees",
@@ -42,6 +46,7 @@ class Home:
     "angles of this connection, sent and received, in degrees",
     aliases=("degree",),
     parse=lambda verb, words: Units.parse(verb, words, degrees=True),
+    examples=("degrees",),
 )
 @dataclass(frozen=True, slots=True)
 class Units:
@@ -59,7 +64,13 @@ class Units:
 _UNITS = (Units(degrees=False), Units(degrees=True))
 
 
-@verb("joints", "v0,...,vn-1", "set all n chain joints; exactly n values", aliases=("j",))
+@verb(
+    "joints",
+    "v0,...,vn-1",
+    "set all n chain joints; exactly n values",
+    aliases=("j",),
+    examples=("joints 0,0.5,0,-1,0,0.6,0",),
+)
 @dataclass(frozen=True, slots=True)
 class Joints:
     """Set all chain joints, in the client's units."""
@@ -75,6 +86,7 @@ class Joints:
     "move",
     "i[,j,...] vi[,vj,...]",
     "set the listed joints; as many values as indices, each index once",
+    examples=("move 0 1", "move 0,1 0.5,-0.5"),
 )
 @dataclass(frozen=True, slots=True)
 class Move:
@@ -97,7 +109,7 @@ class Move:
         return Move(chosen, values)
 
 
-@verb("clear", "", "home, and remove every marker")
+@verb("clear", "", "home, and remove every marker", examples=("clear",))
 @dataclass(frozen=True, slots=True)
 class Clear:
     """Home the robot and remove every marker."""
@@ -108,6 +120,7 @@ class Clear:
     "[world] [x,y,z,roll,pitch,yaw]",
     "drop a marker at that pose in the base frame (metres; angles in the connection's unit), "
     "or with `world` in the world (cell) frame; without a pose, at the end effector",
+    examples=("mark", "mark 0.5,0,1,0,90,0", "mark world 0.5,0,1,0,90,0"),
 )
 @dataclass(frozen=True, slots=True)
 class Mark:
@@ -139,12 +152,14 @@ class Mark:
     "r,g,b (0..255)",
     "the same, each channel 0..255",
     parse=lambda verb, words: Color.parse(verb, words, 255.0),
+    examples=("rgb 0,255,51",),
 )
 @verb(
     "color",
     "r,g,b (0..1)",
     "colour of this connection's next markers, each channel 0..1",
     parse=lambda verb, words: Color.parse(verb, words, 1.0),
+    examples=("color 0,0.5,1",),
 )
 @dataclass(frozen=True, slots=True)
 class Color:
@@ -165,6 +180,7 @@ class Color:
     "marker",
     "|".join(MARKER_SHAPES),
     "shape of this connection's next markers (default a small red sphere)",
+    examples=("marker cube",),
 )
 @dataclass(frozen=True, slots=True)
 class MarkerShape:
@@ -180,7 +196,7 @@ class MarkerShape:
         return MarkerShape(shape)
 
 
-@verb("where", "", "reply the chain's joint values")
+@verb("where", "", "reply the chain's joint values", examples=("where",))
 @dataclass(frozen=True, slots=True)
 class Where:
     """Ask for the chain's joint values."""
@@ -191,6 +207,7 @@ class Where:
     "",
     "reply the end-effector pose in the base frame: x,y,z (m), roll,pitch,yaw "
     "(the connection's unit)",
+    examples=("pose",),
 )
 @dataclass(frozen=True, slots=True)
 class Pose:
@@ -203,6 +220,7 @@ class Pose:
     "reply each chain joint's limits and unit, in index order: `ok -109.4..109.4 deg,...`; "
     "`limits all` adds each joint's velocity, acceleration and jerk limits: "
     "`ok -109.4..109.4 deg v=130 a=260 j=1300,...` (per s, s^2, s^3)",
+    examples=("limits", "limits all"),
 )
 @dataclass(frozen=True, slots=True)
 class Limits:
@@ -219,7 +237,12 @@ class Limits:
         return Limits(all=True)
 
 
-@verb("names", "", "reply the robot name and the chain's joint names in index order")
+@verb(
+    "names",
+    "",
+    "reply the robot name and the chain's joint names in index order",
+    examples=("names",),
+)
 @dataclass(frozen=True, slots=True)
 class Names:
     """Ask for the robot name and the chain's joint names."""
@@ -230,6 +253,7 @@ class Names:
     "",
     "reply the c2rviz version and the robot file's name and checksum: "
     "`ok c2rviz 0.2.0 robot.urdf sha256:1f3a...`",
+    examples=("version",),
 )
 @dataclass(frozen=True, slots=True)
 class Version:
@@ -244,7 +268,8 @@ HELP_USAGE = "help [VERB]"
     "help",
     "",
     "reply the list of commands; `help VERB`: that verb's line (as the list gives it), "
-    "what it does, and its docs page",
+    "what it does, examples, and its docs page",
+    examples=("help", "help moveto"),
 )
 @dataclass(frozen=True, slots=True)
 class Help:
@@ -267,18 +292,21 @@ class Help:
         return Help(LOOKUP[asked].name)
 
     def reply_text(self) -> str:
-        """``help VERB``'s payload: ``moveto|... ARGS: SUMMARY; see docs/PAGE.md``."""
+        """``help VERB``'s payload: ``moveto|... ARGS: SUMMARY; e.g. `EXAMPLE`, ...; see
+        docs/PAGE.md`` (the examples are the verb's own, from its registry entry)."""
         assert self.verb is not None
         entry = LOOKUP[self.verb]
         names = "|".join((entry.name, *entry.aliases))
         line = f"{names} {entry.args}" if entry.args else names
-        return f"{line}: {entry.summary}; see {entry.page}"
+        shown = ", ".join(f"`{example}`" for example in entry.examples)
+        return f"{line}: {entry.summary}; {f'e.g. {shown}; ' if shown else ''}see {entry.page}"
 
 
 @verb(
     "sleep",
     "seconds",
     "pause this connection for that long (others go on); the reply comes when it ends",
+    examples=("sleep 0.5",),
 )
 @dataclass(frozen=True, slots=True)
 class Sleep:
@@ -294,13 +322,18 @@ class Sleep:
         return Sleep(seconds)
 
 
-@verb("bye", "", "close this connection")
+@verb("bye", "", "close this connection", examples=("bye",))
 @dataclass(frozen=True, slots=True)
 class Bye:
     """Close this connection."""
 
 
-@verb("quit", "", "reply, then stop the whole program (command server and viewer), status 0")
+@verb(
+    "quit",
+    "",
+    "reply, then stop the whole program (command server and viewer), status 0",
+    examples=("quit",),
+)
 @dataclass(frozen=True, slots=True)
 class Quit:
     """Stop the whole program."""
