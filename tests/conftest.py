@@ -20,7 +20,16 @@ from typing import Any
 import pytest
 from browser_support import FreshContexts
 from hypothesis import settings
-from support import ARGS, CHROMIUM, ROOT, Client, Process, ServerThread, load_robot
+from support import (
+    ARGS,
+    CHROMIUM,
+    CI_EXAMPLES,
+    ROOT,
+    Client,
+    Process,
+    ServerThread,
+    load_robot,
+)
 
 from c2rviz.session import ServerLimits
 from c2rviz.world.virtual_clock import VirtualClock
@@ -34,12 +43,15 @@ def pytest_configure(config: pytest.Config) -> None:
     )
 
 
-settings.register_profile("ci", deadline=None, print_blob=True)
+settings.register_profile("ci", max_examples=CI_EXAMPLES, deadline=None, print_blob=True)
+settings.register_profile("thorough", max_examples=100, deadline=None, print_blob=True)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
-"""Hypothesis for every run of the suite (``HYPOTHESIS_PROFILE=default`` for its own
-defaults): its examples as each test sets them (docs/testing.md), no deadline (a time
-limit per example on the wall clock, 200 ms by default, fails a test on a busy machine),
-and a failure's blob printed for ``@reproduce_failure``."""
+"""Hypothesis for every run of the suite: ``ci`` by default, ``HYPOTHESIS_PROFILE=thorough``
+for the examples each property test ran before issue 36 (``default`` for hypothesis's own).
+A profile's ``max_examples`` is per 100 of a test's thorough count (``support.examples``):
+``ci`` runs CI_EXAMPLES in 100 (docs/testing.md: the counts, and the failures they still
+catch). Both: no deadline (a time limit per example on the wall clock, 200 ms by default,
+fails a test on a busy machine), and a failure's blob printed for ``@reproduce_failure``."""
 
 
 @pytest.fixture

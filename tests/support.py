@@ -19,6 +19,8 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+from hypothesis import settings
+
 from c2rviz.robot.model import Robot
 from c2rviz.session import ServerLimits
 from c2rviz.testing.server import TestServer
@@ -51,6 +53,17 @@ ROBOTS = {
     "fanuc_lrmate200id": ("robots/fanuc_lrmate200id/robot.urdf", "base_link", "link_6"),
     "kuka_lwr": ("robots/kuka_lwr/robot.urdf", "lwr_base_link", "lwr_7_link"),
 }
+
+CI_EXAMPLES = 25
+"""The ``ci`` hypothesis profile's examples per 100 of a test's thorough count (conftest)."""
+
+
+def examples(thorough: int) -> int:
+    """A property test's ``max_examples``: ``thorough`` (its count before issue 36) under
+    ``HYPOTHESIS_PROFILE=thorough``, scaled by the loaded profile's ``max_examples`` per 100
+    (``ci``: CI_EXAMPLES in 100), and at least 5. A failure a test once found is one of
+    its ``@example``s, so every profile runs it (docs/testing.md)."""
+    return max(5, round(thorough * settings.default.max_examples / 100))
 
 
 @cache

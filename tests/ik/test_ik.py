@@ -18,7 +18,7 @@ import pinocchio as pin
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from support import ROBOTS, ROOT, load_robot
+from support import ROBOTS, ROOT, examples, load_robot
 
 from c2rviz.errors import C2rvizError, JointCountError
 from c2rviz.ik.line import LineBlocked, interpolate, plan_line
@@ -87,7 +87,7 @@ def test_solves_random_reachable_targets(name: str) -> None:
     assert solved >= 198, f"{name}: {solved}/200 solved"
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=examples(25), deadline=None)
 @given(
     name=st.sampled_from(BUNDLED),
     target_at=st.lists(st.floats(0, 1), min_size=7, max_size=7),

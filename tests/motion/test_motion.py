@@ -22,7 +22,7 @@ import pytest
 import ruckig
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from support import ROOT, load_robot
+from support import ROOT, examples, load_robot
 
 from c2rviz.errors import JointCountError
 from c2rviz.motion.limits import (
@@ -468,7 +468,7 @@ def scenarios(draw: st.DrawFn) -> Scenario:
     )
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=examples(60), deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(scenarios())
 def test_any_move_respects_the_limits_and_arrives(scenario: Scenario) -> None:
     """Random in-limit start and target, optionally preempted by a new target or a stop."""

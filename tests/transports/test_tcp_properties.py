@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
-from support import ServerThread, load_robot
+from support import ServerThread, examples, load_robot
 
 from c2rviz.app.config import ServerLimits
 from c2rviz.errors import C2rvizError, LineTooLong
@@ -94,7 +94,7 @@ lines_of_bytes = st.lists(
 # The parser alone
 
 
-@settings(max_examples=500, deadline=None)
+@settings(max_examples=examples(500), deadline=None)
 @given(st.one_of(st.text(), near_miss_line()))
 def test_the_parser_raises_only_our_errors(line):
     try:
@@ -106,7 +106,7 @@ def test_the_parser_raises_only_our_errors(line):
     assert all(math.isfinite(v) for v in values)
 
 
-@settings(max_examples=500, deadline=None)
+@settings(max_examples=examples(500), deadline=None)
 @given(st.binary())
 def test_the_parser_takes_any_decoded_bytes(data):
     for raw in data.split(b"\n"):
@@ -174,7 +174,7 @@ def read_replies(sock: socket.socket, count: int, closes: bool) -> list[str]:
 
 
 @settings(
-    max_examples=200,
+    max_examples=examples(200),
     deadline=None,
     suppress_health_check=[HealthCheck.too_slow],
 )

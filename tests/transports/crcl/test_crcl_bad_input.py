@@ -18,6 +18,7 @@ from crcl_support import (
 )
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from support import examples
 
 REACH = (0.5, 0.0, 0.8)
 
@@ -211,7 +212,9 @@ def test_a_client_that_never_reads_is_reset_and_no_one_else_notices(
 
 
 @settings(
-    max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+    max_examples=examples(25),
+    deadline=None,
+    suppress_health_check=[HealthCheck.function_scoped_fixture],
 )
 @given(junk=st.binary(min_size=1, max_size=300) | st.text(max_size=300).map(str.encode))
 def test_junk_never_costs_the_server(crcl_server, connect, junk: bytes) -> None:

@@ -10,6 +10,7 @@ import pytest
 from crcl_support import DONE, ERROR, command, move_to
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support import examples
 
 INIT = command("InitCanon", 1)
 STILL_HERE = command("Message", 3, "<Message>still here</Message>")
@@ -159,7 +160,7 @@ _PIECES = st.sampled_from(
 )  # fmt: skip
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(
     body=st.lists(_PIECES, max_size=40),
     cuts=st.lists(st.integers(1, 50), min_size=1, max_size=8),

@@ -7,6 +7,7 @@ from typing import cast
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support import examples
 
 from c2rviz.transports.crcl import CrclFramingError, DocumentSplitter, parse_command
 
@@ -179,7 +180,7 @@ def streams(draw: st.DrawFn) -> tuple[list[bytes], bytes, list[int]]:
     return documents, stream, cuts
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(streams())
 def test_any_chunking_gives_the_same_documents(case: tuple[list[bytes], bytes, list[int]]) -> None:
     documents, stream, cuts = case
@@ -190,7 +191,7 @@ def test_any_chunking_gives_the_same_documents(case: tuple[list[bytes], bytes, l
     assert splitter.pending_bytes == 0
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(st.binary(max_size=300), st.integers(1, 50))
 def test_any_bytes_any_chunking_never_crash_and_stay_bounded(data: bytes, size: int) -> None:
     splitter = DocumentSplitter(max_bytes=200)
@@ -210,7 +211,7 @@ FRAGMENTS = [b"<", b">", b"/", b"!--", b"-->", b"<?xml ", b"?>", b"<![CDATA[", b
              b"\n", b"<!DOCTYPE", b"\xef\xbb", b"\xbf", b"<x>", b"</x>", b"/>"]  # fmt: skip
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=examples(300), deadline=None)
 @given(st.lists(st.sampled_from(FRAGMENTS), max_size=40), st.lists(st.integers(0, 200), max_size=8))
 def test_markup_soup_splits_the_same_in_any_chunks(pieces: list[bytes], cuts: list[int]) -> None:
     """Documents, errors and what is left pending do not depend on how bytes arrive."""

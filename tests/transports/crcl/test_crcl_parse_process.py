@@ -8,12 +8,13 @@ from __future__ import annotations
 import os
 import signal
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import pytest
-from crcl_support import DONE, ERROR, command, move_to
-from support import Client
+from crcl_support import DONE, ERROR, CrclServerThread, command, move_to
+from support import Client, load_robot
 
+from c2rviz.session import ServerLimits
 from c2rviz.transports.crcl.server import PARSE_ON_LOOP_BYTES
 from c2rviz.transports.parse_process import ParseProcess
 
@@ -46,6 +47,15 @@ def parsing(server: object) -> ParseProcess:
     return process
 
 
+@pytest.fixture(scope="module")
+def one_server() -> Iterator[CrclServerThread]:
+    """One server for the four large documents below: none ends its parsing process, so
+    one process parses them all (its start, about 0.6 s of CPU, is paid once)."""
+    server = CrclServerThread(load_robot(), ServerLimits()).start()
+    yield server
+    server.stop()
+
+
 @pytest.mark.parametrize(
     ("doc", "state", "words"),
     [
@@ -57,9 +67,9 @@ def parsing(server: object) -> ParseProcess:
     ids=["move", "huge-axis", "bad-boolean", "unknown-type"],
 )
 def test_a_large_document_gets_the_statuses_of_a_small_one(
-    crcl_server, crcl_connect, doc: bytes, state: str, words: str
+    one_server, crcl_connect, doc: bytes, state: str, words: str
 ) -> None:
-    small, large = crcl_connect(crcl_server), crcl_connect(crcl_server)
+    small, large = crcl_connect(one_server), crcl_connect(one_server)
     assert len(padded(doc)) > PARSE_ON_LOOP_BYTES >= len(doc)
     for client, sent in ((small, doc), (large, padded(doc))):
         assert client.run(INIT, 1).command_status.state == DONE
@@ -68,7 +78,7 @@ def test_a_large_document_gets_the_statuses_of_a_small_one(
     heard = large.until(2).command_status
     assert (heard.state, heard.description) == (said.state, said.description)
     assert said.state == state and words in (said.description or ""), said.description
-    assert parsing(crcl_server).started == 1
+    assert parsing(one_server).started == 1  # (the same process as for the others)
 
 
 def test_others_go_on_while_a_large_document_parses(crcl_server, crcl_connect) -> None:

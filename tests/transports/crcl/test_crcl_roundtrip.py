@@ -8,6 +8,7 @@ import pytest
 from crcl_strategies import commands, record_of, statuses, xml_text
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support import examples
 
 from c2rviz.transports.crcl import (
     COMMAND_TYPES,
@@ -52,7 +53,7 @@ def test_every_schema_command_type_has_a_class() -> None:
 
 
 @pytest.mark.parametrize("cls", COMMAND_TYPES, ids=[cls.__name__ for cls in COMMAND_TYPES])
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=examples(15), deadline=None)
 @given(data=st.data())
 def test_each_command_type_round_trips(cls: type[Command], data: st.DataObject) -> None:
     command = data.draw(record_of(cls))
@@ -61,7 +62,7 @@ def test_each_command_type_round_trips(cls: type[Command], data: st.DataObject) 
     assert write_command(parse_command(doc)) == doc
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=examples(200), deadline=None)
 @given(commands)
 def test_commands_round_trip_exactly(command: Command) -> None:
     doc = write_command(command)
@@ -82,7 +83,7 @@ def _signs(record: object) -> list[float]:
     return found
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=examples(50), deadline=None)
 @given(commands, st.none() | xml_text, st.none() | st.integers(0, 99))
 def test_instances_round_trip(
     command: Command, program_file: str | None, index: int | None
@@ -91,13 +92,13 @@ def test_instances_round_trip(
     assert parse_instance(write_instance(instance)) == instance
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(statuses)
 def test_statuses_round_trip(status: CrclStatus) -> None:
     assert parse_status(write_status(status)) == status
 
 
-@settings(max_examples=40, deadline=None)
+@settings(max_examples=examples(40), deadline=None)
 @given(
     record_of(InitCanon),
     st.lists(st.one_of([record_of(cls) for cls in MIDDLE_COMMAND_TYPES]), max_size=5),
@@ -108,7 +109,7 @@ def test_programs_round_trip(first: InitCanon, middle: list[Command], last: EndC
     assert parse_program(write_program(commands)) == commands
 
 
-@settings(max_examples=50, deadline=None)
+@settings(max_examples=examples(50), deadline=None)
 @given(st.lists(commands, min_size=1, max_size=5), st.integers(1, 97))
 def test_written_commands_split_back(batch: list[Command], chunk: int) -> None:
     stream = b"".join(write_command(command) for command in batch)

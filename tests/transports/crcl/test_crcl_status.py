@@ -15,6 +15,7 @@ import pytest
 from crcl_strategies import statuses
 from hypothesis import given, settings
 from lxml import etree
+from support import examples
 
 from c2rviz.transports.crcl import (
     CommandStatus,
@@ -135,7 +136,7 @@ def test_full_status_follows_the_schema_rules() -> None:
     assert parse_status(doc) == FULL
 
 
-@settings(max_examples=150, deadline=None)
+@settings(max_examples=examples(150), deadline=None)
 @given(statuses)
 def test_any_status_follows_the_schema_rules(status: CrclStatus) -> None:
     check_structure(write_status(status))

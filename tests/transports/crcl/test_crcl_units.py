@@ -9,6 +9,7 @@ import pytest
 from crcl_strategies import pose_axes
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from support import examples
 
 from c2rviz.transports.crcl import (
     CrclValueError,
@@ -63,7 +64,7 @@ def test_axes_of_any_length_are_normalised() -> None:
     assert np.allclose(rotation, [[0, -1, 0], [1, 0, 0], [0, 0, 1]])
 
 
-@settings(max_examples=100, deadline=None)
+@settings(max_examples=examples(100), deadline=None)
 @given(pose_axes(), st.tuples(*[st.floats(-3, 3)] * 3), st.sampled_from(["meter", "inch"]))
 def test_matrix_round_trip(
     axes: tuple[Vector, Vector], xyz: tuple[float, float, float], unit: str
