@@ -1,7 +1,8 @@
 """Does one client's big document or frame stall the others? (issue 35, stalls 3 and 4)
 
-Usage: ``python benchmarks/door_stalls_bench.py [--seconds S] [--quick] [--only crcl|rosbridge]``
-(``--quick``: one second a row).
+Usage: ``python benchmarks/door_stalls_bench.py [--seconds S] [--quick|--smoke]
+[--only crcl|rosbridge]`` (``--quick``: one second a row; ``--smoke``, the test suite's:
+every row on the least work, a quarter of a second a row after a quarter of flooding).
 
 The program runs as a subprocess (``python -m c2rviz --no-viewer``, the motoman, every
 door on a free port). While flooders in other processes send big input, a bystander on
@@ -165,13 +166,16 @@ def percentile(values: Sequence[float], fraction: float) -> float:
     return ordered[min(len(ordered) - 1, int(fraction * len(ordered)))]
 
 
-def measure(text_port: int, flood: Callable[[int, float], None] | None, port: int, s: float) -> str:
+def measure(
+    text_port: int, flood: Callable[[int, float], None] | None, port: int, s: float, lead: float
+) -> str:
+    """The bystander's figures over ``s`` seconds, the flood ``lead`` seconds under way first."""
     workers = [
-        multiprocessing.Process(target=flood, args=(port, s + 1.0)) for _ in range(FLOODERS)
+        multiprocessing.Process(target=flood, args=(port, s + lead)) for _ in range(FLOODERS)
     ] if flood else []  # fmt: skip
     for worker in workers:
         worker.start()
-    time.sleep(1.0 if workers else 0.0)  # the flood under way
+    time.sleep(lead if workers else 0.0)  # the flood under way
     times = bystander(text_port, s)
     for worker in workers:
         worker.join(60)
@@ -186,21 +190,25 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=5.0)
     parser.add_argument("--quick", action="store_true", help="one second a row")
+    parser.add_argument("--smoke", action="store_true", help="every row, the least work")
     parser.add_argument("--only", choices=("crcl", "rosbridge"))
     args = parser.parse_args(argv)
     if args.quick:
         args.seconds = 1.0
+    lead = 1.0
+    if args.smoke:
+        args.seconds, lead = 0.25, 0.25
     print(machine())
     popen, text, crcl, ros = start_program()
     try:
-        print(f"bystander, no flood:            {measure(text, None, 0, args.seconds)}")
+        print(f"bystander, no flood:            {measure(text, None, 0, args.seconds, lead)}")
         if args.only in (None, "crcl"):
-            result = measure(text, flood_crcl, crcl, args.seconds)
+            result = measure(text, flood_crcl, crcl, args.seconds, lead)
             print(f"bystander, 4 x 1 MiB CRCL flood: {result}")
         if args.only in (None, "rosbridge"):
-            result = measure(text, flood_rosbridge_names, ros, args.seconds)
+            result = measure(text, flood_rosbridge_names, ros, args.seconds, lead)
             print(f"bystander, 4 x 8000-point traj. refused at a joint name: {result}")
-            result = measure(text, flood_rosbridge, ros, args.seconds)
+            result = measure(text, flood_rosbridge, ros, args.seconds, lead)
             print(f"bystander, 4 x 8000-point traj. refused by its check:    {result}")
     finally:
         popen.terminate()

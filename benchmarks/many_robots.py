@@ -1,8 +1,10 @@
 """Many robots in one cell, all moving, a page open: the server's CPU, the frames each robot
 gets on the page, and a bystander's round trips.
 
-Usage: ``python benchmarks/many_robots.py [--robots 64] [--seconds 10] [--quick]
-[--no-pin] [--page-process [--page-anywhere]]``.
+Usage: ``python benchmarks/many_robots.py [--robots 64] [--seconds 10] [--quick|--smoke]
+[--no-pin] [--page-process [--page-anywhere]]`` (``--quick``: 8 robots for 2 s;
+``--smoke``, the test suite's: every row on the least work, 2 robots for half a second
+after half a second's warm-up).
 
 A temporary ini holds ``[cell:many]`` with N motoman_sia20d members on a grid, every
 port 0 (the program picks free ones). The program runs with its viewer; one websocket
@@ -180,7 +182,7 @@ def let_loose(pid: int) -> None:
 
 
 def measure(
-    count: int, seconds: float, page: bool = False, loose: bool = False
+    count: int, seconds: float, page: bool = False, loose: bool = False, warm_s: float = 3.0
 ) -> dict[str, float]:
     with tempfile.TemporaryDirectory() as folder:
         ini = write_cell(Path(folder), count)
@@ -194,7 +196,7 @@ def measure(
                 let_loose(drawer)
             counter = PageCounter(loadgen.ws_url(proc.url))  # type: ignore[arg-type]
             names = sorted(ports, key=lambda n: int(n[1:]))
-            warm = time.perf_counter() + 3.0
+            warm = time.perf_counter() + warm_s
             driver = threading.Thread(
                 target=drive, args=(ports[names[0]], names, warm + seconds + 1.0), daemon=True
             )
@@ -230,7 +232,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--robots", type=int, default=64, help="robots in the cell (64)")
     parser.add_argument("--seconds", type=float, default=10.0, help="measured time (10)")
-    parser.add_argument("--quick", action="store_true", help="8 robots for 2 s (the tests)")
+    parser.add_argument("--quick", action="store_true", help="8 robots for 2 s")
+    parser.add_argument("--smoke", action="store_true", help="every row, the least work")
     parser.add_argument("--no-pin", action="store_true", help="let the OS place the processes")
     parser.add_argument(
         "--page-process", action="store_true", help="the page in a process of its own"
@@ -242,12 +245,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         "server's, as it inherits)",
     )
     args = parser.parse_args(argv)
-    count, seconds = (8, 2.0) if args.quick else (args.robots, args.seconds)
+    count, seconds, warm_s = (
+        (2, 0.5, 0.5)
+        if args.smoke
+        else (8, 2.0, 3.0)
+        if args.quick
+        else (args.robots, args.seconds, 3.0)
+    )
     print(machine())
     where = "any CPU" if args.page_anywhere else "the server's CPU"
     how = f"; the page in its own process (on {where})" if args.page_process else ""
     print(f"{count} motoman_sia20d moving, a page open; {pin_cpus(not args.no_pin)}{how}")
-    got = measure(count, seconds, args.page_process, args.page_anywhere)
+    got = measure(count, seconds, args.page_process, args.page_anywhere, warm_s)
     goals = PAGE_PROCESS_GOALS if args.page_process else GOALS
     rows = [
         ("server CPU [cores]", got["cpu"], "<=", goals["cpu"]),

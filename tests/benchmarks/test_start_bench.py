@@ -23,7 +23,7 @@ def test_the_start_bench_prints_a_row_per_way_of_starting() -> None:
     )
     assert done.returncode == 0, done.stdout + done.stderr
     figure = r"\d+\.\d{3} \(\d+\.\d{3}\.\.\d+\.\d{3}\)"
-    for way in ("as a user starts it", "--no-viewer", "command port alone"):
+    for way in ("as a user starts it", "--page-process", "--no-viewer", "command port alone"):
         row = next((line for line in done.stdout.splitlines() if line.startswith(way)), "")
         assert re.fullmatch(rf"{re.escape(way)} +{figure} +{figure} *.*", row), done.stdout
     assert re.search(r"as a user starts it .*<= 1 s: (met|NOT met)", done.stdout), done.stdout

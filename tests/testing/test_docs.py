@@ -8,12 +8,14 @@ import os
 import re
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 from support import ROOT, typed_verbs
 
 from c2rviz import Client
 from c2rviz.protocol.registry import VERBS
+from c2rviz.testing.server import TestServer
 
 PAGE = (ROOT / "docs" / "testing.md").read_text()
 BLOCKS = re.findall(r"```(\w+)\n(.*?)```", PAGE, re.S)
@@ -28,25 +30,37 @@ AS_THE_PROGRAM = pytest.mark.c2rviz(clock="real", record=False)
 the program's wiring on its real clock, without a subprocess's seconds of start-up)."""
 
 
+@pytest.fixture(scope="module")
+def example_runs() -> dict[str, subprocess.CompletedProcess[str]]:
+    """Each example's run, by its code: the first example serves two tests with one run."""
+    return {}
+
+
+def run_example(
+    code: str, server: TestServer, folder: Path, runs: dict[str, subprocess.CompletedProcess[str]]
+) -> subprocess.CompletedProcess[str]:
+    """The example run against a fresh server of its own (``server``, unless an earlier test
+    of this module ran it against its own already)."""
+    if code not in runs:
+        script = folder / "example.py"
+        script.write_text(code.replace("port=31000", f"port={server.port}"))
+        runs[code] = subprocess.run(
+            [sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=ENV
+        )
+    return runs[code]
+
+
 @AS_THE_PROGRAM
 @pytest.mark.parametrize("code", SCRIPTS, ids=[f"example-{i}" for i in range(len(SCRIPTS))])
-def test_each_client_example_runs_against_a_server(code, c2rviz_server, tmp_path):
-    script = tmp_path / "example.py"
-    script.write_text(code.replace("port=31000", f"port={c2rviz_server.port}"))
-    done = subprocess.run(
-        [sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=ENV
-    )
+def test_each_client_example_runs_against_a_server(code, c2rviz_server, tmp_path, example_runs):
+    done = run_example(code, c2rviz_server, tmp_path, example_runs)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip()  # it printed what it says it prints
 
 
 @AS_THE_PROGRAM
-def test_the_first_example_prints_what_its_comments_say(c2rviz_server, tmp_path):
-    script = tmp_path / "example.py"
-    script.write_text(SCRIPTS[0].replace("port=31000", f"port={c2rviz_server.port}"))
-    done = subprocess.run(
-        [sys.executable, str(script)], capture_output=True, text=True, timeout=120, env=ENV
-    )
+def test_the_first_example_prints_what_its_comments_say(c2rviz_server, tmp_path, example_runs):
+    done = run_example(SCRIPTS[0], c2rviz_server, tmp_path, example_runs)
     where, collisions = done.stdout.splitlines()
     assert where == "(0.5, 0.2, 0.0, -0.4, 0.0, 0.3, 0.0)"
     assert collisions == "[]"

@@ -183,9 +183,12 @@ def test_the_plugin_in_a_users_pytest_run(sample):
     assert played.returncode == 0, played.stderr  # the run plays back
 
 
-def test_the_entry_point_loads_the_plugin(sample, tmp_path_factory):
-    """pytest finds the plugin through the ``pytest11`` entry point pyproject declares (here a
-    package's metadata on the path says the same, as an installed c2rviz's does)."""
+@pytest.fixture(scope="module")
+def entry_point_run(tmp_path_factory: pytest.TempPathFactory) -> subprocess.CompletedProcess[str]:
+    """One ``pytest --c2rviz-clock virtual`` run, the plugin found only through the
+    ``pytest11`` entry point pyproject declares (here a package's metadata on the path says
+    the same, as an installed c2rviz's does), of a test of the fixtures and the clock: two
+    tests read it (a pytest run costs seconds)."""
     pyproject = (ROOT / "pyproject.toml").read_text()
     section = pyproject.split("[project.entry-points.pytest11]\n")[1].split("\n\n")[0]
     points = dict(re.findall(r'^"?([\w.]+)"? = "([\w.]+)"', section, re.M))
@@ -198,23 +201,34 @@ def test_the_entry_point_loads_the_plugin(sample, tmp_path_factory):
     )
     lines = "".join(f"{name} = {module}\n" for name, module in points.items())
     (info / "entry_points.txt").write_text(f"[pytest11]\n{lines}")
-    (sample / "test_controller.py").write_text(
-        "def test_fixtures(c2rviz):\n    assert c2rviz.where() == (0.0,) * 7\n"
+    folder = tmp_path_factory.mktemp("entry-point")
+    (folder / "pytest.ini").write_text("[pytest]\nfilterwarnings = error\n")
+    (folder / "test_controller.py").write_text(
+        "def test_fixtures(c2rviz, c2rviz_server):\n"
+        "    assert c2rviz.where() == (0.0,) * 7\n"
+        "    assert c2rviz_server.world.clock.describe() == 'virtual'\n"
     )
-    done = run_pytest(
-        sample,
+    return run_pytest(
+        folder,
+        "--c2rviz-clock",
+        "virtual",
         env_extra={"PYTHONPATH": os.pathsep.join([str(ROOT), str(site)])},
     )
+
+
+def test_the_entry_point_loads_the_plugin(entry_point_run):
+    """pytest finds the plugin (its fixtures, its option) through the entry point alone."""
+    done = entry_point_run
     assert counts(done.stdout) == {"passed": 1}, done.stdout + done.stderr
 
 
-def test_the_clock_option_sets_every_tests_clock(sample):
+def test_the_clock_option_sets_every_tests_clock(entry_point_run, sample):
+    done = entry_point_run  # the clock the option gives is the server's
+    assert counts(done.stdout) == {"passed": 1}, done.stdout + done.stderr
     (sample / "test_controller.py").write_text(
         "def test_clock(c2rviz_server):\n"
         "    assert c2rviz_server.world.clock.describe() == 'virtual'\n"
     )
-    done = run_pytest(sample, "-p", "c2rviz.testing.plugin", "--c2rviz-clock", "virtual")
-    assert counts(done.stdout) == {"passed": 1}, done.stdout + done.stderr
     bad = run_pytest(sample, "-p", "c2rviz.testing.plugin", "--c2rviz-clock", "scaled:0")
     assert counts(bad.stdout) == {"error": 1}
     assert "scaled:0: the factor must be a finite number above 0" in bad.stdout
