@@ -26,6 +26,7 @@ import pytest
 from support import Client, ServerThread, load_robot
 from watch_support import STATE, is_reply, read_until
 
+from c2rviz.app.cli import main
 from c2rviz.app.config import load_settings
 from c2rviz.clients import player
 from c2rviz.errors import ConfigError
@@ -259,7 +260,7 @@ def test_watchers_hear_when_a_recording_stops(server: ServerThread, connect, tmp
     assert seen[-1] == f"event record-stopped quick: stopped by tcp 127.0.0.1:{port}"
 
 
-def test_record_flag_records_from_start_to_exit(c2rviz_process, tmp_path: Path):
+def test_record_flag_records_from_start_to_exit(c2rviz_process, tmp_path: Path, capsys):
     proc = c2rviz_process("--no-viewer", "--record", "run", "--record-dir", str(tmp_path))
     client = Client("127.0.0.1", proc.port)
     try:
@@ -275,15 +276,11 @@ def test_record_flag_records_from_start_to_exit(c2rviz_process, tmp_path: Path):
     assert [line for line in lines if line.startswith("joints")][-1] == (
         "joints 0.5,0.0,0.0,0.0,0.0,0.0,0.0"
     )
-    again = subprocess.run(
-        [sys.executable, "-m", "c2rviz", "--no-viewer", "--port", "0", "--record", "run"]
-        + ["--record-dir", str(tmp_path)],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
-    assert again.returncode == 2  # an existing name is refused, before anything starts
-    assert "record: run already exists in" in again.stderr
+    # An existing name is refused, before anything starts: so in this process (the
+    # status `python -m c2rviz` exits with is main's).
+    again = main(["--no-viewer", "--port", "0", "--record", "run", "--record-dir", str(tmp_path)])
+    assert again == 2
+    assert "record: run already exists in" in capsys.readouterr().err
 
 
 def test_a_cell_member_records_its_tool_pose_and_marks_in_its_base_frame(tmp_path: Path):
@@ -432,15 +429,10 @@ def test_settings_for_recordings_and_trails(tmp_path: Path):
     ("name", "message"),
     [("../x", "bad name '../x'"), ("stop", "--record needs a name; 'stop' is not one")],
 )
-def test_record_flag_refuses_a_bad_name(tmp_path: Path, name: str, message: str):
-    done = subprocess.run(
-        [sys.executable, "-m", "c2rviz", "--no-viewer", "--port", "0", "--record", name]
-        + ["--record-dir", str(tmp_path)],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
-    assert done.returncode == 2 and message in done.stderr
+def test_record_flag_refuses_a_bad_name(tmp_path: Path, name: str, message: str, capsys):
+    """Refused before anything starts: main in this process, its status the program's."""
+    status = main(["--no-viewer", "--port", "0", "--record", name, "--record-dir", str(tmp_path)])
+    assert status == 2 and message in capsys.readouterr().err
     assert list(tmp_path.iterdir()) == []
 
 
@@ -493,8 +485,6 @@ def test_recordings_land_in_the_working_directory_by_default(tmp_path: Path):
     writes ./recordings/demo.txt there, not into the project's folder."""
     import os
     import signal
-    import subprocess
-    import sys
 
     proc = subprocess.Popen(
         [sys.executable, "-m", "c2rviz", "--no-viewer", "--port", "0"],

@@ -21,6 +21,7 @@ from c2rviz.view.page_channel import FrameReader
 from c2rviz.view.page_link import IN_FLIGHT, PageLink
 from c2rviz.view.page_process import ForwardingSession, PageProcess
 from c2rviz.view.page_snapshot import Hello, PageConfig, snapshot
+from c2rviz.world.clock import Clock
 from c2rviz.world.world import World
 
 ROBOT = "motoman_sia20d"
@@ -51,8 +52,8 @@ class Pipe:
 class Both:
     """The command side (world, services, link) and the page side (mirror, scene)."""
 
-    def __init__(self) -> None:
-        self.world = World({ROBOT: load_robot()})
+    def __init__(self, clock: Clock | None = None) -> None:
+        self.world = World({ROBOT: load_robot()}, clock=clock)
         self.services = Services(self.world)
         config = PageConfig("127.0.0.1", 0, 100.0, (), None, 4, None, SessionDefaults(), 100, 30, 8)
         self.link = PageLink(self.services, config)
@@ -261,16 +262,41 @@ def test_a_page_that_fell_behind_gets_the_parts_cameras_and_banner_again(both: B
     assert "EMERGENCY STOP" in scene.panels[ROBOT].banner.content
 
 
-def test_a_trail_clear_clears_the_pages_trail(both: Both) -> None:
+class Stepped(Clock):
+    """Time that moves only when a test moves it (``t`` [s])."""
+
+    def __init__(self) -> None:
+        self.t = 0.0
+
+    def now(self) -> float:
+        return self.t
+
+
+def test_a_trail_clear_clears_the_pages_trail() -> None:
+    clock = Stepped()
+    both = Both(clock)
+    try:
+        _trail_cleared(both, clock)
+    finally:
+        both.page.scene.stop()
+        both.services.close()
+
+
+def _trail_cleared(both: Both, clock: Stepped) -> None:
     run = both.session.run
     assert run("trail on") == "ok"
     both.frame()
     keeper, kept = both.page.services.trails, both.services.trails
-    for k in range(1, 100_000):  # a point per frame of the clock: move until there are 4
-        assert run(f"move 0 {k % 90}") == "ok"
+    # A point per frame of the clock: move until there are 4. (Joint 1, not joint 0: at
+    # home the tool is on joint 0's axis, so turning it leaves the tool where it is and
+    # the trail never grew; the loop once ran 100,000 moves to its end.)
+    for k in range(1, 100_000):
+        clock.t += 5 * both.world.frame_s  # moves frames apart: a point each, both sides
+        assert run(f"move 1 {k % 90}") == "ok"
         both.frame()
         if len(kept.points(ROBOT)) >= 4:
             break
+    assert len(kept.points(ROBOT)) >= 4
     np.testing.assert_allclose(keeper.points(ROBOT), kept.points(ROBOT))
     assert run("trail clear") == "ok"
     both.frame()

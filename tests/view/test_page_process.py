@@ -149,9 +149,11 @@ def test_a_killed_page_process_comes_back_and_commands_go_on(
     assert policies(first) == {os.SCHED_BATCH}  # the page's threads never preempt commands
     mover, bystander = Tcp(proc.port), Tcp(proc.port)
     try:
-        for line in ("degrees", "motion on", "speed 5", "marker cube", "mark"):
+        for line in ("degrees", "motion on", "speed 20", "marker cube", "mark"):
             assert mover.ask(line) == "ok"
-        mover.send("move 0 90")  # ok when it arrives: several seconds at speed 5
+        # ok when it arrives: 7 s at speed 20 (28 s at speed 5, once), ample for the kill
+        # and a bystander's `where` mid-move
+        mover.send("move 0 90")
         os.kill(first, signal.SIGKILL)
         assert bystander.ask("where").startswith("ok ")  # mid-move, the page gone
         assert mover.reply() == "ok"  # the move went on to its end
