@@ -20,10 +20,11 @@ import io
 import socket
 import time
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
 import numpy as np
-from support import ROOT
+from support import ROOT, start_program
 
 ARTIFACTS = ROOT / "test-artifacts"
 VIEWPORT = {"width": 1000, "height": 700}
@@ -96,6 +97,26 @@ class FreshContexts:
     def new_page(self, **options: Any) -> Any:
         return self.new_context(**options).new_page()
 
+    def lasting_page(self, **options: Any) -> Any:
+        """A page in a context of its own that outlives the test (``close_contexts`` leaves
+        it): for a ``LastingProgram``, closed by its owner."""
+        return self._browser.new_context(**options).new_page()
+
+    def unmark(self) -> None:
+        asyncio._set_running_loop(None)
+
+    @contextlib.contextmanager
+    def marked(self) -> Iterator[None]:
+        """Playwright's loop marked as in ``resume`` for a fixture's own use of Chromium
+        outside a test's (a shared program's page), then as it was."""
+        was = asyncio._get_running_loop()
+        self.resume()
+        try:
+            yield
+        finally:
+            if was is None:
+                self.unmark()
+
     def resume(self) -> None:
         """Before a test: the loop marked again, and a new Chromium if the last one died
         (one test's crash must not fail every later browser test)."""
@@ -109,7 +130,7 @@ class FreshContexts:
             while self._contexts:
                 self._contexts.pop().close()
         finally:
-            asyncio._set_running_loop(None)
+            self.unmark()
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._browser, name)
@@ -155,24 +176,34 @@ class Tcp:
         self.sock.close()
 
 
-def scene_pixels(page: Any) -> np.ndarray:
+def crop(png: bytes) -> np.ndarray:
+    """The scene's region of a screenshot (PNG bytes of the page)."""
     from PIL import Image
 
-    image = Image.open(io.BytesIO(page.screenshot())).convert("RGB")
+    image = Image.open(io.BytesIO(png)).convert("RGB")
     return np.asarray(image, dtype=np.int16)[SCENE]
 
 
+def scene_pixels(page: Any) -> np.ndarray:
+    return crop(page.screenshot())
+
+
 def settle(page: Any, name: str, timeout_s: float = 60.0) -> np.ndarray:
-    """The drawn scene once two screenshots in a row agree; saved as ``name``.png."""
-    previous = scene_pixels(page)
+    """The drawn scene once two screenshots in a row agree; the first of them saved as
+    ``name``.png (a screenshot waits for a new frame: 0.4-0.6 s each on a busy machine,
+    so the one compared is the one kept, not a third)."""
+    png = page.screenshot()
+    previous = crop(png)
     deadline = time.monotonic() + timeout_s
     while time.monotonic() < deadline:
         page.wait_for_timeout(150)
-        current = scene_pixels(page)
+        now = page.screenshot()
+        current = crop(now)
         if np.array_equal(current, previous):
             break
-        previous = current
-    page.screenshot(path=str(ARTIFACTS / f"{name}.png"))
+        png, previous = now, current
+    ARTIFACTS.mkdir(exist_ok=True)
+    (ARTIFACTS / f"{name}.png").write_bytes(png)
     return previous
 
 
@@ -279,8 +310,8 @@ def panel_state(page: Any) -> dict[str, str]:
     return state
 
 
-def open_page(browser: Any, url: str) -> Any:
-    page = browser.new_page(viewport=VIEWPORT)
+def open_page(browser: Any, url: str, lasting: bool = False) -> Any:
+    page = (browser.lasting_page if lasting else browser.new_page)(viewport=VIEWPORT)
     # fixedDpr: viser otherwise lowers the resolution when software WebGL is slow,
     # at a moment of its choosing, and identical scenes stop giving identical pixels.
     page.goto(url + "/?fixedDpr=1")
@@ -288,21 +319,54 @@ def open_page(browser: Any, url: str) -> Any:
     return page
 
 
-@contextlib.contextmanager
-def program_page(
-    browser: Any, c2rviz_process: Callable[..., Any], *args: str
-) -> Iterator[tuple[Any, Any, Tcp]]:
-    """The program (``ARGS``, its viewer on a free port, lit plainly), a page with the robot
-    drawn, and a controller on its command port (closed after)."""
-    ARTIFACTS.mkdir(exist_ok=True)
-    proc = c2rviz_process("--viser-port", "0", *PLAIN, *args)
-    page = open_page(browser, proc.viewer_url)
-    wait_for_robot(page)
-    tcp = Tcp(proc.port)
-    try:
-        yield proc, page, tcp
-    finally:
-        tcp.close()
+class LastingProgram:
+    """One program (the Motoman, its viewer on a free port, lit plainly, ``ARGS``) and a page
+    with its robot drawn, shared by the tests that take it (``tests/browser/conftest.py``).
+
+    A new page costs 3-9 s of Chromium's CPU before its robot is drawn, the program 2 s
+    more (docs/testing.md): tests that only need the Motoman at home share both, and
+    ``session`` puts the world back as a new program has it before each.
+    """
+
+    def __init__(self, chromium: FreshContexts, record_dir: Path, *args: str) -> None:
+        ARTIFACTS.mkdir(exist_ok=True)
+        self.record_dir = record_dir
+        self.proc = start_program(
+            "--viser-port", "0", *PLAIN, "--record-dir", str(record_dir), *args
+        )
+        try:
+            self.page = open_page(chromium, self.proc.viewer_url, lasting=True)
+            self.home_poses = wait_for_robot(self.page)["poses"]
+        except BaseException:
+            self.proc.stop()
+            raise
+
+    @contextlib.contextmanager
+    def session(self) -> Iterator[tuple[Any, Any, Tcp]]:
+        """The program, its page and a new controller on its command port (closed after),
+        the world as a new program has it: at rest at home, no markers, trail off, the
+        ghost on, the page live and showing all that."""
+        tcp = Tcp(self.proc.port)
+        try:
+            for line in ("stop", "trail off", "ghost on", "clear"):
+                assert tcp.ask(line) == "ok", line
+            if field(self.page, "Shown").input_value() != "live":
+                self.page.get_by_role("button", name="live", exact=True).click()
+            wait_for_scene(
+                self.page,
+                "the arm at home, no markers",
+                lambda state: state["markers"] == 0 and same_poses(state["poses"], self.home_poses),
+            )
+            wait_for(lambda: field(self.page, "Shown").input_value() == "live", "the page live")
+            yield self.proc, self.page, tcp
+        finally:
+            tcp.close()
+
+    def close(self) -> None:
+        try:
+            self.page.context.close()
+        finally:
+            self.proc.stop()
 
 
 def wait_for(predicate: Callable[[], bool], what: str = "timed out") -> None:

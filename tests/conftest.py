@@ -10,10 +10,6 @@ program as a subprocess for the tests that need ``main`` (quit, signals).
 from __future__ import annotations
 
 import os
-import re
-import subprocess
-import sys
-import time
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -24,11 +20,11 @@ from support import (
     ARGS,
     CHROMIUM,
     CI_EXAMPLES,
-    ROOT,
     Client,
     Process,
     ServerThread,
     load_robot,
+    start_program,
 )
 
 from c2rviz.session import ServerLimits
@@ -101,50 +97,13 @@ def c2rviz_process() -> Iterator[Callable[..., Process]]:
     procs: list[Process] = []
 
     def start(*args: str, timeout: float = 120.0, default_crcl_port: bool = False) -> Process:
-        # No rosbridge door (port 9090) unless the test names its port: tests stay apart.
-        door = () if any(a.startswith("--rosbridge-port") for a in args) else ("--no-rosbridge",)
-        named = any(a.startswith(("--crcl-port", "--no-crcl")) for a in args)
-        if not (named or default_crcl_port):
-            door += ("--crcl-port", "0")  # a free port: not 64444, which may be taken
-        popen = subprocess.Popen(
-            [sys.executable, "-m", "c2rviz", "--port", "0", *door, *args],
-            cwd=ROOT,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-            env={**os.environ, "PYTHONUNBUFFERED": "1"},
-        )
-        output: list[str] = []
-        deadline = time.monotonic() + timeout
-        port = None
-        url = None
-        no_viewer = "--no-viewer" in args
-        assert popen.stdout is not None
-        while time.monotonic() < deadline:
-            line = popen.stdout.readline()
-            if not line:
-                break
-            output.append(line)
-            if m := re.search(r"commands on [\d.]+:(\d+)", line):
-                port = int(m.group(1))
-            if m := re.search(r"viewer at (\S+)", line):
-                url = m.group(1)
-            if port is not None and (no_viewer or url is not None):
-                break
-        if port is None:
-            popen.kill()
-            raise RuntimeError("c2rviz did not start:\n" + "".join(output))
-        proc = Process(popen, port, output, url)
+        proc = start_program(*args, timeout=timeout, default_crcl_port=default_crcl_port)
         procs.append(proc)
         return proc
 
     yield start
     for proc in procs:
-        if proc.popen.poll() is None:
-            proc.popen.kill()
-            proc.popen.wait(timeout=10)
-        if proc.popen.stdout is not None:
-            proc.popen.stdout.close()
+        proc.stop()
 
 
 @pytest.fixture(scope="session")

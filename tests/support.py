@@ -9,10 +9,13 @@ from __future__ import annotations
 
 import contextlib
 import inspect
+import os
+import re
 import socket
 import subprocess
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from functools import cache
@@ -178,6 +181,14 @@ class Process:
     def wait(self, timeout: float = 60.0) -> int:
         return self.popen.wait(timeout=timeout)
 
+    def stop(self) -> None:
+        """Killed if still running, its output pipe closed."""
+        if self.popen.poll() is None:
+            self.popen.kill()
+            self.popen.wait(timeout=10)
+        if self.popen.stdout is not None:
+            self.popen.stdout.close()
+
 
 def typed_verbs(cls: type) -> dict[str, list[str]]:
     """Each verb that ``cls`` (``Client`` or ``AsyncClient``) has a typed method for, and
@@ -188,3 +199,43 @@ def typed_verbs(cls: type) -> dict[str, list[str]]:
         if verb is not None:
             found.setdefault(verb, []).append(name)
     return found
+
+
+def start_program(*args: str, timeout: float = 120.0, default_crcl_port: bool = False) -> Process:
+    """Start ``python -m c2rviz --port 0 ARGS`` (``--no-rosbridge`` too, unless ARGS name
+    ``--rosbridge-port``, and ``--crcl-port 0`` unless they name CRCL's or ask for its
+    ``default_crcl_port``); wait until it listens (the ``c2rviz_process`` fixture's)."""
+    # No rosbridge door (port 9090) unless the test names its port: tests stay apart.
+    door = () if any(a.startswith("--rosbridge-port") for a in args) else ("--no-rosbridge",)
+    named = any(a.startswith(("--crcl-port", "--no-crcl")) for a in args)
+    if not (named or default_crcl_port):
+        door += ("--crcl-port", "0")  # a free port: not 64444, which may be taken
+    popen = subprocess.Popen(
+        [sys.executable, "-m", "c2rviz", "--port", "0", *door, *args],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    output: list[str] = []
+    deadline = time.monotonic() + timeout
+    port = None
+    url = None
+    no_viewer = "--no-viewer" in args
+    assert popen.stdout is not None
+    while time.monotonic() < deadline:
+        line = popen.stdout.readline()
+        if not line:
+            break
+        output.append(line)
+        if m := re.search(r"commands on [\d.]+:(\d+)", line):
+            port = int(m.group(1))
+        if m := re.search(r"viewer at (\S+)", line):
+            url = m.group(1)
+        if port is not None and (no_viewer or url is not None):
+            break
+    if port is None:
+        popen.kill()
+        raise RuntimeError("c2rviz did not start:\n" + "".join(output))
+    return Process(popen, port, output, url)

@@ -13,11 +13,10 @@ camera. Waits are on signals with generous deadlines, as in test_browser.py.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from typing import Any
 
 import pytest
-from browser_support import changed, field, program_page, settle, wait_for, wait_until
+from browser_support import LastingProgram, changed, field, settle, wait_for, wait_until
 
 pytestmark = pytest.mark.browser
 
@@ -63,10 +62,8 @@ def numbers(reply: str) -> list[float]:
     return [float(v) for v in reply[3:].split(",")]
 
 
-def test_dragging_the_tool_handle_moves_the_arm(
-    browser: Any, c2rviz_process: Callable[..., Any]
-) -> None:
-    with program_page(browser, c2rviz_process) as (_proc, page, tcp):
+def test_dragging_the_tool_handle_moves_the_arm(browser: Any, motoman: LastingProgram) -> None:
+    with motoman.session() as (_proc, page, tcp):
         home = tcp.ask("where")
         before = settle(page, "handle-1-before")
         found = wait_until(
@@ -93,9 +90,9 @@ def test_dragging_the_tool_handle_moves_the_arm(
 
 
 def test_clicking_a_marker_and_go_to_puts_the_tool_on_it(
-    browser: Any, c2rviz_process: Callable[..., Any]
+    browser: Any, motoman: LastingProgram
 ) -> None:
-    with program_page(browser, c2rviz_process) as (_proc, page, tcp):
+    with motoman.session() as (_proc, page, tcp):
         # A marker where the tool stands at a reachable pose, then back home.
         for line in ("degrees", "move 1,3,5 30,-40,45", "marker cube", "mark"):
             assert tcp.ask(line) == "ok", line

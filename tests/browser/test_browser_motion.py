@@ -7,16 +7,15 @@ target commanded at once. Waits are on signals (test_browser.py).
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import pytest
 from browser_support import (
+    LastingProgram,
     Tcp,
     changed,
     page_state,
-    program_page,
     same_poses,
     scene_pixels,
     settle,
@@ -30,9 +29,9 @@ TARGET = "90,45,0,-30,0,60,0"  # degrees
 
 
 def test_a_move_in_motion_is_drawn_as_it_goes_and_ends_at_the_target(
-    browser: Any, c2rviz_process: Callable[..., Any]
+    browser: Any, motoman: LastingProgram
 ) -> None:
-    with program_page(browser, c2rviz_process) as (proc, page, mover):
+    with motoman.session() as (proc, page, mover):
         asker = Tcp(proc.port)
         home_poses = page_state(page)["poses"]  # type: ignore[index]
         for line in ("degrees", "motion on", "speed 10"):  # a move of several seconds

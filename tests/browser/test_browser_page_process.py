@@ -18,8 +18,8 @@ import test_browser_motion
 import test_browser_trail
 from browser_support import (
     DEADLINE_S,
+    LastingProgram,
     changed,
-    program_page,
     scene_pixels,
     settle,
     wait_for,
@@ -63,12 +63,14 @@ def test_the_same_with_the_page_in_its_own_process(
         return c2rviz_process(*args, "--page-process", **kwargs)
 
     test = getattr(module, name)
-    more = {
-        arg: request.getfixturevalue(arg)
-        for arg in inspect.signature(test).parameters
-        if arg not in ("browser", "c2rviz_process")
-    }
-    test(browser=browser, c2rviz_process=in_its_own_process, **more)
+    given = {"browser": browser, "c2rviz_process": in_its_own_process}
+    shared = {"motoman": "motoman_page_process"}  # the shared Motoman, its page on its own
+    test(
+        **{
+            arg: given[arg] if arg in given else request.getfixturevalue(shared.get(arg, arg))
+            for arg in inspect.signature(test).parameters
+        }
+    )
 
 
 def scene_nodes(page: Any) -> list[str]:
@@ -76,12 +78,12 @@ def scene_nodes(page: Any) -> list[str]:
 
 
 def test_parts_goals_cameras_and_the_fault_banner_come_from_the_page_process(
-    browser: Any, c2rviz_process: Callable[..., Any]
+    browser: Any, motoman_page_process: LastingProgram
 ) -> None:
     """What the in-process page draws of the cell (tests/view/test_view_parts.py,
     test_view_cameras.py, the banner in test_view_instruments.py), drawn by the page
     process from the rows the channel carries, in real Chromium."""
-    with program_page(browser, c2rviz_process, "--page-process") as (_, page, tcp):
+    with motoman_page_process.session() as (_, page, tcp):
         home = settle(page, "page-process-cell-1-home")
         assert tcp.ask("part p1 box 0.1,0.1,0.1 0.6,0.3,0.05,0,0,0") == "ok"
         assert tcp.ask("goal p1 0.6,-0.3,0.05,0,0,0") == "ok"

@@ -10,6 +10,8 @@ the player's own state (``window.__c2rvizPlayer``).
 from __future__ import annotations
 
 import csv
+import shutil
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -17,9 +19,12 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from browser_support import ARTIFACTS, LINK_NODE_JS, in_root, wait_until
-from support import ServerThread, load_robot
+from support import Client, ServerThread, load_robot
 
+from c2rviz.session import ServerLimits
 from c2rviz.view.record_frames import HTML_HZ, MAX_HTML_FRAMES
+from c2rviz.world.state import RobotState
+from c2rviz.world.virtual_clock import VirtualClock
 
 pytestmark = pytest.mark.browser
 
@@ -68,6 +73,34 @@ def record(server: ServerThread, connect: Any, folder: Path) -> None:
         assert client.ask(line).startswith("ok"), line
 
 
+@pytest.fixture(scope="module")
+def take(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Path, RobotState]]:
+    """One recording of ``record`` for the module's tests (they only read it, or damage a
+    copy): its folder, and the world's state after it (to write a damaged copy's page)."""
+    folder = tmp_path_factory.mktemp("take")
+    server = ServerThread(load_robot(), ServerLimits(), clock=VirtualClock()).start()
+    clients: list[Client] = []
+
+    def connect(server: ServerThread) -> Client:
+        clients.append(Client(server.host, server.port))
+        return clients[-1]
+
+    try:
+        record(server, connect, folder)
+        yield folder, server.world.state()
+    finally:
+        for client in clients:
+            client.close()
+        server.stop()
+
+
+def copy_of(take: tuple[Path, RobotState], folder: Path) -> Path:
+    """The recording's files in ``folder`` (a test's own ``tmp_path``)."""
+    for name in ("take.csv", "take.txt", "take.html"):
+        shutil.copy(take[0] / name, folder / name)
+    return folder
+
+
 def csv_rows(path: Path) -> np.ndarray:
     with open(path, newline="") as file:
         return np.array(list(csv.reader(file))[1:], dtype=float)
@@ -108,9 +141,9 @@ def open_recording(browser: Any, path: Path) -> Any:
 
 
 def test_the_recorded_page_seeks_forward_and_back_to_the_csvs_frames(
-    start_server: Any, connect: Any, tmp_path: Path, browser: Any
+    take: tuple[Path, RobotState], tmp_path: Path, browser: Any
 ) -> None:
-    record(start_server(), connect, tmp_path)
+    copy_of(take, tmp_path)
     rows = csv_rows(tmp_path / "take.csv")
     page = open_recording(browser, tmp_path / "take.html")
     end = rows[-1, 0]
@@ -154,9 +187,9 @@ def test_the_recorded_page_seeks_forward_and_back_to_the_csvs_frames(
 
 
 def test_the_recorded_pages_controls_step_speed_and_refuse_what_is_out_of_range(
-    start_server: Any, connect: Any, tmp_path: Path, browser: Any
+    take: tuple[Path, RobotState], tmp_path: Path, browser: Any
 ) -> None:
-    record(start_server(), connect, tmp_path)
+    copy_of(take, tmp_path)
     page = open_recording(browser, tmp_path / "take.html")
     page.evaluate("window.__c2rvizPlayer.seek(1.0)")
     frame = page.evaluate(STATE)["frame"]
@@ -191,13 +224,12 @@ def test_the_recorded_pages_controls_step_speed_and_refuse_what_is_out_of_range(
     ],
 )
 def test_a_damaged_recording_opens_with_its_message(
-    start_server: Any, connect: Any, tmp_path: Path, browser: Any, damage: str, message: str
+    take: tuple[Path, RobotState], tmp_path: Path, browser: Any, damage: str, message: str
 ) -> None:
     from c2rviz.observers.recorder import Recorded
     from c2rviz.view.record_page import write_html
 
-    server = start_server()
-    record(server, connect, tmp_path)
+    copy_of(take, tmp_path)
     csv_path, txt = tmp_path / "take.csv", tmp_path / "take.txt"
     if damage == "cut":  # a crash mid-write: the CSV ends in half a row
         text = csv_path.read_text()
@@ -206,7 +238,7 @@ def test_a_damaged_recording_opens_with_its_message(
         body = txt.read_text()
         body = "\n".join(line for line in body.splitlines() if not line.startswith("# recorded"))
         txt.write_text(body.replace("joints 0.0,", "joints 0.5,") + "\njoints 1,1,1,1,1,1,1\n")
-    state = server.world.state()
+    state = take[1]
     recorded = Recorded("take", state.robot.name, txt, csv_path, 0, 0.0, None, ())  # type: ignore[arg-type]
     write_html(recorded, state)
     page = open_recording(browser, tmp_path / "take.html")

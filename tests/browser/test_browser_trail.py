@@ -3,12 +3,11 @@ along the tool's path; `trail off` takes it away. Waits are on signals (test_bro
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import pytest
-from browser_support import program_page, scene_pixels, settle, wait_for
+from browser_support import LastingProgram, scene_pixels, settle, wait_for
 
 pytestmark = pytest.mark.browser
 
@@ -26,10 +25,8 @@ def orange_pixels(scene: np.ndarray) -> int:
     return int(((r > 200) & (g > 100) & (g < 200) & (b < 80)).sum())
 
 
-def test_a_move_leaves_a_trail_on_the_page(
-    browser: Any, c2rviz_process: Callable[..., Any]
-) -> None:
-    with program_page(browser, c2rviz_process) as (_proc, page, tcp):
+def test_a_move_leaves_a_trail_on_the_page(browser: Any, motoman: LastingProgram) -> None:
+    with motoman.session() as (_proc, page, tcp):
         before = orange_pixels(settle(page, "trail-1-before"))
         for line in ("trail on", "motion on", "speed 100", "degrees"):
             assert tcp.ask(line) == "ok"
