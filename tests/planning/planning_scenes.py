@@ -115,6 +115,14 @@ class IndependentCheck:
                 (coal.Box(*size), coal.Transform3s(where.rotation, where.translation))
             )
         objects = self.geometry.geometryObjects
+        # A bounding sphere per shape, exact arithmetic only: shapes whose spheres are apart
+        # cannot touch, so coal is asked only about the rest (the same answers, sooner).
+        for shape in [obj.geometry for obj in objects] + [box for box, _ in self.boxes]:
+            shape.computeLocalAABB()
+        self._centre = np.array([obj.geometry.aabb_center for obj in objects])
+        self._radius = np.array([obj.geometry.aabb_radius for obj in objects]) + 1e-9
+        self._box_centre = [np.array(where.getTranslation()) for _, where in self.boxes]
+        self._box_radius = [box.aabb_radius for box, _ in self.boxes]
         joined = {(self.model.parents[a.parentJoint], a.parentJoint) for a in objects} | {
             (a.parentJoint, self.model.parents[a.parentJoint]) for a in objects
         }
@@ -129,12 +137,16 @@ class IndependentCheck:
             self._place(q)
             apart_everywhere -= {pair for pair in candidates if self._touch(*pair)}
         self.self_pairs = sorted(apart_everywhere)
+        self._pairs = np.array(self.self_pairs, dtype=int).reshape(-1, 2)
 
     def _place(self, q: Sequence[float]) -> None:
         config = self.robot.configuration(q)
         pin.updateGeometryPlacements(self.model, self.data, self.geometry, self.gdata, config)
         self._shapes = [obj.geometry for obj in self.geometry.geometryObjects]
         self._where = [coal.Transform3s(m.rotation, m.translation) for m in self.gdata.oMg]
+        rotations = np.array([m.rotation for m in self.gdata.oMg])
+        translations = np.array([m.translation for m in self.gdata.oMg])
+        self._world = np.einsum("nij,nj->ni", rotations, self._centre) + translations
 
     def _touch(self, i: int, j: int) -> bool:
         return _collide(self._shapes[i], self._where[i], self._shapes[j], self._where[j])
@@ -143,13 +155,19 @@ class IndependentCheck:
         """What ``q`` [rad or m] touches: ``link/box k`` and ``link/link`` names."""
         self._place(q)
         names = [obj.name for obj in self.geometry.geometryObjects]
-        found = [
-            f"{names[i]}/box{k}"
-            for k, (box, where) in enumerate(self.boxes)
-            for i in range(len(names))
-            if _collide(self._shapes[i], self._where[i], box, where)
-        ]
-        found += [f"{names[i]}/{names[j]}" for i, j in self.self_pairs if self._touch(i, j)]
+        found = []
+        for k, (box, where) in enumerate(self.boxes):
+            gap = np.linalg.norm(self._world - self._box_centre[k], axis=1)
+            near = np.flatnonzero(gap <= self._radius + self._box_radius[k])
+            found += [
+                f"{names[i]}/box{k}"
+                for i in near
+                if _collide(self._shapes[i], self._where[i], box, where)
+            ]
+        first, second = self._pairs[:, 0], self._pairs[:, 1]
+        gap = np.linalg.norm(self._world[first] - self._world[second], axis=1)
+        near = self._pairs[gap <= self._radius[first] + self._radius[second]]
+        found += [f"{names[i]}/{names[j]}" for i, j in near.tolist() if self._touch(i, j)]
         return found
 
 
@@ -172,11 +190,13 @@ def polyline_samples(waypoints: np.ndarray, step_rad: float) -> np.ndarray:
     return np.vstack(points)
 
 
-def distance_to_polyline(q: np.ndarray, waypoints: np.ndarray) -> float:
-    """Euclidean distance [rad or m] from ``q`` to the nearest point of the polyline."""
-    best = np.inf
+def distance_to_polyline(qs: np.ndarray, waypoints: np.ndarray) -> np.ndarray:
+    """Euclidean distance [rad or m] from each row of ``qs`` to the nearest point of the
+    polyline (one array op per edge, not a Python loop per sample)."""
+    qs = np.atleast_2d(np.asarray(qs, dtype=float))
+    best = np.full(len(qs), np.inf)
     for a, b in zip(waypoints[:-1], waypoints[1:]):
         d = b - a
-        f = float(np.clip(np.dot(q - a, d) / max(np.dot(d, d), 1e-300), 0.0, 1.0))
-        best = min(best, float(np.linalg.norm(q - (a + f * d))))
+        f = np.clip((qs - a) @ d / max(float(np.dot(d, d)), 1e-300), 0.0, 1.0)
+        best = np.minimum(best, np.linalg.norm(qs - (a + f[:, None] * d), axis=1))
     return best

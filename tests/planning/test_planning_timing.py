@@ -49,7 +49,7 @@ def test_timed_path_stays_on_the_polyline_within_limits_and_arrives(
     waypoints = random_polyline(limits, 4, seed=len(name))
     path = time_path(waypoints, limits, start=100.0, speed=speed)
     qs = assert_within_limits(path, limits, speed)
-    assert max(distance_to_polyline(q, waypoints) for q in qs) < 1e-9
+    assert distance_to_polyline(qs, waypoints).max() < 1e-9
     assert path.sample(path.arrival) == tuple(waypoints[-1])
     assert path.sample(path.start - 1.0) == tuple(waypoints[0])
     # it passes every corner, in order, at rest

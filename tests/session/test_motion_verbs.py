@@ -202,14 +202,16 @@ def test_speed_scales_the_duration_as_the_profile_predicts(server: ServerThread,
 
 
 @pytest.mark.parametrize("verb", ["home", "rand", "clear"])
-@pytest.mark.wall_clock
 def test_home_rand_and_clear_travel_too(server: ServerThread, open_client, verb: str):
+    """On the virtual clock: the watcher, connected, holds time still while it sees the
+    arm moving; once it leaves, the move's time passes at once and the reply comes."""
     mover = open_client("off")
     mover.ask(f"j {FAR}")
     mover.ask("motion on")
     watcher = open_client()
     mover.send(f"{verb}\n")
     wait_until_moving(watcher)
+    watcher.close()
     assert mover.read_line() == "ok"
     assert mover.ask("status") == "ok idle"
     if verb != "rand":
