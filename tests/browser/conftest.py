@@ -36,3 +36,20 @@ def motoman_page_process(
 ) -> Iterator[LastingProgram]:
     """The same with ``--page-process``: the page served by a process of its own."""
     yield from lasting(chromium, tmp_path_factory, "--page-process")
+
+
+@pytest.fixture
+def own_motoman(
+    chromium: FreshContexts, tmp_path_factory: pytest.TempPathFactory
+) -> Iterator[LastingProgram]:
+    """A Motoman program and page of the test's own (the look-back test: shared, its
+    page-process run once waited 180 s for a look back that never came, in a full run)."""
+    yield from lasting(chromium, tmp_path_factory)
+
+
+@pytest.fixture
+def own_motoman_page_process(
+    chromium: FreshContexts, tmp_path_factory: pytest.TempPathFactory
+) -> Iterator[LastingProgram]:
+    """The same with ``--page-process``."""
+    yield from lasting(chromium, tmp_path_factory, "--page-process")

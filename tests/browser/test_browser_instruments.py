@@ -117,8 +117,9 @@ def test_the_plot_shows_a_joints_command_within_a_frame(
 
 
 def test_looking_back_in_the_live_page_shows_the_arm_as_the_csv_has_it(
-    browser: Any, motoman: LastingProgram
+    browser: Any, own_motoman: LastingProgram
 ) -> None:
+    motoman = own_motoman
     with motoman.session() as (proc, page, tcp):
         # Both closed here: a socket closed while its file is open stays open until the
         # file is collected, and the garbage collector's ResourceWarning then failed

@@ -64,7 +64,10 @@ def test_the_same_with_the_page_in_its_own_process(
 
     test = getattr(module, name)
     given = {"browser": browser, "c2rviz_process": in_its_own_process}
-    shared = {"motoman": "motoman_page_process"}  # the shared Motoman, its page on its own
+    shared = {  # the (shared) Motoman, its page on its own
+        "motoman": "motoman_page_process",
+        "own_motoman": "own_motoman_page_process",
+    }
     test(
         **{
             arg: given[arg] if arg in given else request.getfixturevalue(shared.get(arg, arg))
