@@ -107,6 +107,11 @@ class CommandServer:
             self.world.faults.listeners.remove(self._fault)
         if self._server is not None:
             self._server.close()
+            # A socket accepted just before has its transport made but its connection_made
+            # still queued: let those run, so every connection is in the sets closed below
+            # (else its transport is never closed: a ResourceWarning when it is collected).
+            for _ in range(3):
+                await asyncio.sleep(0)
         for connection in list(self.connections):
             connection.shutdown()
         if self.open:  # each gets its last replies and then closes, or is cut off
