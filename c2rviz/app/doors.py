@@ -38,10 +38,10 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from ..errors import C2rvizError, ConfigError, shown
+from ..ini import normalize_origin
 from ..session.services import Services
 from ..transports.crcl.server import DEFAULT_PORT, CrclLimits, CrclServer
 from ..transports.rosbridge import PolicyError, RosbridgePolicy, RosbridgeServer
-from ..transports.rosbridge.policy import normalize_origin
 from ..transports.rosbridge.robot_bridge import RobotBridge
 from .config import Settings
 from .members import Member

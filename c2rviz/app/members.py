@@ -39,13 +39,13 @@ import pinocchio as pin
 
 from ..collision.model import CollisionModel
 from ..errors import C2rvizError, ConfigError
-from ..ini import read_ini
+from ..ini import number, read_ini
 from ..motion.limits import MotionLimits
 from ..robot.catalogue import CatalogueEntry, find_robot
 from ..robot.frames import pose_se3
 from ..robot.model import Robot
 from ..world.world import World
-from .config import ROBOT_KEYS, Settings, number, read_robots
+from .config import ROBOT_KEYS, Settings, read_robots
 from .ini_world import (
     IniFault,
     IniObject,

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..collision.geometry import read_srdf
 from ..errors import C2rvizError, ConfigError
-from ..observers.recorder import Recorded
+from ..observers.recorded import Recorded
 from ..protocol.verbs.scene import Record
 from ..session.services import Services
 from ..transports.tcp_server import CommandServer

@@ -5,8 +5,8 @@ for a thread of one's own (``batch``). Pure: no asyncio.
 """
 
 from .batch import BatchCheck, CheckGeometry, PlacedShape
-from .geometry import Pair, read_srdf
-from .model import CollisionError, CollisionModel, segment
+from .geometry import CollisionError, Pair, read_srdf
+from .model import CollisionModel, segment
 from .other_robots import OtherRobot, first_hit_between, pairs_between, placed_shapes
 from .workcell import MAX_OBJECTS, WorkcellObject
 

@@ -4,10 +4,10 @@ points planned and checked whole (``trajectory``), and what any path played on t
 offers, with the straight line's and the trajectory's plays (``path_play``).
 """
 
-from .limits import MotionLimitError, MotionLimits, motion_limits
+from .limits import MotionLimitError, MotionLimits, MotionPlanError, TrajectoryError, motion_limits
 from .path_play import LinePlay, PathPlay, TrajectoryPlay, brake_limits, ramp_limits
-from .planner import Motion, MotionPlanError
-from .trajectory import PlannedTrajectory, TrajectoryError, plan_trajectory
+from .planner import Motion
+from .trajectory import PlannedTrajectory, plan_trajectory
 
 __all__ = [
     "LinePlay",

@@ -43,8 +43,9 @@ from ..collision.workcell import WorkcellObject
 from ..protocol import replies
 from ..robot.frames import in_base, se3_pose, wxyz_se3
 from ..world.cameras import Camera
-from ..world.observer import Marker, Observer
+from ..world.observer import Observer
 from ..world.parts import Part
+from ..world.state import Marker
 from ..world.world import World
 from .camera_feed import CameraSignature, camera_changes, camera_signature
 from .record_files import RecordFiles, body_tally, cut_to_line, join_body

@@ -49,8 +49,8 @@ from ..protocol import replies
 from ..robot.frames import in_base, se3_pose, wxyz_se3
 from ..world.cameras import Camera, Seen
 from ..world.clock import Timer
-from ..world.observer import Marker, Observer
-from ..world.state import RobotState
+from ..world.observer import Observer
+from ..world.state import Marker, RobotState
 from ..world.world import World, seen_text
 from .camera_feed import CameraFeed
 

@@ -34,7 +34,7 @@ from ..app.doors import Opened, close_doors, open_doors
 from ..app.ini_world import ini_cameras, place_cameras
 from ..app.members import furnish
 from ..app.program import write_page
-from ..observers.recorder import Recorded
+from ..observers.recorded import Recorded
 from ..robot.model import Robot
 from ..session.services import Services
 from ..session.session import Session

@@ -27,7 +27,8 @@ import numpy as np
 import viser
 
 from ..protocol.grammar import MARKER_SHAPES
-from ..world.observer import MAX_MARKERS, Marker
+from ..world.observer import MAX_MARKERS
+from ..world.state import Marker
 from . import adapter
 from .robot_view import node_name
 

@@ -40,8 +40,7 @@ import viser
 from ..errors import limit_text
 from ..robot.frames import se3_pose
 from ..robot.model import Robot
-from ..world.state import Marker
-from ..world.world import RobotState
+from ..world.state import Marker, RobotState
 from . import adapter
 
 RECENT_COMMANDS = 8  # lines kept for the 'last commands' readout

@@ -39,7 +39,8 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
-from ..robot.model import Robot, RobotError
+from ..errors import RobotError
+from ..robot.model import Robot
 
 HTML_HZ = 30.0
 """Most frames a second kept for the page."""

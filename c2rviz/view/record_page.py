@@ -41,7 +41,7 @@ import numpy as np
 import pinocchio as pin
 
 from ..collision.workcell import WorkcellObject
-from ..observers.recorder import Recorded
+from ..observers.recorded import Recorded
 from ..protocol.grammar import MARKER_SHAPES
 from ..robot.model import Robot
 from ..robot.visuals import load_link_geometry

@@ -38,9 +38,10 @@ from ..robot.visuals import LinkGeometry, load_link_geometry
 from ..session.services import Services
 from ..session.session import Session
 from ..world.cameras import Camera
-from ..world.observer import Marker, Scene
+from ..world.observer import Scene
 from ..world.part_rules import Goal
 from ..world.parts import Part
+from ..world.state import Marker
 from . import adapter, scene_send
 from .cell_layers import CameraLayer, PartsLayer, TrailLayer, WorkcellLayer
 from .door_rules import DoorPolicy

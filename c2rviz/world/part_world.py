@@ -20,13 +20,12 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pinocchio as pin
 
-from ..collision.geometry import Obstacle, drop, robot_geometry, signed_distance
+from ..collision.geometry import Obstacle, drop, extent, robot_geometry, signed_distance
 from .part_rules import (
     Goal,
     GoalBook,
     GoalResult,
     at_cup,
-    extent,
     finger_links,
     jaws,
     opening_for,

@@ -40,8 +40,9 @@ from ...observers.bag_topics import part_items
 from ...observers.watch import WatchHub
 from ...ros.messages import Msg, marker_array, string, tf_message, transforms
 from ...world.clock import Timer
-from ...world.observer import MAX_MARKERS, Marker, Observer
+from ...world.observer import MAX_MARKERS, Observer
 from ...world.parts import Part
+from ...world.state import Marker
 from ...world.world import World
 from .bridge import TopicHub
 from .topics import DIAGNOSTICS_TOPIC, WORLD_FRAME, RobotTopics, diagnostics
