@@ -6,7 +6,7 @@ geometry of parts.
 elements, or its ``<visual>`` ones where it has none. Meshes are resolved like
 the viewer's, through ``RobotSource``, and replaced by their convex hulls so a
 check stays a few microseconds. ``adjacent_links``, ``moving_joints`` and the
-SRDF reader give the pairs never worth checking; ``collision.py`` samples the rest.
+SRDF reader give the pairs never worth checking; ``checks.choose_pairs`` samples the rest.
 
 The parts' geometry (``signed_distance``, ``extent``, ``contains``, ``drop``): how far
 apart two shapes are, how wide a part is along a line, and how far a released part drops

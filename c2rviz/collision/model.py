@@ -1,6 +1,6 @@
 """Collisions: the robot against itself and against the workcell, with coal.
 
-The geometry is ``collision_geometry.robot_geometry`` (URDF collision elements,
+The geometry is ``geometry.robot_geometry`` (URDF collision elements,
 visual ones where a link has none, on the full model). Which link pairs are
 checked is settled once, at construction, as MoveIt's setup assistant does:
 never links joined by a joint (a link without geometry passes its neighbours

@@ -3,7 +3,7 @@
 An object is a box, sphere, cylinder or mesh with a name, a size, a placement in
 the robot's base frame and a colour for drawing. ``Workcell`` holds them in the
 order they were first set and checks every input; ``collision_geometry`` turns
-one into coal's shape. Nothing here knows the robot's joints: ``collision.py``
+one into coal's shape. Nothing here knows the robot's joints: ``checks.build_checks``
 puts the shapes next to the links.
 
 Sizes follow the URDF: a box is (x, y, z) edge lengths, a sphere (radius,), a

@@ -7,7 +7,7 @@ joint-space line ``q = q_k + u * s`` (``u`` the edge's direction scaled to
 length, from rest to rest. Joint ``i`` then moves at ``u_i * ds/dt``, so
 bounding ``ds/dt`` by ``min(v_i / |u_i|)`` (and the acceleration and jerk of
 ``s`` likewise) keeps every joint within its velocity, acceleration and jerk
-limits, scaled by the speed fraction as ``motion.py`` scales them (``f``,
+limits, scaled by the speed fraction as ``motion.planner`` scales them (``f``,
 ``f**2``, ``f**3``).
 
 Why rest at every corner: at a corner the direction changes at once, so a

@@ -1,7 +1,7 @@
 """Where a robot description comes from: its URDF text and its mesh files.
 
 ``load_source`` reads a URDF (expanding a ``.xacro`` first, with
-``xacro_source``) into a ``RobotSource``; the source resolves every mesh
+``xacro.expand_xacro``) into a ``RobotSource``; the source resolves every mesh
 reference in it to a file on disk, the way ROS would but without ROS:
 
 - ``package://NAME/rest`` looks for package NAME, in this order: in each
