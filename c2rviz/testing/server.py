@@ -240,7 +240,10 @@ class TestServer:
     def stop(self) -> None:
         """Stop serving (every client is answered and closed), free the ports."""
         if self._loop is not None and self._stop is not None and self._thread.is_alive():
-            self._loop.call_soon_threadsafe(self._stop.set)
+            # The server may be ending on its own (a client's ``quit``): its loop can close
+            # between the check above and this call, and then there is nothing to stop.
+            with contextlib.suppress(RuntimeError):
+                self._loop.call_soon_threadsafe(self._stop.set)
         self._thread.join(timeout=60)
         give_back(self._key)
         self._key = None
