@@ -13,9 +13,11 @@ beside the goal (issue 35: p99 <= 5 ms), and beside the same bystander with no f
    refused before InitCanon, so the cost is the parse), back to back, reading their
    statuses.
 2. rosbridge trajectory: 4 clients each send ``/joint_trajectory`` frames of 8000 points
-   (about 1 MB), one after the other: refused at a joint name the arm lacks (the cost
-   is the decode and the message's read), then refused by the plan's limit check (its
-   first point too far for the time given: the decode, the read and the plan).
+   (about 1 MB), one after the other: refused at a joint name the arm lacks (the decode
+   and the message's read, in the door's decoding process, which sends back only the
+   trajectory's outline; the loop's cost is the frame's receipt and the refusal), then
+   refused by the plan's limit check (its first point too far for the time given: the
+   decode, the read, the reading taken back and the plan).
 
 Figures only: nothing here passes or fails. The machine is shared: its load average
 is printed first.

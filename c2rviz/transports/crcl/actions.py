@@ -52,7 +52,7 @@ from .commands import (
 )
 from .controller import ARM, DWELL, GRIPPER, Action, Controller, Refused, Report, registrar
 from .documents import COMMAND_TYPES
-from .motions import actuate, dwell, grip, halt, move_through, move_to, placement
+from .motions import Placements, actuate, dwell, grip, halt, move_through, move_to, placement
 from .primitives import RotSpeedRelative, TransSpeedAbsolute, TransSpeedRelative
 from .setting_commands import (
     SetAngleUnits,
@@ -112,8 +112,7 @@ def _move_to(ctl: Controller, report: Report, command: MoveTo) -> None:
 
 @_action(MoveThroughTo)
 def _move_through(ctl: Controller, report: Report, command: MoveThroughTo) -> None:
-    unit = ctl.settings.length_unit
-    targets = [placement(pose, unit) for pose in command.waypoints]
+    targets = Placements(command.waypoints, ctl.settings.length_unit)
     ctl.start(ARM, report, lambda c, job: move_through(c, job, targets, command.move_straight))
 
 

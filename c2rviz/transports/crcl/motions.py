@@ -13,7 +13,8 @@ collisions apply alike.
   way is braked first.
 - ``MoveThroughTo``: every waypoint solved (or every line planned) and checked, off the
   event loop, before the arm moves, then one after the other; an error names the
-  waypoint (1-based).
+  waypoint (1-based). Each waypoint becomes a placement as its leg is planned
+  (``Placements``), so a thousand of them never hold the loop at once.
 - ``ActuateJoints``: the named joints (the others keep their target) at the speed
   their ``JointSpeed``/``JointAccel`` allow within the limits.
 - ``StopMotion``/``EndCanon``: the arm brakes within its limits, the fingers stop.
@@ -24,18 +25,48 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Sequence
+from typing import overload
 
 import pinocchio as pin
 
 from ...ik.chain import Target
 from .controller import Controller, Job, Refused
 from .primitives import Pose
-from .units import pose_to_matrix
+from .units import check_points, pose_to_matrix
 
 
 def placement(pose: Pose, length_unit: str) -> pin.SE3:
     """A CRCL pose (in ``length_unit``) as a placement in the base frame [m]."""
     return pin.SE3(pose_to_matrix(pose, length_unit))
+
+
+class Placements(Sequence[pin.SE3]):
+    """CRCL poses (in ``length_unit``) as placements in the base frame [m], each made as it
+    is asked for: a ``MoveThroughTo``'s waypoint as its leg is planned, in that leg's turn
+    of the event loop (a thousand made at once held it some 30 ms). Their points are
+    checked whole when it is made, so a waypoint out of range refuses the command at once.
+
+    Raises:
+        CrclValueError: A point out of range (``units.check_points``).
+    """
+
+    def __init__(self, poses: Sequence[Pose], length_unit: str) -> None:
+        check_points((pose.point for pose in poses), length_unit)
+        self.poses, self.length_unit = poses, length_unit
+
+    def __len__(self) -> int:
+        return len(self.poses)
+
+    @overload
+    def __getitem__(self, index: int) -> pin.SE3: ...
+
+    @overload
+    def __getitem__(self, index: slice) -> list[pin.SE3]: ...
+
+    def __getitem__(self, index: int | slice) -> pin.SE3 | list[pin.SE3]:
+        if isinstance(index, slice):
+            return [placement(pose, self.length_unit) for pose in self.poses[index]]
+        return placement(self.poses[index], self.length_unit)
 
 
 async def move_to(ctl: Controller, job: Job, target: pin.SE3, straight: bool) -> None:

@@ -8,7 +8,7 @@ session's conversion layer (``session.units``), which the text port's degrees us
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from typing import Final
 
 import numpy as np
@@ -91,6 +91,27 @@ def pose_rotation(pose: Pose) -> NDArray[np.float64]:
     return np.column_stack((x, np.cross(z, x), z))
 
 
+def check_points(points: Iterable[Point], length_unit: str = "meter") -> None:
+    """Refuse the first coordinate of ``points`` (in ``length_unit``) farther than
+    ``protocol.grammar.POSITION_M`` (1000 m) from the origin, as the text port refuses it.
+
+    Raises:
+        CrclValueError: naming the coordinate (``Point X``).
+    """
+    factor = length_factor(length_unit)
+    for point in points:
+        for label, value in zip("XYZ", (point.x, point.y, point.z)):
+            if abs(value * factor) > POSITION_M:
+                raise (
+                    CrclValueError(
+                        f"{value:g} {length_unit} is out of range: a position lies within "
+                        f"-{POSITION_M:g}..{POSITION_M:g} m of the origin"
+                    )
+                    .within(label)
+                    .within("Point")
+                )
+
+
 def pose_to_matrix(pose: Pose, length_unit: str = "meter") -> NDArray[np.float64]:
     """The 4x4 homogeneous transform of a pose, its translation in meters.
 
@@ -103,17 +124,8 @@ def pose_to_matrix(pose: Pose, length_unit: str = "meter") -> NDArray[np.float64
             (1000 m) from the origin, as the text port refuses it.
     """
     factor = length_factor(length_unit)
+    check_points((pose.point,), length_unit)
     point = pose.point
-    for label, value in zip("XYZ", (point.x, point.y, point.z)):
-        if abs(value * factor) > POSITION_M:
-            raise (
-                CrclValueError(
-                    f"{value:g} {length_unit} is out of range: a position lies within "
-                    f"-{POSITION_M:g}..{POSITION_M:g} m of the origin"
-                )
-                .within(label)
-                .within("Point")
-            )
     matrix = np.eye(4)
     matrix[:3, :3] = pose_rotation(pose)
     matrix[:3, 3] = (point.x * factor, point.y * factor, point.z * factor)

@@ -27,7 +27,7 @@ some of its messages (``snapshot``).
 from __future__ import annotations
 
 import logging
-from collections.abc import Awaitable, Callable, Mapping, Sequence
+from collections.abc import Awaitable, Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -49,6 +49,13 @@ class Bridge(Protocol):
 
     def services(self) -> Sequence[tuple[str, str]]:
         """Every service besides rosapi's: ``(name, type)``, e.g. ``("/c2rviz/command", ...)``."""
+        ...
+
+    def trajectory_joints(self) -> Mapping[str, Collection[str]]:
+        """The joint names a trajectory may name, by the absolute name of each topic that
+        takes trajectories (``[NS]/joint_trajectory``: its robot's chain joints). A large
+        one naming another is refused as it is decoded: only its outline
+        (``messages.TrajectoryOutline``) comes to ``publish``, never its points."""
         ...
 
     def params(self) -> Mapping[str, object]:
@@ -106,7 +113,8 @@ class Bridge(Protocol):
             topic: The absolute topic name.
             msg: The message as the client sent it, not yet checked against its type;
                 a large one of a type c2rviz reads (``messages.read_ahead``) was read
-                as it was decoded, and comes as a stand-in that its reader takes.
+                as it was decoded, and comes as a stand-in that its reader (or, for a
+                trajectory refused there, ``messages.outline``) takes.
 
         Returns:
             An awaitable that ends once the message is taken (a move started),

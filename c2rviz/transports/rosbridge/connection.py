@@ -15,7 +15,7 @@ import asyncio
 import dataclasses
 import logging
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Collection, Mapping
 from typing import Any, Protocol
 
 from websockets.asyncio.server import ServerConnection
@@ -38,7 +38,8 @@ DECODE_ON_LOOP_BYTES = 16384
 """The largest frame decoded on the event loop [bytes]; a larger one (a trajectory of
 thousands of points) is decoded and its message read in the server's decoding process
 (``parse_process``), the other clients served meanwhile, this client's next frames
-after it."""
+after it; a trajectory naming a joint its robot lacks comes back as its outline
+(``messages.TrajectoryOutline``), refused without its points taken in."""
 REPLY_TOPIC = "/c2rviz/reply"
 """The reply topic's name under each robot's namespace (``[NS]/c2rviz/reply``)."""
 
@@ -57,15 +58,19 @@ class Host(Protocol):
     def encode(self, spelling: str, msg: dict[str, Any]) -> str | None: ...
 
 
-def _decode(text: str, topics: dict[str, str]) -> tuple[protocol.Op, object]:
+def _decode(
+    text: str, topics: dict[str, str], joints: Mapping[str, Collection[str]]
+) -> tuple[protocol.Op, object]:
     """In the decoding process: the frame's request and, for a publish to a topic whose
     message c2rviz reads (a trajectory, a joint state), that reading
-    (``messages.read_ahead``). The message itself then stays here: its reader is what
-    takes it (``Bridge.publish``), and it would cost the loop as much to take in again."""
+    (``messages.read_ahead``; a trajectory naming a joint not in ``joints`` of its topic,
+    only its outline). The message itself then stays here: its reader is what takes it
+    (``Bridge.publish``), and it would cost the loop as much to take in again."""
     op = protocol.parse_frame(text)
     if isinstance(op, protocol.Publish):
-        kind = topics.get(resolve_name(op.topic))
-        reading = None if kind is None else messages.read_ahead(kind, op.msg)
+        name = resolve_name(op.topic)
+        kind = topics.get(name)
+        reading = None if kind is None else messages.read_ahead(kind, op.msg, joints.get(name))
         if reading is not None:
             return dataclasses.replace(op, msg={}), reading
     return op, None
@@ -163,7 +168,8 @@ class Connection:
             decoding = self.server.decoding
             if len(text) > DECODE_ON_LOOP_BYTES and decoding is not None:
                 topics = dict(self.server.graph().topics)
-                decoded, reading = await decoding.run(_decode, text, topics)
+                joints = self.bridge.trajectory_joints()
+                decoded, reading = await decoding.run(_decode, text, topics, joints)
             else:
                 decoded = protocol.parse_frame(text)
             op = decoded

@@ -48,7 +48,7 @@ from ...robot.model import Robot
 from ...session.calls import MAX_TRAJECTORY_CHECKS
 from ...session.services import Services
 from ...session.session import Session
-from .messages import JointPositions, JointTrajectory
+from .messages import JointPositions, JointTrajectory, TrajectoryOutline
 
 # Text command lines.
 
@@ -267,10 +267,14 @@ def joint_command(session: Session, command: JointPositions) -> None:
     session.set_joints(q, said=said)  # motion on: nobody waits for the arrival
 
 
-async def joint_trajectory(session: Session, trajectory: JointTrajectory) -> None:
+async def joint_trajectory(
+    session: Session, trajectory: JointTrajectory | TrajectoryOutline
+) -> None:
     """Check ``trajectory`` whole, then play it from now on the world's clock. Its plan,
     its limit check and (``guard on``) its collision check run off the event loop, on the
-    session's worker: a trajectory of thousands of points stalls no other client.
+    session's worker: a trajectory of thousands of points stalls no other client. Its
+    outline (a large one, found naming a joint the robot lacks as it was decoded) is
+    refused as the trajectory would be.
 
     Raises:
         UnknownJointName: A name that is not a chain joint.
@@ -279,10 +283,8 @@ async def joint_trajectory(session: Session, trajectory: JointTrajectory) -> Non
         TrajectoryError: A point or an instant between points breaks a limit.
         PathCollides: With ``guard on``, an instant of it collides.
     """
-    points = trajectory.points
-    said = session.said(
-        f"/joint_trajectory {len(points)} points, {points[-1].time_from_start_s:g} s"
-    )
+    shown = TrajectoryOutline.of(trajectory)
+    said = session.said(f"/joint_trajectory {shown.point_count} points, {shown.duration_s:g} s")
     try:
         start, planned = await session.unstopped(_checked(session, trajectory))
         _at_rest(session, start)  # (another door may have moved it meanwhile)
@@ -301,7 +303,7 @@ def _at_rest(session: Session, start: np.ndarray | None = None) -> None:
 
 
 async def _checked(
-    session: Session, trajectory: JointTrajectory
+    session: Session, trajectory: JointTrajectory | TrajectoryOutline
 ) -> tuple[np.ndarray, PlannedTrajectory]:
     """``_plan``, then the guard's check of what it planned."""
     start, planned = await _plan(session, trajectory)
@@ -310,11 +312,13 @@ async def _checked(
 
 
 async def _plan(
-    session: Session, trajectory: JointTrajectory
+    session: Session, trajectory: JointTrajectory | TrajectoryOutline
 ) -> tuple[np.ndarray, PlannedTrajectory]:
     """Where the arm starts, and the trajectory planned and checked against the limits
     from there on the session's worker."""
     indices = _indices(session, "joint_names", trajectory.joint_names)
+    if isinstance(trajectory, TrajectoryOutline):  # (read against other joints: never here)
+        raise C2rvizError("joint_names: the trajectory was read for another chain; send it again")
     _at_rest(session)
     robot, state, world = session.robot, session.state, session.world
     start = np.asarray(state.q, dtype=float)

@@ -9,14 +9,17 @@ after points[2]``. Fields a type does not have are refused, as rosbridge does.
 
 A large message is read off the event loop (``read_ahead``, by the connection that
 decoded its frame there); ``remember`` keeps that reading so the reader, called
-again on the loop with the very same message, returns it without reading twice.
+again on the loop with the very same message, returns it without reading twice. A
+trajectory read there that names a joint its robot lacks comes back as its
+``TrajectoryOutline`` (``outline``), not its points: it is refused, and its refusal
+needs only that.
 """
 
 from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -121,21 +124,54 @@ class JointTrajectory:
     points: tuple[TrajectoryPoint, ...]
 
 
+@dataclass(frozen=True)
+class TrajectoryOutline:
+    """A ``JointTrajectory`` without its points: what its refusal tells.
+
+    Attributes:
+        joint_names: Its joint names.
+        point_count: How many points it has.
+        duration_s: Its last point's ``time_from_start`` [s].
+    """
+
+    joint_names: tuple[str, ...]
+    point_count: int
+    duration_s: float
+
+    @classmethod
+    def of(cls, trajectory: JointTrajectory | TrajectoryOutline) -> TrajectoryOutline:
+        """The outline of ``trajectory`` (an outline: itself)."""
+        if isinstance(trajectory, TrajectoryOutline):
+            return trajectory
+        points = trajectory.points
+        return cls(trajectory.joint_names, len(points), points[-1].time_from_start_s)
+
+
 _READ_AHEAD: dict[int, tuple[Mapping[str, Any], object]] = {}
 """Messages read already (off the event loop, ``read_ahead``), by ``id``: the message
 and its reading (or its ``MessageError``), until ``forget``."""
 
 
-def read_ahead(type_name: str, msg: Mapping[str, Any]) -> object:
+def read_ahead(
+    type_name: str, msg: Mapping[str, Any], joints: Collection[str] | None = None
+) -> object:
     """Read ``msg`` as ``type_name`` (on any thread): the dataclass its reader gives, the
-    ``MessageError`` it raises, or None when c2rviz has no reader for the type."""
+    ``MessageError`` it raises, or None when c2rviz has no reader for the type; a
+    trajectory naming a joint not in ``joints`` (its robot's), its ``TrajectoryOutline``."""
     reader = _READERS.get(type_name)
     if reader is None:
         return None
     try:
-        return reader(msg)
+        reading = reader(msg)
     except MessageError as error:
         return error
+    if (
+        joints is not None
+        and isinstance(reading, JointTrajectory)
+        and any(name not in joints for name in reading.joint_names)
+    ):
+        return TrajectoryOutline.of(reading)
+    return reading
 
 
 def remember(msg: Mapping[str, Any], reading: object) -> None:
@@ -147,6 +183,12 @@ def remember(msg: Mapping[str, Any], reading: object) -> None:
 def forget(msg: Mapping[str, Any]) -> None:
     """Drop what ``remember`` kept for ``msg``."""
     _READ_AHEAD.pop(id(msg), None)
+
+
+def outline(msg: Mapping[str, Any]) -> TrajectoryOutline | None:
+    """The ``TrajectoryOutline`` that ``remember`` kept for this very message, else None
+    (the ``MessageError`` kept for it as a trajectory: raised)."""
+    return _known(msg, TrajectoryOutline, JOINT_TRAJECTORY)  # type: ignore[no-any-return]
 
 
 def _known(msg: Mapping[str, Any], kind: type, type_name: str) -> Any:

@@ -30,7 +30,7 @@ robot's URDF; in a cell ``NS/robot_description`` is each robot's too.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from functools import partial
 from typing import Any
 
@@ -41,7 +41,13 @@ from ...ros.messages import string
 from ...session.services import Services
 from .bridge import TopicHub
 from .inputs import CommandLines, joint_command, joint_trajectory
-from .messages import COMMAND_SERVICE_TYPE, command_request, command_response, string_data
+from .messages import (
+    COMMAND_SERVICE_TYPE,
+    command_request,
+    command_response,
+    outline,
+    string_data,
+)
 from .messages import joint_positions as read_joint_positions
 from .messages import joint_trajectory as read_joint_trajectory
 from .topics import (
@@ -138,6 +144,11 @@ class RobotBridge:
     def services(self) -> Sequence[tuple[str, str]]:
         return [(name, COMMAND_SERVICE_TYPE) for name in self._services]
 
+    def trajectory_joints(self) -> Mapping[str, Collection[str]]:
+        return {
+            topics.joint_trajectory: topics.robot.joint_names for topics in self.robots.values()
+        }
+
     def params(self) -> Mapping[str, object]:
         return self._params
 
@@ -198,7 +209,8 @@ class RobotBridge:
         elif kind == "joint_command":
             joint_command(self.lines.session(source, robot), read_joint_positions(msg))
         else:
-            await joint_trajectory(self.lines.session(source, robot), read_joint_trajectory(msg))
+            session = self.lines.session(source, robot)
+            await joint_trajectory(session, outline(msg) or read_joint_trajectory(msg))
 
     async def call_service(self, source: str, service: str, args: dict[str, Any]) -> dict[str, Any]:
         robot = self._services.get(service)

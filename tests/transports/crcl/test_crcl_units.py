@@ -106,3 +106,28 @@ def test_crcl_and_the_text_port_convert_through_one_layer() -> None:
     robot = load_robot("motoman_sia20d")
     table = UnitTable.build(robot, degrees=True)
     assert list(table.scale) == joint_factors(robot.prismatic, "meter", "degree")
+
+
+def test_a_move_throughs_waypoints_become_placements_one_by_one(monkeypatch) -> None:
+    """A ``MoveThroughTo``'s waypoints become placements as each leg asks for its own, none
+    up front (a thousand at once held the event loop some 30 ms); a placement is
+    ``pose_to_matrix``'s, and every point is checked at once: one out of range refuses
+    them all before any is made."""
+    from c2rviz.transports.crcl import motions
+
+    made: list[Pose] = []
+    real = motions.placement
+    monkeypatch.setattr(motions, "placement", lambda p, unit: (made.append(p), real(p, unit))[1])
+    down = (Vector(1.0, 0.0, 0.0), Vector(0.0, 0.0, -1.0))
+    poses = [Pose(Point(500.0, 10.0 * k, 800.0), *down) for k in range(4)]
+    targets = motions.Placements(poses, "millimeter")
+    assert len(targets) == 4 and made == []
+    assert np.array_equal(targets[2].homogeneous, pose_to_matrix(poses[2], "millimeter"))
+    assert made == [poses[2]]
+    assert [t.translation[1] for t in targets[1:3]] == pytest.approx([0.01, 0.02])
+    assert [t.translation[1] for t in targets] == pytest.approx([0.0, 0.01, 0.02, 0.03])
+    far = [*poses, Pose(Point(500.0, 2e3, 800.0), *down), Pose(Point(3e3, 0.0, 0.0), *down)]
+    made.clear()
+    with pytest.raises(CrclValueError, match=r"^Point/Y: 2000 meter is out of range"):
+        motions.Placements(far, "meter")
+    assert made == []

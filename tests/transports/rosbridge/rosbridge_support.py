@@ -62,6 +62,9 @@ class CounterBridge:
     def services(self) -> list[tuple[str, str]]:
         return [("/c2rviz/command", COMMAND_SERVICE_TYPE)]
 
+    def trajectory_joints(self) -> dict[str, tuple[str, ...]]:
+        return {}
+
     def params(self) -> dict[str, object]:
         return {"robot_description": "<robot name='counter'/>"}
 

@@ -1,7 +1,9 @@
 """Issue 35, stall 3: a frame over ``DECODE_ON_LOOP_BYTES`` is decoded, and its message
 read, in the rosbridge door's decoding process (``transports.parse_process``). Other
 clients go on meanwhile, the message is read once (there, not on the loop), and a
-decoding process that dies costs that frame an error status; the next starts anew."""
+decoding process that dies costs that frame an error status; the next starts anew. A
+large trajectory naming a joint the arm lacks is refused there: only its outline comes
+back, and its client hears what it would hear of a small one."""
 
 from __future__ import annotations
 
@@ -16,10 +18,13 @@ from typing import Any
 import pytest
 from rosbridge_support import CounterBridge, ServerThread
 from websockets.sync.client import connect
-from world_support import WAIT_S
+from websockets.sync.connection import Connection as ClientConnection
+from world_support import WAIT_S, WorldServer
 
 from c2rviz.transports.parse_process import ParseProcess
+from c2rviz.transports.rosbridge import messages
 from c2rviz.transports.rosbridge.connection import DECODE_ON_LOOP_BYTES
+from c2rviz.transports.rosbridge.inputs import joint_trajectory
 
 HUGE = 10**400  # 401 digits: JSON allows it, a float64 cannot hold it
 CALL = {"op": "call_service", "service": "/c2rviz/command"}
@@ -130,3 +135,74 @@ def test_a_decoding_process_that_dies_costs_one_frame(
         client.send(inbox(data + "next"))
         assert bridge.published.get(timeout=WAIT_S)[2] == data + "next"
     assert process.started == 2 and process.pid not in (None, first)
+
+
+def trajectory_frame(id: str, count: int, names: list[str]) -> str:
+    """A ``/joint_trajectory`` publish of ``count`` points, 10 ms apart."""
+    points = [
+        {
+            "positions": [0.1] * len(names),
+            "time_from_start": {"sec": k // 100, "nanosec": k % 100 * 10**7},
+        }
+        for k in range(1, count + 1)
+    ]
+    msg = {"joint_names": names, "points": points}
+    return json.dumps({"op": "publish", "id": id, "topic": "/joint_trajectory", "msg": msg})
+
+
+def refusal(ws: ClientConnection, frame: str) -> tuple[str, str]:
+    """The status a refused frame gets, and the error on the client's reply topic."""
+    ws.send(frame)
+    status = reply = None
+    while status is None or reply is None:
+        answer = json.loads(ws.recv(timeout=WAIT_S))
+        if answer["op"] == "status":
+            status = answer["msg"]
+        elif answer["op"] == "publish" and answer["topic"] == "/c2rviz/reply":
+            reply = answer["msg"]["data"]
+    return status, reply
+
+
+def test_a_large_trajectory_naming_a_joint_the_arm_lacks_is_refused_as_it_decodes(
+    world_server: WorldServer, monkeypatch
+) -> None:
+    """Its points never come back to the loop: the decoding process sends its outline
+    (names, count, duration), and the client hears, byte for byte, what a small frame
+    naming the same joint hears; the world notes each as refused, with its points' count."""
+    kept: list[object] = []
+    real = messages.remember
+    monkeypatch.setattr(messages, "remember", lambda m, r: (kept.append(r), real(m, r))[1])
+    names = ["joint_s", "hand"]
+    large = trajectory_frame("p", 3000, names)
+    assert len(large) > DECODE_ON_LOOP_BYTES
+    with connect(world_server.url, open_timeout=WAIT_S, max_size=None) as ws:
+        ws.send(json.dumps({"op": "subscribe", "topic": "/c2rviz/reply"}))
+        small = refusal(ws, trajectory_frame("p", 2, names))
+        assert refusal(ws, large) == small
+    expected = "publish /joint_trajectory: joint_names[1]: 'hand' is not a joint of motoman_sia20d"
+    assert small[0].startswith(expected) and small[1] == f"error: {small[0]}"
+    assert kept == [messages.TrajectoryOutline(("joint_s", "hand"), 3000, 30.0)]
+    notes = [(n.line, n.accepted) for n in world_server.notes_of("/joint_trajectory")]
+    assert notes == [
+        ("/joint_trajectory 2 points, 0.02 s", False),
+        ("/joint_trajectory 3000 points, 30 s", False),
+    ]
+
+
+def test_an_outline_whose_joints_the_arm_has_is_refused(world_server: WorldServer) -> None:
+    """An outline is only made for a trajectory naming a joint its robot lacks; were the
+    robot's joints others by the time it is served, it is still refused, never played."""
+    from c2rviz.errors import C2rvizError
+    from c2rviz.session import Session
+
+    outline = messages.TrajectoryOutline(("joint_s",), 2, 1.0)
+
+    async def serve() -> str:
+        try:
+            await joint_trajectory(Session(world_server.services, "test"), outline)
+        except C2rvizError as error:
+            return str(error)
+        return "taken"
+
+    assert "send it again" in world_server.run(serve())
+    assert world_server.notes_of("/joint_trajectory")[-1].accepted is False

@@ -8,9 +8,11 @@ import pytest
 
 from c2rviz.errors import C2rvizError
 from c2rviz.transports.rosbridge.messages import (
+    JOINT_TRAJECTORY,
     JointPositions,
     JointTrajectory,
     MessageError,
+    TrajectoryOutline,
     TrajectoryPoint,
     TypeNameError,
     command_request,
@@ -18,6 +20,7 @@ from c2rviz.transports.rosbridge.messages import (
     joint_positions,
     joint_trajectory,
     normalize_type,
+    read_ahead,
     same_type,
     string_data,
 )
@@ -99,6 +102,19 @@ def test_a_trajectory_in_seconds() -> None:
             TrajectoryPoint((0.3, 0.4), 2.25),
         ),
     )
+
+
+def test_a_trajectory_read_ahead_for_joints_it_lacks_is_its_outline() -> None:
+    """Read off the loop for a robot's joints: a trajectory naming another comes back as
+    its outline (names, count, last time), one naming only those whole; a message that
+    does not fit its type is its error, whatever it names."""
+    msg = {"joint_names": ["a", "x"], "points": [point(0.5, 0.1, 0.2), point(2.25, 0.3, 0.4)]}
+    assert read_ahead(JOINT_TRAJECTORY, msg, ("a", "b")) == TrajectoryOutline(("a", "x"), 2, 2.25)
+    assert read_ahead(JOINT_TRAJECTORY, msg, ("a", "x")) == joint_trajectory(msg)
+    assert read_ahead(JOINT_TRAJECTORY, msg) == joint_trajectory(msg)
+    msg["points"].append(point(1.0, 0.0, 0.0))
+    error = read_ahead(JOINT_TRAJECTORY, msg, ("a", "b"))
+    assert isinstance(error, MessageError) and "points[2].time_from_start" in str(error)
 
 
 def test_the_command_service() -> None:
