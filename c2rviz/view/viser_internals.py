@@ -228,12 +228,15 @@ def queue_pose(handle: Any, position: np.ndarray, wxyz: np.ndarray, force: bool 
             the server refused).
     """
     state = handle._impl
+    messages: list[Any] = []
     if force or (state.position != position).any():
         state.position[:] = position
-        state.api._queue_scene_message(_Position(state.name, tuple(state.position.tolist())))
+        messages.append(_Position(state.name, tuple(state.position.tolist())))
     if force or (state.wxyz != wxyz).any():
         state.wxyz[:] = wxyz
-        state.api._queue_scene_message(_Orientation(state.name, tuple(state.wxyz.tolist())))
+        messages.append(_Orientation(state.name, tuple(state.wxyz.tolist())))
+    if messages:
+        queue_updates(state.api, messages)
 
 
 class PoseBatch:
