@@ -36,7 +36,6 @@ from ..world.state import RobotState
 from . import adapter
 from .door_rules import RateLimitedLog
 from .page_input import Handoff
-from .robot_view import wxyz
 
 log = logging.getLogger("c2rviz.view")
 
@@ -140,7 +139,8 @@ class ToolHandles:
         if ee is None:
             ee = robot.ee_pose(state.q)
         tool = state.origin * robot.base_placement * ee * state.tool
-        adapter.queue_pose(self.nodes[name], tool.translation, wxyz(tool.rotation), force)
+        pose = pin.SE3ToXYZQUAT(tool)  # x y z, then the quaternion as x y z w
+        adapter.queue_pose(self.nodes[name], pose[:3], pose[[6, 3, 4, 5]], force)
 
     def due(self) -> set[str]:
         """The robots whose handle a drag left to be drawn (put back, or after a move)."""

@@ -114,6 +114,8 @@ class LinkTree:
     def local(self, link: TreeLink, data: pin.Data) -> pin.SE3:
         """``link``'s pose in its parent link's frame (the root link's: in the model's
         root frame), from ``data`` after ``pin.forwardKinematics``."""
+        if link.before is None and link.after is None and len(link.joints) == 1:
+            return data.liMi[link.joints[0]]  # most links: the joint's placement alone
         pose: pin.SE3 | None = None
         for j in link.joints:
             pose = data.liMi[j] if pose is None else pose * data.liMi[j]

@@ -160,6 +160,8 @@ class RobotPanel:
                 hint="move the tool to the marker clicked last (moveto marker N)",
             )
         self.chosen: Marker | None = None
+        self._shown_target: tuple[float, ...] | None = None  # every slider shows it
+        self._shown_motion: tuple[bool, float] | None = None
 
     def to_slider(self, index: int, value: float) -> float:
         """Joint value [rad or m] in slider units (deg or m), within the slider's range."""
@@ -173,15 +175,26 @@ class RobotPanel:
         return round(shown, 6)  # 30, not 29.999999999999996 (which the page shows as "30.0")
 
     def show_joints(self, target: Sequence[float], busy: Callable[[Any], bool]) -> None:
-        """Every slider to the commanded value, but those the page is moving (``busy``)."""
+        """Every slider to the commanded value, but those the page is moving (``busy``).
+
+        A target every slider shows already costs one comparison (a send of many robots
+        asks for each robot's sliders at each frame; the target changes with a command)."""
+        target = tuple(target)
+        if target == self._shown_target:
+            return
+        skipped = False
         for i, (slider, value) in enumerate(zip(self.sliders, target)):
-            if not busy(slider):
+            if busy(slider):
+                skipped = True
+            else:
                 adapter.set_gui_value(slider, self.to_slider(i, value))
+        self._shown_target = None if skipped else target
 
     def answer(self, index: int, sent: float, value: float, client: int, force: bool) -> None:
         """After the page set slider ``index`` to ``sent``: show the true ``value`` [rad or
         m] on every tab; the tab that sent it is skipped if it already shows it."""
         shown = self.to_slider(index, value)
+        self._shown_target = None  # show_joints looks at every slider again
         if shown == sent and not force:
             adapter.set_gui_value(self.sliders[index], shown, exclude_client=client)
         else:
@@ -197,6 +210,10 @@ class RobotPanel:
         adapter.set_gui_value(self.pose, text)
 
     def show_motion(self, moving: bool, seconds_left: float) -> None:
+        """``idle``, or ``moving, 1.2 s left`` (``seconds_left`` [s])."""
+        if (moving, seconds_left) == self._shown_motion:
+            return
+        self._shown_motion = (moving, seconds_left)
         text = f"moving, {seconds_left:.1f} s left" if moving else "idle"
         adapter.set_gui_value(self.motion, text)
 

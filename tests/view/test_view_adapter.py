@@ -31,7 +31,7 @@ from websockets.sync.client import ClientConnection, connect
 
 from c2rviz.app.config import LIGHTINGS
 from c2rviz.ini import normalize_origin
-from c2rviz.view import adapter
+from c2rviz.view import adapter, viser_internals
 from c2rviz.view.door_rules import DoorPolicy, DoorPolicyError, RateLimitedLog
 
 VERSION = f"viser-v{viser.__version__}"
@@ -621,6 +621,68 @@ def test_set_gui_value_sends_without_calling_back(served: Callable[..., Served])
         updates = [m for m in read_until(other, sentinel) if m["type"] == "GuiUpdateMessage"]
         assert [u["updates"] for u in updates] == [{"value": 6.0}]
     assert s.own_callbacks == []
+
+
+def test_queue_updates_leaves_viser_s_buffer_as_its_own_push_does(
+    served: Callable[..., Served],
+) -> None:
+    """The batch of pose updates (``PoseBatch``'s one pass) against viser's push one by
+    one: the same messages under the same ids, the superseded ones dropped, the same
+    indices (what a new tab is replayed, what viser's purge reads)."""
+    ours, theirs = served(), served()
+    nodes = {s: [s.server.scene.add_frame(f"/batch/{k}") for k in range(3)] for s in (ours, theirs)}
+    rounds = [
+        [("p", 0, (1.0, 2.0, 3.0)), ("o", 0, (0.0, 1.0, 0.0, 0.0)), ("o", 2, (0.5,) * 4)],
+        [("o", 0, (0.0, 0.0, 1.0, 0.0)), ("p", 1, (4.0, 5.0, 6.0)), ("o", 2, (1.0, 0, 0, 0))],
+    ]
+    make = {"p": viser_internals._Position, "o": viser_internals._Orientation}
+    for batch in rounds:
+        messages = {
+            s: [make[kind](nodes[s][k]._impl.name, value) for kind, k, value in batch]
+            for s in (ours, theirs)
+        }
+        with ours.server.atomic():
+            viser_internals.queue_updates(ours.server.scene, messages[ours])
+        with theirs.server.atomic():
+            for m in messages[theirs]:
+                theirs.server.scene._queue_scene_message(m)
+
+    def kept(s: Served) -> tuple[Any, ...]:  # the nodes' (the panels' ids are random)
+        buffer = s.server._websock_server._broadcast_buffer
+        return (
+            buffer.message_counter,
+            {
+                i: m.as_serializable_dict([])
+                for i, m in buffer.message_from_id.items()
+                if getattr(m, "name", "").startswith("/batch")
+            },
+            {k: i for k, i in buffer.id_from_redundancy_key.items() if "/batch" in k},
+            {k: v for k, v in buffer.ids_from_entity_state_key.items() if "/batch" in k[1]},
+        )
+
+    assert kept(ours) == kept(theirs)
+    with ours.connect() as ws:  # and a new tab is told the newest pose of each
+        seen = [m for m in read_until(ws, ours.sentinel()) if m.get("name") == "/batch/0"]
+        poses = [m for m in seen if m["type"] in ("SetPositionMessage", "SetOrientationMessage")]
+        assert [(m["type"], m.get("position", m.get("wxyz"))) for m in poses] == [
+            ("SetPositionMessage", [1.0, 2.0, 3.0]),
+            ("SetOrientationMessage", [0.0, 0.0, 1.0, 0.0]),
+        ]
+
+
+def test_a_fast_message_that_no_longer_matches_viser_s_fails_loudly(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The fast messages put on the wire what viser would; when a viser upgrade changes
+    its message, the check says so (before a tab is sent a message it cannot read)."""
+    adapter.check()
+    monkeypatch.setattr(
+        viser_internals._Orientation,
+        "as_serializable_dict",
+        lambda self, buffers=None: {"name": self.name, "type": "SetOrientationMessage"},
+    )
+    with pytest.raises(adapter.ViserInternalsError, match="SetOrientationMessage as c2rviz"):
+        adapter.check()
 
 
 # 8. the version check

@@ -20,6 +20,7 @@ from support import load_robot
 from viewer_tabs import Harness, Tab
 
 from c2rviz.view import adapter, scene_send, viser_scene
+from c2rviz.view import panel as panel_module
 from c2rviz.view.panel import READOUT_HZ, READOUTS_PER_S
 from c2rviz.view.plots import PLOT_HZ, PLOTS_PER_S
 from c2rviz.view.scene_send import REST_PER_WORK, SendScheduler
@@ -206,3 +207,41 @@ def test_a_moving_arm_is_sent_orientations_only(cell: Callable[..., Harness]) ->
     kinds = [m["type"] for m in list(tab.received)[seen:] if m.get("name") in links]
     assert "SetOrientationMessage" in kinds
     assert "SetPositionMessage" not in kinds
+
+
+def test_a_panel_sends_its_sliders_only_when_the_target_moves(
+    cell: Callable[..., Harness],
+) -> None:
+    """A send of many robots asks each panel for its sliders at every frame: a target
+    they show already sends nothing, and a slider left alone while the page moved it
+    (busy) is set once it is free, though the target has not moved since."""
+    h = cell(count=1)
+    panel = h.scene.panels["r0"]
+    sent: list[tuple[Any, Any]] = []
+    real = adapter.set_gui_value
+
+    def spy(handle: Any, value: Any, **kwargs: Any) -> bool:
+        if real(handle, value, **kwargs):
+            sent.append((handle, value))
+            return True
+        return False
+
+    target = (0.5, -0.25, 0.3, 0.75, -0.4, 0.1, 0.2)
+
+    def run() -> None:
+        original = panel_module.adapter.set_gui_value
+        panel_module.adapter.set_gui_value = spy  # type: ignore[assignment]
+        try:
+            first = panel.sliders[0]
+            panel.show_joints(target, lambda slider: slider is first)  # the page holds 0
+            assert [handle for handle, _ in sent] == panel.sliders[1:]
+            sent.clear()
+            panel.show_joints(target, lambda slider: False)  # free now: 0 is set
+            assert sent == [(first, panel.to_slider(0, target[0]))]
+            sent.clear()
+            panel.show_joints(list(target), lambda slider: False)
+            assert sent == []
+        finally:
+            panel_module.adapter.set_gui_value = original  # type: ignore[assignment]
+
+    h.call(run)
