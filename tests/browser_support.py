@@ -89,8 +89,17 @@ class FreshContexts:
         self._contexts: list[Any] = []
         self._loop: asyncio.AbstractEventLoop | None = asyncio._get_running_loop()
 
-    def new_context(self, **options: Any) -> Any:
+    def _context(self, **options: Any) -> Any:
+        """A new context whose actions (a click waits for its button to be visible and
+        still, a ``fill`` for its box) wait as long as the tests' own waits: Playwright's
+        30 s default ran out once on a 2-core machine at load 13, a recorded page's button
+        not yet still."""
         context = self._browser.new_context(**options)
+        context.set_default_timeout(DEADLINE_S * 1000)
+        return context
+
+    def new_context(self, **options: Any) -> Any:
+        context = self._context(**options)
         self._contexts.append(context)
         return context
 
@@ -100,7 +109,7 @@ class FreshContexts:
     def lasting_page(self, **options: Any) -> Any:
         """A page in a context of its own that outlives the test (``close_contexts`` leaves
         it): for a ``LastingProgram``, closed by its owner."""
-        return self._browser.new_context(**options).new_page()
+        return self._context(**options).new_page()
 
     def unmark(self) -> None:
         asyncio._set_running_loop(None)
