@@ -195,6 +195,7 @@ class Connection(asyncio.Protocol):
         run = session.run
         batch = session.set_joints_batch
         skip_to = 0
+        count = len(lines)
         started = time.perf_counter()
         for i, line in enumerate(lines):
             if i < skip_to:
@@ -209,7 +210,7 @@ class Connection(asyncio.Protocol):
                 if self.halted and not self.eof and is_stop(line):
                     self.halted = False  # its turn: the plans sent after it run
                     session.services.worker.go_on(session)
-                if line.startswith(BATCHED):
+                if line.startswith(BATCHED) and i + 1 < count:  # a run needs two lines
                     taken = batch(lines, i)
                     if taken:
                         skip_to = i + taken
