@@ -22,11 +22,8 @@ from . import replies
 Line = str | C2rvizError
 """A decoded line (without its ``\\n``), or why it could not be one."""
 
-BATCH_BYTES = 65536
-"""Complete lines handed out per batch [bytes]. The text port answers a batch with one
-write, and ends a client's turn after ``transports.tcp_reading.TURN_S`` of work anyway:
-8 KiB batches cost a pipelining client a write and a pause of its reading per ~160
-``joints`` lines (issue 40)."""
+BATCH_BYTES = 8192
+"""Complete lines handed out per batch [bytes]."""
 
 
 class LineFramer:
