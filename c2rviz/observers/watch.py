@@ -378,3 +378,6 @@ class WatchHub(Observer):
 
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         self.cameras.wake()
+
+    def on_commands(self, source: str, lines: Sequence[str]) -> None:
+        self.cameras.wake()  # once is enough: the first wakes the parked cameras

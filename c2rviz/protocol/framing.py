@@ -23,7 +23,10 @@ Line = str | C2rvizError
 """A decoded line (without its ``\\n``), or why it could not be one."""
 
 BATCH_BYTES = 8192
-"""Complete lines handed out per batch [bytes]."""
+"""Complete lines handed out per batch [bytes]. The text port answers a batch with one
+write, and the write is where viser's thread gets the interpreter's lock: 64 KiB batches
+cost a pipelining client ~10% less CPU but the page 20-30% of its frames during a flood
+(issue 40, docs/benchmarks.md), so they stay at 8 KiB while the page shares the process."""
 
 
 class LineFramer:

@@ -30,6 +30,7 @@ that names it (docs/limits.md lists them).
 from __future__ import annotations
 
 import difflib
+import itertools
 import math
 import re
 from collections.abc import Sequence
@@ -100,12 +101,16 @@ def numbers(verb: str, text: str) -> tuple[float, ...]:
 
 
 def numbers_batch(texts: Sequence[str], n: int) -> list[float] | None:
-    """The values of several comma lists of exactly ``n`` decimals each, read in one go: the
-    hot path of a controller streaming ``joints`` lines. None when any list is not plainly
-    that (its line is then parsed alone, by ``numbers``, which says what is wrong)."""
+    """The values of several comma lists of exactly ``n`` decimals each (each may end in
+    the ``\r`` of a CRLF line), read in one go: the hot path of a controller streaming
+    ``joints`` lines. None when any list is not plainly that (its line is then parsed
+    alone, by ``numbers``, which says what is wrong)."""
     joined = ",".join(texts)
-    commas = n - 1
-    if _NUMBER_CHARS_RE.fullmatch(joined) is None or any(t.count(",") != commas for t in texts):
+    if "\r" in joined:
+        joined = ",".join([t.removesuffix("\r") for t in texts])
+    if _NUMBER_CHARS_RE.fullmatch(joined) is None:
+        return None
+    if list(map(str.count, texts, itertools.repeat(","))).count(n - 1) != len(texts):
         return None
     try:
         return list(map(float, joined.split(",")))  # as ``numbers``: float() judges them

@@ -125,10 +125,7 @@ def recorded(session: Session, said: str | Said | None, act: Callable[[], Reply]
 
 def taken_all(session: Session, texts: Sequence[str], reply: str) -> None:
     """``texts`` were all taken at once, each answered ``reply`` (a run of ``joints`` lines)."""
-    world, source = session.world, session.source
-    for text in texts:
-        world.note(source, text, True)
-        world.replied(source, text, reply)
+    session.world.taken(session.source, texts, reply)
 
 
 def taken(session: Session, text: str, reply: Reply) -> Reply:

@@ -171,7 +171,7 @@ class Session(UnitEdge, Modes):
             texts.append(line)
         if len(texts) < 2:
             return 0
-        flat = numbers_batch([t[t.index(" ") + 1 :].removesuffix("\r") for t in texts], self.n)
+        flat = numbers_batch([t.partition(" ")[2] for t in texts], self.n)
         table = self.table
         if flat is None or not table.within(flat):
             return 0

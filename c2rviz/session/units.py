@@ -11,7 +11,6 @@ A door's own names for its units (CRCL's ``millimeter``, ``footPound``) stay wit
 
 from __future__ import annotations
 
-import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -75,10 +74,15 @@ class UnitTable:
     def within(self, values: Sequence[float]) -> bool:
         """Every value is finite and within its joint's limits; ``values`` may hold several
         configurations one after the other (checked in C: the hot path)."""
-        return (
-            math.isfinite(sum(values))
-            and all(map(le, itertools.cycle(self.lower), values))
-            and all(map(le, values, itertools.cycle(self.upper)))
+        if not math.isfinite(sum(values)):
+            return False
+        lower, upper = self.lower, self.upper
+        n = len(lower)
+        if len(values) <= n:
+            return all(map(le, lower, values)) and all(map(le, values, upper))
+        # Several: each joint's column at once (its least and greatest value).
+        return all(
+            lower[j] <= min(values[j::n]) and max(values[j::n]) <= upper[j] for j in range(n)
         )
 
     def to_si(self, values: Sequence[float]) -> Sequence[float]:

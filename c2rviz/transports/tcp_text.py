@@ -18,7 +18,7 @@ import asyncio
 import logging
 import time
 from collections.abc import Awaitable, Sequence
-from itertools import chain
+from itertools import chain, islice
 from typing import Protocol
 
 from ..errors import C2rvizError, LineTooLong
@@ -194,11 +194,10 @@ class Connection(asyncio.Protocol):
         session = self.session
         run = session.run
         batch = session.set_joints_batch
-        skip_to = 0
+        count = len(lines)
         started = time.perf_counter()
-        for i, line in enumerate(lines):
-            if i < skip_to:
-                continue  # answered as part of a run of plain `joints` lines
+        numbered = enumerate(lines)
+        for i, line in numbered:
             if i % _TURN_CHECK == _TURN_CHECK - 1 and time.perf_counter() - started > TURN_S:
                 self._write(out)
                 self._yield(lines[i:])
@@ -209,10 +208,10 @@ class Connection(asyncio.Protocol):
                 if self.halted and not self.eof and is_stop(line):
                     self.halted = False  # its turn: the plans sent after it run
                     session.services.worker.go_on(session)
-                if line.startswith(BATCHED):
+                if line.startswith(BATCHED) and i + 1 < count:  # a run needs two lines
                     taken = batch(lines, i)
-                    if taken:
-                        skip_to = i + taken
+                    if taken:  # the lines after it were answered with it: skip them
+                        next(islice(numbered, taken - 1, taken - 1), None)
                         out.extend([replies.OK] * taken)
                         continue
                 answer = run(line)

@@ -59,6 +59,12 @@ class Observer:
     def on_command(self, source: str, line: str, accepted: bool) -> None:
         """``source`` sent ``line``; ``accepted`` False if it was refused."""
 
+    def on_commands(self, source: str, lines: Sequence[str]) -> None:
+        """``source`` sent ``lines``, all taken at once (a run of ``joints`` lines): as
+        ``on_command`` for each, in order (an observer may do it once for them all)."""
+        for line in lines:
+            self.on_command(source, line, True)
+
     def on_reply(self, source: str, line: str, reply: str) -> None:
         """``source``'s ``line`` got ``reply`` (its text, errors too), once known: at once,
         or when a reply that waits comes (a move's on arrival); not if it never came."""
@@ -96,6 +102,16 @@ class Observer:
 
     def on_cameras(self, cameras: Sequence[Camera]) -> None:
         """The logical cameras are now ``cameras`` (poses in the world frame)."""
+
+
+def hears(observer: Observer) -> str:
+    """What of a command line ``observer`` does something with (its class overrides the
+    no-op): ``both`` (the line and its reply), ``commands``, ``replies`` or ``""``."""
+    kind = type(observer)
+    commands = kind.on_command is not Observer.on_command
+    commands = commands or kind.on_commands is not Observer.on_commands
+    replies = kind.on_reply is not Observer.on_reply
+    return "both" if commands and replies else "commands" if commands else replies * "replies"
 
 
 class Scene(Observer):

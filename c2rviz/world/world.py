@@ -33,7 +33,7 @@ from .fault_rules import FaultRules
 from .grips import Grips
 from .live_collisions import Contacts
 from .moves import Travel, Travels
-from .observer import Observer
+from .observer import Observer, hears
 from .part_world import WorldParts
 from .state import Marker, RobotState
 
@@ -83,10 +83,7 @@ class World:
             dict(disabled_pairs or {}),
             max_objects,
         )
-        self.observers: list[Observer] = [self.contacts]
-        if scene is not None:
-            self.observers.append(scene)
-        self._repliers = _repliers(self.observers)  # those that keep replies (recordings)
+        self.observers = [self.contacts] if scene is None else [self.contacts, scene]
         self.travels = Travels(self._show, self._rested, self.clock, self.frame_s, self._planned)
         for name, state in self.robots.items():
             self.travels.add(state, (limits or {}).get(name) or motion_limits(state.robot))
@@ -102,6 +99,21 @@ class World:
         """The logical cameras (``cameras.py``; what one sees: ``sight`` below)."""
         self.faults.parts, self.parts.slips = self.parts, self.faults.slips  # drop, slip
         self.faults.cameras = self.cameras  # blackout
+
+    @property
+    def observers(self) -> list[Observer]:
+        """Who hears the world's effects, in order (``add_observers``, ``remove_observer``;
+        a new list may be assigned)."""
+        return self._observers
+
+    @observers.setter
+    def observers(self, observers: list[Observer]) -> None:
+        self._observers = observers
+        # Those that do something with a line or its reply: most lines reach no other.
+        heard = [(o, hears(o)) for o in observers]
+        self._commanders = [o for o, what in heard if what in ("both", "commands")]
+        self._repliers = [o for o, what in heard if what in ("both", "replies")]
+        self._takers = [(o, what) for o, what in heard if what]
 
     def state(self, name: str | None = None) -> RobotState:
         """The robot called ``name`` (the default robot for None)."""
@@ -174,7 +186,7 @@ class World:
         """The robot is seen at ``q`` at time ``t``: tell every observer."""
         state.q = q
         self.parts.moved(state.name, q)
-        for observer in self.observers:
+        for observer in self._observers:
             observer.on_joints(state.name, q, t)
 
     def _show_opening(self, state: RobotState, opening: float, t: float) -> None:
@@ -312,7 +324,7 @@ class World:
 
     def note(self, source: str, line: str, accepted: bool) -> None:
         """``source`` sent ``line``; tell the observers (a 'last commands' readout)."""
-        for observer in self.observers:
+        for observer in self._commanders:
             observer.on_command(source, line, accepted)
 
     def replied(self, source: str, line: str, reply: str) -> None:
@@ -320,18 +332,28 @@ class World:
         for observer in self._repliers:  # most lines: none, so this costs next to nothing
             observer.on_reply(source, line, reply)
 
+    def taken(self, source: str, lines: Sequence[str], reply: str) -> None:
+        """``source``'s ``lines`` were all taken, each answered ``reply`` (a run of ``joints``
+        lines): each observer hears what ``note`` and ``replied`` per line would tell it (all
+        at once through ``on_commands`` if it does nothing with replies)."""
+        for observer, what in self._takers:
+            if what == "both":
+                for line in lines:
+                    observer.on_command(source, line, True)
+                    observer.on_reply(source, line, reply)
+            elif what == "commands":
+                observer.on_commands(source, lines)
+            else:
+                for line in lines:
+                    observer.on_reply(source, line, reply)
+
     def add_observers(self, observers: Iterable[Observer]) -> None:
-        self.observers.extend(observers)
-        self._repliers = _repliers(self.observers)
+        self.observers = [*self._observers, *observers]
 
     def remove_observer(self, observer: Observer) -> None:
-        self.observers.remove(observer)
-        self._repliers = _repliers(self.observers)
-
-
-def _repliers(observers: Sequence[Observer]) -> list[Observer]:
-    """The observers that do something with ``on_reply``."""
-    return [o for o in observers if type(o).on_reply is not Observer.on_reply]
+        observers = list(self._observers)
+        observers.remove(observer)
+        self.observers = observers
 
 
 def occluders(world: World) -> list[Occluder]:
