@@ -154,7 +154,10 @@ def test_a_long_window_is_thinned_and_the_tool_speed_is_plotted(harness) -> None
     assert samples > PLOT_POINTS  # seconds of motion at 100 frames a second
     assert len(plots.positions.data[0]) <= PLOT_POINTS
     speed = plots.tool_speed.data[1]
-    assert speed.max() > 0.1 and speed[-1] < 1e-3  # fast on the way, at rest at the end
+    # fast on the way, all but at rest at the end: the last point is the mean speed over
+    # the last frame's interval before arrival, which a busy machine stretches (0.014 m/s
+    # against a peak of 0.8 once at load 6; under 1e-3 at 100 frames a second)
+    assert speed.max() > 0.1 and speed[-1] < 0.05 * speed.max()
     assert plots.speeds.visible  # moves take time: velocities shown
     assert np.abs(plots.speeds.data[1]).max() > 10.0  # joint_s swung at tens of deg/s
 
