@@ -352,15 +352,20 @@ def _read_status(sock: socket.socket) -> bytes:
 
 
 def document_flood(program: Program, size: int, clients: int, each: int) -> Callable[[], None]:
-    """``clients`` CRCL connections each sending ``each`` documents of about ``size``
-    bytes (a ``Message`` with a long text) and reading the status after each."""
-    filler = base64.b64encode(os.urandom(size * 3 // 4 + 3)).decode()[:size]
-    doc = (
+    """``clients`` CRCL connections each sending ``each`` documents of ``size`` bytes in
+    all (a ``Message`` with a long text: 1 MiB is the door's largest; a filler of ``size``
+    made the document a little larger, and the door closed each connection at once) and
+    reading the status after each."""
+    head = (
         '<?xml version="1.0" encoding="UTF-8"?>\n<CRCLCommandInstance xmlns:xsi='
         '"http://www.w3.org/2001/XMLSchema-instance">\n  <CRCLCommand xsi:type="MessageType">'
-        f"\n    <CommandID>7</CommandID>\n    <Message>{filler}</Message>\n  </CRCLCommand>\n"
-        "</CRCLCommandInstance>\n"
-    ).encode()
+        "\n    <CommandID>7</CommandID>\n    <Message>"
+    )
+    tail = "</Message>\n  </CRCLCommand>\n</CRCLCommandInstance>\n"
+    room = size - len(head) - len(tail)
+    filler = base64.b64encode(os.urandom(room * 3 // 4 + 3)).decode()[:room]
+    doc = (head + filler + tail).encode()
+    assert len(doc) == size
 
     def one() -> None:
         sock = socket.create_connection(("127.0.0.1", program.crcl), timeout=120)
